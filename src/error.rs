@@ -1,0 +1,50 @@
+//! Typed errors for bad input: they name what is wrong and never panic.
+
+use thiserror::Error;
+
+/// What can be wrong with a cloth description.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum ClothError {
+    /// A number outside its allowed range (or not finite).
+    #[error("`{field}` must be {expected}, got {value}")]
+    InvalidParameter {
+        /// The field, as written in a scene file.
+        field: &'static str,
+        /// The value given.
+        value: f32,
+        /// What is allowed.
+        expected: &'static str,
+    },
+    /// A grid needs at least 2×2 particles to have a spring and a face.
+    #[error("a grid cloth needs at least 2×2 particles, got {width}×{height}")]
+    GridTooSmall {
+        /// Particles across.
+        width: u32,
+        /// Particles down.
+        height: u32,
+    },
+    /// A grid so large it would not fit in memory or in 32-bit indices.
+    #[error("a grid of {width}×{height} particles is larger than the limit of {limit}")]
+    GridTooLarge {
+        /// Particles across.
+        width: u32,
+        /// Particles down.
+        height: u32,
+        /// The largest particle count allowed.
+        limit: usize,
+    },
+    /// A pin names a particle that does not exist.
+    #[error("pin index {index} is out of range: the cloth has {count} particles")]
+    PinOutOfRange {
+        /// The pin index given.
+        index: u32,
+        /// How many particles the cloth has.
+        count: usize,
+    },
+    /// A mesh given as a cloth has no usable triangles or positions.
+    #[error("the mesh cannot be a cloth: {reason}")]
+    BadMesh {
+        /// What is missing.
+        reason: String,
+    },
+}

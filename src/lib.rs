@@ -1,0 +1,56 @@
+//! # bevy_cloth
+//!
+//! Cloth simulation for Bevy on the CPU: the mass-spring model of the 2014 thesis
+//! "Model elastične tkanine" (seed 000) and the BMSTU T-shirt course work (seed 002),
+//! with a measured solver that runs the same way in a game, a test and a benchmark.
+//!
+//! Add [`ClothPlugin`](plugin::ClothPlugin) and spawn a [`Cloth`](components::Cloth):
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use bevy_cloth::prelude::*;
+//!
+//! fn main() {
+//!     App::new()
+//!         .add_plugins((DefaultPlugins, ClothPlugin::default()))
+//!         .add_systems(Startup, setup)
+//!         .run();
+//! }
+//!
+//! fn setup(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
+//!     commands.spawn((
+//!         Cloth::grid(32, 32, 0.05).with_pins(Pins::TopCorners),
+//!         MeshMaterial3d(materials.add(StandardMaterial { double_sided: true, cull_mode: None, ..default() })),
+//!         Transform::from_xyz(0.0, 2.0, 0.0),
+//!     ));
+//! }
+//! ```
+//!
+//! Layers, top to bottom: [`scene`] files and Rust builders → [`components::Cloth`]
+//! (plain data) → [`solver::Cloth`] (pure Rust, no ECS) → [`plugin`] (systems, mesh
+//! write-back).
+#![forbid(unsafe_code)]
+#![warn(missing_docs)]
+
+pub mod components;
+pub mod error;
+pub mod mesh;
+pub mod params;
+pub mod plugin;
+pub mod scene;
+pub mod shape;
+pub mod solver;
+
+/// The types a user needs to add cloth to an app.
+pub mod prelude {
+    pub use crate::components::{
+        Cloth, ClothEnvironment, ClothInvalid, ClothPaused, ClothSimulation, ClothTorn,
+    };
+    pub use crate::error::ClothError;
+    pub use crate::params::{
+        ClothParams, Environment, Integrator, SpringFamily, SpringParams, Substeps, Wind, WindField,
+    };
+    pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSystems};
+    pub use crate::scene::{ClothScene, SceneCloth, SceneError};
+    pub use crate::shape::{ClothShape, Pins};
+}

@@ -1,0 +1,115 @@
+//! The cloth's render mesh: built once, then rewritten in place after each fixed step.
+
+use bevy::asset::RenderAssetUsages;
+use bevy::math::Vec3;
+use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
+
+use crate::error::ClothError;
+use crate::solver;
+
+/// A mesh with one vertex per particle (positions in the cloth's local frame), smooth
+/// normals, UVs and the visible triangles. `uvs` defaults to the grid's `(i/(w−1), j/(h−1))`.
+pub fn cloth_mesh(cloth: &solver::Cloth, uvs: Option<Vec<[f32; 2]>>) -> Mesh {
+    let n = cloth.particle_count();
+    let uvs = uvs
+        .filter(|u| u.len() == n)
+        .unwrap_or_else(|| match cloth.grid_size() {
+            Some((w, h)) => (0..n as u32)
+                .map(|k| {
+                    let (i, j) = (k % w, k / w);
+                    [i as f32 / (w - 1) as f32, j as f32 / (h - 1) as f32]
+                })
+                .collect(),
+            None => vec![[0.0, 0.0]; n],
+        });
+    let mut mesh = Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, vec![[0.0f32; 3]; n])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0f32, 0.0, 1.0]; n])
+    .with_inserted_attribute(Mesh::ATTRIBUTE_UV_0, uvs)
+    .with_inserted_indices(Indices::U32(Vec::new()));
+    let mut normals = vec![Vec3::ZERO; n];
+    write_mesh(&mut mesh, cloth, &mut normals, true);
+    mesh
+}
+
+/// Writes positions and normals into the mesh's existing buffers (no new buffers), and
+/// the index buffer too when `faces_changed` (a spring tore, or the mesh is new).
+/// Positions are written in the cloth's frame, so the entity's transform places them.
+pub fn write_mesh(
+    mesh: &mut Mesh,
+    cloth: &solver::Cloth,
+    normals: &mut [Vec3],
+    faces_changed: bool,
+) {
+    let to_local = cloth.frame().inverse();
+    cloth.normals_into(normals);
+    if let Some(VertexAttributeValues::Float32x3(out)) =
+        mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
+    {
+        for (o, x) in out.iter_mut().zip(cloth.positions()) {
+            *o = to_local.transform_point3(*x).to_array();
+        }
+    }
+    if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_NORMAL)
+    {
+        for (o, n) in out.iter_mut().zip(normals.iter()) {
+            *o = to_local
+                .transform_vector3(*n)
+                .normalize_or(Vec3::Z)
+                .to_array();
+        }
+    }
+    if faces_changed {
+        let visible = cloth.triangle_visible();
+        let indices: Vec<u32> = cloth
+            .triangles()
+            .iter()
+            .zip(visible)
+            .filter(|(_, v)| **v)
+            .flat_map(|(t, _)| *t)
+            .collect();
+        mesh.insert_indices(Indices::U32(indices));
+    }
+}
+
+/// What a mesh-shaped cloth takes from its source mesh.
+#[derive(Clone, Debug, Default)]
+pub struct MeshSource {
+    /// Vertex positions in the mesh's frame.
+    pub positions: Vec<Vec3>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// UVs, when the mesh has them.
+    pub uvs: Option<Vec<[f32; 2]>>,
+}
+
+/// Reads a triangle-list mesh's positions, triangles and UVs, for a mesh-shaped cloth.
+pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
+    let bad = |reason: &str| ClothError::BadMesh {
+        reason: reason.to_string(),
+    };
+    if mesh.primitive_topology() != PrimitiveTopology::TriangleList {
+        return Err(bad("only triangle lists can be cloth"));
+    }
+    let positions: Vec<Vec3> = match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
+        Some(VertexAttributeValues::Float32x3(p)) => p.iter().map(|&p| Vec3::from(p)).collect(),
+        _ => return Err(bad("it has no Float32x3 positions")),
+    };
+    let flat: Vec<u32> = match mesh.indices() {
+        Some(indices) => indices.iter().map(|i| i as u32).collect(),
+        None => (0..positions.len() as u32).collect(),
+    };
+    let triangles = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let uvs = match mesh.attribute(Mesh::ATTRIBUTE_UV_0) {
+        Some(VertexAttributeValues::Float32x2(uv)) => Some(uv.clone()),
+        _ => None,
+    };
+    Ok(MeshSource {
+        positions,
+        triangles,
+        uvs,
+    })
+}

@@ -1,0 +1,368 @@
+//! Plain-data model parameters shared by the solver, the ECS layer and scene files.
+//!
+//! Everything here is `Reflect` (so the inspector can edit it) and `serde` (so scene
+//! files can hold it). Nothing here knows about the ECS.
+
+use bevy::math::Vec3;
+use bevy::reflect::Reflect;
+use serde::{Deserialize, Serialize};
+
+use crate::error::ClothError;
+
+/// Serde for `Vec3` as a `(x, y, z)` tuple, so scene files can hold vectors without
+/// turning on serde for the whole of Bevy.
+pub mod vec3_serde {
+    use bevy::math::Vec3;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes `(x, y, z)`.
+    pub fn serialize<S: Serializer>(v: &Vec3, s: S) -> Result<S::Ok, S::Error> {
+        (v.x, v.y, v.z).serialize(s)
+    }
+
+    /// Reads `(x, y, z)`.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Vec3, D::Error> {
+        let (x, y, z) = <(f32, f32, f32)>::deserialize(d)?;
+        Ok(Vec3::new(x, y, z))
+    }
+}
+
+/// One family of springs (seed 000 §2.2, Slika 1): whether it exists and how stiff it is.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SpringFamily {
+    /// Switch the whole family off (seed 000 §4, Slika 18–20 show cloth without each family).
+    pub enabled: bool,
+    /// Hooke constant `k` in N/m (seed 002 eq. 1.4).
+    pub stiffness: f32,
+}
+
+impl Default for SpringFamily {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            stiffness: 100.0,
+        }
+    }
+}
+
+impl SpringFamily {
+    /// An enabled family with the given stiffness.
+    pub fn new(stiffness: f32) -> Self {
+        Self {
+            enabled: true,
+            stiffness,
+        }
+    }
+
+    /// A switched-off family (keeps its stiffness so switching it back on restores it).
+    pub fn off(stiffness: f32) -> Self {
+        Self {
+            enabled: false,
+            stiffness,
+        }
+    }
+
+    /// The stiffness that acts: 0 when switched off.
+    pub fn effective(&self) -> f32 {
+        if self.enabled { self.stiffness } else { 0.0 }
+    }
+}
+
+/// The four spring families of a grid cloth and the damping along springs.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SpringParams {
+    /// Horizontal and vertical neighbours (i±1, j±1), rest length = spacing.
+    pub structural: SpringFamily,
+    /// Diagonal neighbours, rest length = √2·spacing.
+    pub shear: SpringFamily,
+    /// Every second particle (i±2, j±2), rest length = 2·spacing.
+    pub bend: SpringFamily,
+    /// Every second particle diagonally, rest length = 2√2·spacing (seed 000 §2.2, optional).
+    pub bend_diagonal: SpringFamily,
+    /// Damping along each spring in N·s/m: `F = c ((v_b − v_a)·d̂) d̂`.
+    pub damping: f32,
+}
+
+impl Default for SpringParams {
+    /// Seed 000 §4: a structural:shear:bend ratio of 2:1:1 "gives good results".
+    fn default() -> Self {
+        Self {
+            structural: SpringFamily::new(200.0),
+            shear: SpringFamily::new(100.0),
+            bend: SpringFamily::new(100.0),
+            bend_diagonal: SpringFamily::off(50.0),
+            damping: 0.0,
+        }
+    }
+}
+
+impl SpringParams {
+    /// All families from one structural stiffness with the seed's 2:1:1 ratio.
+    pub fn from_structural(stiffness: f32) -> Self {
+        Self {
+            structural: SpringFamily::new(stiffness),
+            shear: SpringFamily::new(stiffness * 0.5),
+            bend: SpringFamily::new(stiffness * 0.5),
+            bend_diagonal: SpringFamily::off(stiffness * 0.25),
+            damping: 0.0,
+        }
+    }
+}
+
+/// How positions advance in time.
+///
+/// For a fixed step `h` the two are the same recurrence in exact arithmetic:
+/// `x_{n+1} − x_n = x_n − x_{n−1} + a h²` is `v_{n+1} = v_n + a h, x_{n+1} = x_n + v_{n+1} h`
+/// with `v_n = (x_n − x_{n−1})/h`. They differ in rounding (Verlet recovers velocity as a
+/// difference of positions, which loses digits in `f32` at tiny `h`) and in how a change of
+/// `h` is handled (Verlet must rescale its implicit velocity; see `Cloth::begin_step`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
+pub enum Integrator {
+    /// Position Verlet, seed 002 eq. 1.12: `x' = 2x − x_prev + a h²`.
+    #[default]
+    Verlet,
+    /// Semi-implicit (symplectic) Euler, seed 000 eq. 21–22: `v' = v + a h`, `x' = x + v' h`.
+    SemiImplicitEuler,
+}
+
+/// How many substeps one fixed step is split into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Reflect, Serialize, Deserialize)]
+pub enum Substeps {
+    /// Exactly this many substeps (at least 1).
+    Fixed(u32),
+    /// As many as the explicit stability bound asks for (see `Cloth::stable_substeps`),
+    /// at least 1 and at most `max`.
+    Auto {
+        /// Upper limit; a cloth that would need more is reported as under-resolved.
+        max: u32,
+    },
+}
+
+impl Default for Substeps {
+    fn default() -> Self {
+        Substeps::Auto { max: 8192 }
+    }
+}
+
+/// Parameters of the mass-spring model of one cloth. Edits take effect on the next step.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClothParams {
+    /// Mass of one particle in kg (seed 002 §1.4: 0.001–1 g, i.e. 1e-6–1e-3 kg).
+    pub node_mass: f32,
+    /// Spring families and spring damping.
+    pub springs: SpringParams,
+    /// Linear air drag per particle in N·s/m: `F = −c v` (seed 000 eq. 31, seed 002 eq. 1.5).
+    pub drag: f32,
+    /// The time integrator.
+    pub integrator: Integrator,
+    /// Substeps per fixed step.
+    pub substeps: Substeps,
+    /// Provot (1995) strain limit: springs longer than `(1 + limit)·rest` are shortened
+    /// after each substep. `None` switches it off.
+    pub strain_limit: Option<f32>,
+    /// Gauss–Seidel sweeps of the strain limiter per substep.
+    pub strain_limit_iterations: u32,
+    /// A spring longer than `tear_ratio · rest_length` breaks (seed 000 §3.2). `None`: never.
+    pub tear_ratio: Option<f32>,
+}
+
+impl Default for ClothParams {
+    fn default() -> Self {
+        Self {
+            node_mass: 0.5e-3,
+            springs: SpringParams::default(),
+            drag: 0.5e-3,
+            integrator: Integrator::Verlet,
+            substeps: Substeps::default(),
+            strain_limit: Some(0.1),
+            strain_limit_iterations: 2,
+            tear_ratio: None,
+        }
+    }
+}
+
+fn check(
+    field: &'static str,
+    value: f32,
+    ok: bool,
+    expected: &'static str,
+) -> Result<(), ClothError> {
+    if ok && value.is_finite() {
+        Ok(())
+    } else {
+        Err(ClothError::InvalidParameter {
+            field,
+            value,
+            expected,
+        })
+    }
+}
+
+impl ClothParams {
+    /// Checks every value; the error names the field.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        check(
+            "node_mass",
+            self.node_mass,
+            self.node_mass > 0.0,
+            "a positive mass in kg",
+        )?;
+        let s = &self.springs;
+        for (field, family) in [
+            ("springs.structural.stiffness", s.structural),
+            ("springs.shear.stiffness", s.shear),
+            ("springs.bend.stiffness", s.bend),
+            ("springs.bend_diagonal.stiffness", s.bend_diagonal),
+        ] {
+            check(
+                field,
+                family.stiffness,
+                family.stiffness >= 0.0,
+                "a stiffness ≥ 0 N/m",
+            )?;
+        }
+        check(
+            "springs.damping",
+            s.damping,
+            s.damping >= 0.0,
+            "a damping ≥ 0 N·s/m",
+        )?;
+        check("drag", self.drag, self.drag >= 0.0, "a drag ≥ 0 N·s/m")?;
+        match self.substeps {
+            Substeps::Fixed(0) => {
+                return Err(ClothError::InvalidParameter {
+                    field: "substeps",
+                    value: 0.0,
+                    expected: "at least 1 substep",
+                });
+            }
+            Substeps::Auto { max: 0 } => {
+                return Err(ClothError::InvalidParameter {
+                    field: "substeps.max",
+                    value: 0.0,
+                    expected: "at least 1 substep",
+                });
+            }
+            _ => {}
+        }
+        if let Some(limit) = self.strain_limit {
+            check("strain_limit", limit, limit > 0.0, "a strain limit > 0")?;
+        }
+        if let Some(ratio) = self.tear_ratio {
+            check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
+        }
+        Ok(())
+    }
+}
+
+/// The spatial pattern of the wind.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
+pub enum WindField {
+    /// The same force on every particle: `F = strength · d̂` (seed 000 §3.2).
+    #[default]
+    Constant,
+    /// Seed 002 listing 3.3: gusts from trigonometric functions of position and time.
+    /// With `d̂ = +z` and strength 0.1 this is the listing's
+    /// `(0.1 sin(10t), ·, 0.1 |sin(z + 10t)|)`; the listing's middle (y) line is missing
+    /// from the seed text, so the vertical component here is 0.
+    Trigonometric,
+}
+
+/// Wind as a direction, a strength (N per particle) and a field.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Wind {
+    /// Where the wind blows to; normalised when used (a zero vector means no wind).
+    #[serde(with = "vec3_serde")]
+    pub direction: Vec3,
+    /// Force per particle in N.
+    pub strength: f32,
+    /// Spatial and temporal pattern.
+    pub field: WindField,
+}
+
+impl Default for Wind {
+    fn default() -> Self {
+        Self {
+            direction: Vec3::Z,
+            strength: 0.0,
+            field: WindField::Constant,
+        }
+    }
+}
+
+impl Wind {
+    /// Wind force on a particle at `position` at simulated time `time`.
+    #[inline]
+    pub fn force_at(&self, position: Vec3, time: f32) -> Vec3 {
+        let d = self.direction.normalize_or_zero();
+        match self.field {
+            WindField::Constant => d * self.strength,
+            WindField::Trigonometric => {
+                // Seed 002 listing 3.3, rotated so that the listing's +z is `d`.
+                let side = Vec3::Y.cross(d).normalize_or(Vec3::X);
+                let phase = 10.0 * time;
+                let along = (position.dot(d) + phase).sin().abs();
+                let across = phase.sin();
+                self.strength * (along * d + across * side)
+            }
+        }
+    }
+}
+
+/// Gravity and wind: the world a cloth lives in.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Environment {
+    /// Acceleration of gravity in m/s² (seed 002 eq. 1.6).
+    #[serde(with = "vec3_serde")]
+    pub gravity: Vec3,
+    /// Switch gravity off without forgetting its value (seed 000's G key).
+    pub gravity_enabled: bool,
+    /// The wind.
+    pub wind: Wind,
+}
+
+impl Default for Environment {
+    fn default() -> Self {
+        Self {
+            gravity: Vec3::new(0.0, -9.81, 0.0),
+            gravity_enabled: true,
+            wind: Wind::default(),
+        }
+    }
+}
+
+impl Environment {
+    /// The gravity that acts: zero when switched off.
+    pub fn effective_gravity(&self) -> Vec3 {
+        if self.gravity_enabled {
+            self.gravity
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// Checks gravity and wind for non-finite values.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        let g = self.gravity;
+        check("gravity", g.length(), g.is_finite(), "a finite vector")?;
+        let w = &self.wind;
+        check(
+            "wind.direction",
+            w.direction.length(),
+            w.direction.is_finite(),
+            "a finite vector",
+        )?;
+        check(
+            "wind.strength",
+            w.strength,
+            w.strength >= 0.0,
+            "a strength ≥ 0 N",
+        )?;
+        Ok(())
+    }
+}

@@ -1,0 +1,420 @@
+//! `ClothPlugin`: the thin ECS layer over the solver.
+//!
+//! In the simulation schedule (`FixedUpdate` by default, 16 ms):
+//! ```text
+//! ClothSystems::Prepare      build / rebuild cloths, apply edited parameters, move pins
+//! ClothSystems::Substeps     run the ClothSubstep schedule N times, which holds
+//!     ClothSystems::AccumulateForces → Integrate → FitTargets → Constrain
+//! ClothSystems::Finish       tearing (ClothTorn messages), step timing
+//! ```
+//! and in `PostUpdate`, once per frame after the fixed loop, `ClothSystems::WriteMesh`
+//! writes positions and normals into each cloth's mesh buffers in place.
+//!
+//! A substep schedule (as avian's `SubstepSchedule`) makes each phase a real system set
+//! that runs every substep, so a game can add its own forces in a system ordered
+//! `.after(ClothSystems::AccumulateForces).before(ClothSystems::Integrate)` in
+//! [`ClothSubstep`]. Each phase runs over all cloths in parallel.
+
+use std::time::{Duration, Instant};
+
+use bevy::app::FixedUpdate;
+use bevy::asset::AssetEventSystems;
+use bevy::ecs::intern::Interned;
+use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+use bevy::prelude::*;
+use bevy::transform::helper::TransformHelper;
+
+use crate::components::{
+    Cloth, ClothEnvironment, ClothInvalid, ClothPaused, ClothSimulation, ClothTorn,
+};
+use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
+use crate::params::{
+    ClothParams, Environment, Integrator, SpringFamily, SpringParams, Substeps, Wind, WindField,
+};
+use crate::shape::{ClothShape, Pins};
+use crate::solver;
+
+/// The ordered system sets of the cloth simulation.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ClothSystems {
+    /// Build new cloths, rebuild changed ones, apply parameter edits, move pins.
+    Prepare,
+    /// Run the [`ClothSubstep`] schedule as many times as the cloths need.
+    Substeps,
+    /// (In [`ClothSubstep`]) forces from the old state: gravity, wind, drag, springs.
+    AccumulateForces,
+    /// (In [`ClothSubstep`]) advance positions by one substep.
+    Integrate,
+    /// (In [`ClothSubstep`]) move particles toward model targets (shape matching, patches).
+    FitTargets,
+    /// (In [`ClothSubstep`]) pins and strain limiting.
+    Constrain,
+    /// Tear over-stretched springs and report them; record step time.
+    Finish,
+    /// (In `PostUpdate`) write positions and normals into the meshes.
+    WriteMesh,
+}
+
+/// The schedule run once per substep inside [`ClothSystems::Substeps`].
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ClothSubstep;
+
+/// How many substeps this fixed step runs (the most any cloth needs) and which one is
+/// running; each cloth takes part in the first `n` of them, `n` being its own count.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct ClothSubstepPlan {
+    /// Substeps to run in this step.
+    pub count: u32,
+    /// The substep running now.
+    pub index: u32,
+}
+
+/// Adds cloth simulation to an app.
+///
+/// ```no_run
+/// use bevy::prelude::*;
+/// use bevy_cloth::prelude::*;
+/// App::new()
+///     .add_plugins((DefaultPlugins, ClothPlugin::default()))
+///     .add_systems(Startup, |mut commands: Commands| {
+///         commands.spawn((Cloth::grid(32, 32, 0.05), Transform::from_xyz(0.0, 2.0, 0.0)));
+///     })
+///     .run();
+/// ```
+pub struct ClothPlugin {
+    /// The schedule the simulation steps in.
+    pub schedule: Interned<dyn ScheduleLabel>,
+    /// When set, `Time<Fixed>` is set to this period (16 ms by default, seed 000 §5).
+    pub timestep: Option<Duration>,
+}
+
+impl Default for ClothPlugin {
+    fn default() -> Self {
+        Self {
+            schedule: FixedUpdate.intern(),
+            timestep: Some(Duration::from_millis(16)),
+        }
+    }
+}
+
+impl ClothPlugin {
+    /// Steps cloths in `schedule` (its `Time` delta is the step) and leaves `Time<Fixed>`.
+    pub fn new(schedule: impl ScheduleLabel) -> Self {
+        Self {
+            schedule: schedule.intern(),
+            timestep: None,
+        }
+    }
+
+    /// Sets the fixed timestep.
+    pub fn with_timestep(mut self, timestep: Duration) -> Self {
+        self.timestep = Some(timestep);
+        self
+    }
+}
+
+impl Plugin for ClothPlugin {
+    fn build(&self, app: &mut App) {
+        if let Some(step) = self.timestep {
+            app.insert_resource(Time::<Fixed>::from_duration(step));
+        }
+        app.register_type::<Cloth>()
+            .register_type::<ClothShape>()
+            .register_type::<Pins>()
+            .register_type::<ClothParams>()
+            .register_type::<SpringParams>()
+            .register_type::<SpringFamily>()
+            .register_type::<Integrator>()
+            .register_type::<Substeps>()
+            .register_type::<Environment>()
+            .register_type::<Wind>()
+            .register_type::<WindField>()
+            .register_type::<ClothEnvironment>()
+            .register_type::<ClothPaused>()
+            .init_resource::<ClothEnvironment>()
+            .init_resource::<ClothPaused>()
+            .init_resource::<ClothSubstepPlan>()
+            .add_message::<ClothTorn>();
+
+        let mut substep = Schedule::new(ClothSubstep);
+        substep.set_executor(SingleThreadedExecutor::new());
+        substep.configure_sets(
+            (
+                ClothSystems::AccumulateForces,
+                ClothSystems::Integrate,
+                ClothSystems::FitTargets,
+                ClothSystems::Constrain,
+            )
+                .chain(),
+        );
+        substep.add_systems((
+            accumulate_forces.in_set(ClothSystems::AccumulateForces),
+            integrate.in_set(ClothSystems::Integrate),
+            constrain.in_set(ClothSystems::Constrain),
+        ));
+        app.add_schedule(substep);
+
+        app.configure_sets(
+            self.schedule,
+            (
+                ClothSystems::Prepare,
+                ClothSystems::Substeps,
+                ClothSystems::Finish,
+            )
+                .chain(),
+        )
+        .add_systems(
+            self.schedule,
+            (
+                (build_cloths, begin_steps)
+                    .chain()
+                    .in_set(ClothSystems::Prepare),
+                run_substeps.in_set(ClothSystems::Substeps),
+                finish_steps.in_set(ClothSystems::Finish),
+            ),
+        )
+        .add_systems(
+            PostUpdate,
+            write_meshes
+                .in_set(ClothSystems::WriteMesh)
+                .before(AssetEventSystems),
+        );
+    }
+}
+
+/// Builds a cloth's solver and mesh: a grid from its description, a mesh shape from the
+/// entity's (or the remembered source) mesh. `Ok(None)`: the source mesh is not loaded yet.
+fn build_one(
+    cloth: &Cloth,
+    frame: bevy::math::Affine3A,
+    source: Option<&Mesh>,
+) -> Result<Option<(solver::Cloth, Mesh)>, crate::error::ClothError> {
+    cloth.validate()?;
+    match cloth.shape {
+        ClothShape::Grid { .. } => {
+            let solver = cloth.build(frame)?;
+            let mesh = cloth_mesh(&solver, None);
+            Ok(Some((solver, mesh)))
+        }
+        ClothShape::Mesh => {
+            let Some(source) = source else {
+                return Ok(None);
+            };
+            let MeshSource {
+                positions,
+                triangles,
+                uvs,
+            } = mesh_triangles(source)?;
+            let solver = solver::Cloth::from_mesh(
+                &positions,
+                &triangles,
+                &cloth.pins,
+                &cloth.params,
+                frame,
+            )?;
+            let mesh = cloth_mesh(&solver, uvs);
+            Ok(Some((solver, mesh)))
+        }
+    }
+}
+
+/// Remembers the mesh a mesh-shaped cloth was made from (its `Mesh3d` is replaced by the
+/// simulated copy, so the source stays untouched).
+#[derive(Component, Clone, Debug)]
+struct ClothSourceMesh(Handle<Mesh>);
+
+#[allow(clippy::type_complexity)]
+fn build_cloths(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    transforms: TransformHelper,
+    mut cloths: Query<(
+        Entity,
+        Ref<Cloth>,
+        Option<&mut ClothSimulation>,
+        Option<&Mesh3d>,
+        Option<&ClothSourceMesh>,
+        Has<ClothInvalid>,
+    )>,
+) {
+    for (entity, cloth, sim, mesh3d, source, invalid) in &mut cloths {
+        let frame = transforms
+            .compute_global_transform(entity)
+            .map(|g| g.affine())
+            .unwrap_or_default();
+        if let Some(mut sim) = sim {
+            sim.solver.set_frame(frame);
+            if !cloth.is_changed() {
+                continue;
+            }
+            if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) {
+                match sim.solver.set_params(&cloth.params) {
+                    Ok(()) if invalid => {
+                        commands.entity(entity).remove::<ClothInvalid>();
+                    }
+                    Ok(()) => {}
+                    Err(e) => {
+                        error!("cloth {entity}: {e}; the cloth is paused until this is fixed");
+                        commands.entity(entity).insert(ClothInvalid(e));
+                    }
+                }
+                continue;
+            }
+        } else if invalid && !cloth.is_changed() {
+            continue;
+        }
+        let source_handle = match cloth.shape {
+            ClothShape::Mesh => source.map(|s| s.0.clone()).or(mesh3d.map(|m| m.0.clone())),
+            ClothShape::Grid { .. } => None,
+        };
+        let source_mesh = source_handle.as_ref().and_then(|h| meshes.get(h));
+        match build_one(&cloth, frame, source_mesh) {
+            Ok(Some((solver, mesh))) => {
+                let sim = ClothSimulation::new(solver, &cloth);
+                let handle = meshes.add(mesh);
+                let mut entity_commands = commands.entity(entity);
+                entity_commands
+                    .insert((sim, Mesh3d(handle)))
+                    .remove::<ClothInvalid>();
+                if let Some(source_handle) = source_handle {
+                    entity_commands.insert(ClothSourceMesh(source_handle));
+                }
+            }
+            Ok(None) => {}
+            Err(e) => {
+                error!("cloth {entity} is not simulated: {e}");
+                commands
+                    .entity(entity)
+                    .insert(ClothInvalid(e))
+                    .remove::<ClothSimulation>();
+            }
+        }
+    }
+}
+
+/// Per-cloth bookkeeping of the step in progress.
+#[derive(Component, Clone, Copy, Debug, Default)]
+struct StepProgress {
+    substeps: u32,
+    elapsed: Duration,
+}
+
+fn begin_steps(
+    mut commands: Commands,
+    time: Res<Time>,
+    paused: Res<ClothPaused>,
+    mut plan: ResMut<ClothSubstepPlan>,
+    mut cloths: Query<
+        (Entity, &mut ClothSimulation, Option<&mut StepProgress>),
+        Without<ClothInvalid>,
+    >,
+) {
+    let dt = time.delta_secs();
+    plan.count = 0;
+    plan.index = 0;
+    for (entity, mut sim, progress) in &mut cloths {
+        let start = Instant::now();
+        let substeps = if paused.0 {
+            0
+        } else {
+            sim.solver.begin_step(dt)
+        };
+        let progress_now = StepProgress {
+            substeps,
+            elapsed: start.elapsed(),
+        };
+        match progress {
+            Some(mut p) => *p = progress_now,
+            None => {
+                commands.entity(entity).insert(progress_now);
+            }
+        }
+        plan.count = plan.count.max(substeps);
+    }
+}
+
+fn run_substeps(world: &mut World) {
+    let count = world.resource::<ClothSubstepPlan>().count;
+    for index in 0..count {
+        world.resource_mut::<ClothSubstepPlan>().index = index;
+        world.run_schedule(ClothSubstep);
+    }
+}
+
+/// Runs one solver phase on every cloth that takes part in the current substep, in
+/// parallel, adding the time it took to that cloth's step time.
+fn for_each_active(
+    plan: &ClothSubstepPlan,
+    cloths: &mut Query<(&mut ClothSimulation, &mut StepProgress), Without<ClothInvalid>>,
+    phase: impl Fn(&mut solver::Cloth) + Sync + Send,
+) {
+    cloths.par_iter_mut().for_each(|(mut sim, mut progress)| {
+        if plan.index < progress.substeps {
+            let start = Instant::now();
+            phase(&mut sim.solver);
+            progress.elapsed += start.elapsed();
+        }
+    });
+}
+
+type ActiveCloths<'w, 's> =
+    Query<'w, 's, (&'static mut ClothSimulation, &'static mut StepProgress), Without<ClothInvalid>>;
+
+fn accumulate_forces(
+    plan: Res<ClothSubstepPlan>,
+    env: Res<ClothEnvironment>,
+    mut cloths: ActiveCloths,
+) {
+    for_each_active(&plan, &mut cloths, |c| c.accumulate_forces(&env));
+}
+
+fn integrate(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    for_each_active(&plan, &mut cloths, solver::Cloth::integrate);
+}
+
+fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    for_each_active(&plan, &mut cloths, solver::Cloth::constrain);
+}
+
+fn finish_steps(
+    mut torn: MessageWriter<ClothTorn>,
+    mut cloths: Query<(Entity, &mut ClothSimulation, &StepProgress), Without<ClothInvalid>>,
+) {
+    for (entity, mut sim, progress) in &mut cloths {
+        if progress.substeps == 0 {
+            continue;
+        }
+        let start = Instant::now();
+        let sim = &mut *sim;
+        sim.solver.end_step();
+        for &spring in sim.solver.last_torn() {
+            let s = spring as usize;
+            let particles = [sim.solver.springs().a[s], sim.solver.springs().b[s]];
+            torn.write(ClothTorn {
+                cloth: entity,
+                spring,
+                particles,
+            });
+        }
+        sim.last_step_ms = (progress.elapsed + start.elapsed()).as_secs_f32() * 1e3;
+        sim.mesh_dirty = true;
+    }
+}
+
+fn write_meshes(
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut cloths: Query<(&mut ClothSimulation, &Mesh3d)>,
+) {
+    for (mut sim, mesh3d) in &mut cloths {
+        if !sim.mesh_dirty {
+            continue;
+        }
+        let Some(mut mesh) = meshes.get_mut(&mesh3d.0) else {
+            continue;
+        };
+        let sim = &mut *sim;
+        let faces_changed = sim.solver.take_faces_changed();
+        write_mesh(&mut mesh, &sim.solver, &mut sim.normals, faces_changed);
+        sim.mesh_dirty = false;
+    }
+}

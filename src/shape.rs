@@ -1,0 +1,130 @@
+//! What a cloth looks like before it moves: its shape and where it is pinned.
+
+use bevy::reflect::Reflect;
+use serde::{Deserialize, Serialize};
+
+use crate::error::ClothError;
+
+/// The most particles one cloth may have (a 2048×2048 grid).
+pub const MAX_PARTICLES: usize = 1 << 22;
+
+/// The initial layout of a cloth's particles.
+#[derive(Clone, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+pub enum ClothShape {
+    /// A `width × height` grid hanging in the local XY plane: particle `(i, j)` starts at
+    /// `(i·spacing − (width−1)·spacing/2, −j·spacing, 0)`, so the local origin is the middle
+    /// of the top edge (where a curtain rod would be). Seed 000 §3.2's construction.
+    Grid {
+        /// Particles across (i).
+        width: u32,
+        /// Particles down (j).
+        height: u32,
+        /// Distance between neighbours in m: the structural rest length.
+        spacing: f32,
+    },
+    /// The vertices and triangles of the entity's own `Mesh3d`: each vertex becomes a
+    /// particle, each edge a structural spring, and the two far corners of each pair of
+    /// triangles sharing an edge a bend spring.
+    Mesh,
+}
+
+impl Default for ClothShape {
+    fn default() -> Self {
+        ClothShape::Grid {
+            width: 32,
+            height: 32,
+            spacing: 0.05,
+        }
+    }
+}
+
+impl ClothShape {
+    /// Checks sizes; a grid smaller than 2×2 or with a bad spacing is an error.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        if let ClothShape::Grid {
+            width,
+            height,
+            spacing,
+        } = *self
+        {
+            if width < 2 || height < 2 {
+                return Err(ClothError::GridTooSmall { width, height });
+            }
+            if width as usize * height as usize > MAX_PARTICLES {
+                return Err(ClothError::GridTooLarge {
+                    width,
+                    height,
+                    limit: MAX_PARTICLES,
+                });
+            }
+            if !(spacing > 0.0 && spacing.is_finite()) {
+                return Err(ClothError::InvalidParameter {
+                    field: "shape.spacing",
+                    value: spacing,
+                    expected: "a positive distance in m",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Which particles are held in place. Pinned particles follow the cloth's frame (for an
+/// entity, its transform), so moving the frame moves the cloth.
+#[derive(Clone, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
+pub enum Pins {
+    /// Nothing is pinned: the cloth falls.
+    None,
+    /// The whole top row of a grid (j = 0).
+    TopRow,
+    /// The two top corners of a grid (seed 000 Slika 5).
+    #[default]
+    TopCorners,
+    /// Particles by index (`j·width + i` for a grid).
+    Indices(Vec<u32>),
+}
+
+impl Pins {
+    /// The pinned particle indices. A grid of `grid_width` columns pins by row and column;
+    /// a mesh (no grid) pins its highest vertices for `TopRow` and the leftmost and
+    /// rightmost of those for `TopCorners`.
+    pub fn resolve(
+        &self,
+        positions: &[bevy::math::Vec3],
+        grid_width: Option<u32>,
+    ) -> Result<Vec<u32>, ClothError> {
+        let count = positions.len();
+        let indices: Vec<u32> = match (self, grid_width) {
+            (Pins::None, _) => Vec::new(),
+            (Pins::TopRow, Some(w)) => (0..w).collect(),
+            (Pins::TopCorners, Some(w)) => vec![0, w - 1],
+            (Pins::TopRow | Pins::TopCorners, None) => {
+                let top = positions
+                    .iter()
+                    .map(|p| p.y)
+                    .fold(f32::NEG_INFINITY, f32::max);
+                let eps = 1e-4 * (1.0 + top.abs());
+                let row: Vec<u32> = (0..count as u32)
+                    .filter(|&i| positions[i as usize].y >= top - eps)
+                    .collect();
+                if matches!(self, Pins::TopCorners) && row.len() > 2 {
+                    let by_x = |a: &&u32, b: &&u32| {
+                        positions[**a as usize]
+                            .x
+                            .total_cmp(&positions[**b as usize].x)
+                    };
+                    let left = *row.iter().min_by(by_x).expect("row is not empty");
+                    let right = *row.iter().max_by(by_x).expect("row is not empty");
+                    vec![left, right]
+                } else {
+                    row
+                }
+            }
+            (Pins::Indices(list), _) => list.clone(),
+        };
+        if let Some(&index) = indices.iter().find(|&&i| i as usize >= count) {
+            return Err(ClothError::PinOutOfRange { index, count });
+        }
+        Ok(indices)
+    }
+}

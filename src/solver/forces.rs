@@ -1,0 +1,69 @@
+//! Phase 1 of a substep: every force from the old state.
+
+use super::{Cloth, SpringKind};
+use crate::params::Environment;
+
+impl Cloth {
+    /// Clears and accumulates the forces on every free particle: gravity (seed 002
+    /// eq. 1.6), wind, linear drag `−c v` (seed 000 eq. 31) and the springs. Reads only the
+    /// old state, so the result does not depend on particle order (seed 000 §3.2).
+    pub fn accumulate_forces(&mut self, env: &Environment) {
+        let g = env.effective_gravity();
+        let drag = self.params.drag;
+        let time = self.time;
+        let wind = env.wind;
+        let has_wind = wind.strength > 0.0 && wind.direction != bevy::math::Vec3::ZERO;
+        let p = &mut self.particles;
+        for i in 0..p.position.len() {
+            let mut f = p.mass[i] * g - drag * p.velocity[i];
+            if has_wind {
+                f += wind.force_at(p.position[i], time);
+            }
+            p.force[i] = f;
+        }
+        let damping = self.params.springs.damping;
+        for kind in SpringKind::ALL {
+            let k = self.stiffness(kind);
+            if k == 0.0 {
+                continue;
+            }
+            self.spring_forces(self.springs.ranges[kind as usize].clone(), k, damping);
+        }
+    }
+
+    /// Hooke springs `F = k (|l| − l0) l/|l|` (seed 002 eq. 1.4) plus damping along the
+    /// spring. Each spring pushes its ends with equal and opposite forces; dividing by each
+    /// end's mass in `integrate` shares the motion by inverse mass, as seed 000 eq. 2 asks.
+    fn spring_forces(&mut self, range: std::ops::Range<usize>, k: f32, damping: f32) {
+        let s = &self.springs;
+        let p = &mut self.particles;
+        for idx in range {
+            if !s.alive[idx] {
+                continue;
+            }
+            let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
+            let d = p.position[b] - p.position[a];
+            let len = d.length();
+            if len <= f32::EPSILON {
+                continue;
+            }
+            let dir = d / len;
+            let mut magnitude = k * (len - s.rest_length[idx]);
+            if damping > 0.0 {
+                magnitude += damping * (p.velocity[b] - p.velocity[a]).dot(dir);
+            }
+            let f = dir * magnitude;
+            p.force[a] += f;
+            p.force[b] -= f;
+        }
+    }
+
+    /// Adds an external force (N) to particle `i` for the current substep. Call it between
+    /// `accumulate_forces` and `integrate` (in the plugin: after
+    /// `ClothSystems::AccumulateForces`, before `ClothSystems::Integrate`).
+    pub fn add_force(&mut self, i: usize, force: bevy::math::Vec3) {
+        if let Some(f) = self.particles.force.get_mut(i) {
+            *f += force;
+        }
+    }
+}

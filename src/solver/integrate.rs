@@ -1,0 +1,117 @@
+//! Phases 2 and 3 of a substep: integration and constraints.
+
+use super::{Cloth, SpringKind};
+use crate::params::Integrator;
+
+impl Cloth {
+    /// Advances every free particle by one substep `h` from its accumulated force.
+    pub fn integrate(&mut self) {
+        let h = self.h;
+        let h2 = h * h;
+        let p = &mut self.particles;
+        match self.params.integrator {
+            Integrator::Verlet => {
+                // Seed 002 eq. 1.12 prints `+ a Δt²/2`; substituting eq. 1.10 into 1.9
+                // drops the `x_{n−1}` Taylor term, and the correct Störmer–Verlet step is
+                // `x' = 2x − x_prev + a Δt²` (with the ½, free fall would reach only g t²/4).
+                for i in 0..p.position.len() {
+                    let w = p.inv_mass[i];
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let x = p.position[i];
+                    let next = 2.0 * x - p.previous[i] + p.force[i] * (w * h2);
+                    p.previous[i] = x;
+                    p.position[i] = next;
+                    p.velocity[i] = (next - x) / h;
+                }
+            }
+            Integrator::SemiImplicitEuler => {
+                // Seed 000 eq. 21–22: the new velocity first, then the position from it.
+                for i in 0..p.position.len() {
+                    let w = p.inv_mass[i];
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let v = p.velocity[i] + p.force[i] * (w * h);
+                    p.previous[i] = p.position[i];
+                    p.velocity[i] = v;
+                    p.position[i] += v * h;
+                }
+            }
+        }
+    }
+
+    /// Moves pinned particles along their path and applies Provot's strain limit; then
+    /// advances the clock by one substep.
+    pub fn constrain(&mut self) {
+        self.substep_index += 1;
+        let t = self.substep_index as f32 / self.substeps.max(1) as f32;
+        let h = self.h;
+        let p = &mut self.particles;
+        for (k, &i) in self.pins.iter().enumerate() {
+            let i = i as usize;
+            let target = self.pin_from[k].lerp(self.pin_to[k], t);
+            p.previous[i] = p.position[i];
+            p.velocity[i] = (target - p.position[i]) / h;
+            p.position[i] = target;
+        }
+        if let Some(limit) = self.params.strain_limit {
+            self.limit_strain(limit, h);
+        }
+        self.time += h;
+    }
+
+    /// Provot (1995): springs longer than `(1 + limit)·l0` are shortened to that length,
+    /// each end moved by its share of inverse mass (seed 000 eq. 2); Gauss–Seidel sweeps
+    /// over the structural and shear springs. Velocities take the same correction over `h`.
+    fn limit_strain(&mut self, limit: f32, h: f32) {
+        let s = &self.springs;
+        let p = &mut self.particles;
+        let families = [SpringKind::Structural, SpringKind::Shear];
+        for _ in 0..self.params.strain_limit_iterations {
+            for kind in families {
+                if !self.params.springs.structural.enabled && kind == SpringKind::Structural
+                    || !self.params.springs.shear.enabled && kind == SpringKind::Shear
+                {
+                    continue;
+                }
+                for idx in s.ranges[kind as usize].clone() {
+                    if !s.alive[idx] {
+                        continue;
+                    }
+                    let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
+                    let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
+                    let w = wa + wb;
+                    if w == 0.0 {
+                        continue;
+                    }
+                    let d = p.position[b] - p.position[a];
+                    let len = d.length();
+                    let max = (1.0 + limit) * s.rest_length[idx];
+                    if len <= max {
+                        continue;
+                    }
+                    let correction = d * ((len - max) / (len * w));
+                    p.position[a] += correction * wa;
+                    p.position[b] -= correction * wb;
+                    p.velocity[a] += correction * (wa / h);
+                    p.velocity[b] -= correction * (wb / h);
+                }
+            }
+        }
+    }
+
+    /// Keeps Verlet's implicit velocity `(x − x_prev)/h` when `h` changes by `ratio`.
+    pub(super) fn rescale_verlet_velocity(&mut self, ratio: f32) {
+        if self.params.integrator != Integrator::Verlet {
+            return;
+        }
+        let p = &mut self.particles;
+        for i in 0..p.position.len() {
+            if p.inv_mass[i] != 0.0 {
+                p.previous[i] = p.position[i] - (p.position[i] - p.previous[i]) * ratio;
+            }
+        }
+    }
+}

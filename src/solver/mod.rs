@@ -1,0 +1,680 @@
+//! The physics core: pure Rust, no ECS. The plugin, the tests, the command line and the
+//! benches all call the same [`Cloth::step`], so what is measured is what runs in a game.
+//!
+//! One step of `dt` is split into substeps of `h = dt / N`; each substep runs the phases
+//! in a fixed order (seed 000 §3.2: all forces from the old state before any position
+//! changes):
+//! 1. [`Cloth::accumulate_forces`] — gravity, wind, drag, springs;
+//! 2. [`Cloth::integrate`] — Verlet or semi-implicit Euler;
+//! 3. [`Cloth::constrain`] — pins, Provot strain limiting.
+//!
+//! After the substeps, [`Cloth::end_step`] tears over-stretched springs.
+
+mod forces;
+mod integrate;
+mod state;
+pub mod topology;
+
+pub use state::Particles;
+pub use topology::{SpringKind, Springs};
+
+use bevy::math::{Affine3A, Vec3};
+
+use crate::error::ClothError;
+use crate::params::{ClothParams, Environment};
+use crate::shape::{ClothShape, Pins};
+
+/// Energies of a cloth in J, for measurement (see [`Cloth::energy`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energy {
+    /// `Σ ½ m v²` over free particles.
+    pub kinetic: f32,
+    /// `Σ −m g·x` over free particles (zero at the world origin).
+    pub gravitational: f32,
+    /// `Σ ½ k (l − l0)²` over acting springs.
+    pub spring: f32,
+}
+
+impl Energy {
+    /// Kinetic + gravitational + spring energy.
+    pub fn total(&self) -> f32 {
+        self.kinetic + self.gravitational + self.spring
+    }
+}
+
+/// Stretch of the structural springs, `(l − l0)/l0`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Strain {
+    /// The largest stretch (negative when every spring is compressed).
+    pub max: f32,
+    /// The mean of `|l − l0|/l0`.
+    pub mean: f32,
+}
+
+/// A simulated cloth: particles, springs, triangles and the step.
+#[derive(Clone, Debug)]
+pub struct Cloth {
+    particles: Particles,
+    springs: Springs,
+    /// Particle positions in the cloth's own frame before any motion (for reset, pins).
+    local_rest: Vec<Vec3>,
+    grid: Option<(u32, u32)>,
+    triangles: Vec<[u32; 3]>,
+    triangle_springs: Vec<[u32; 3]>,
+    spring_triangles: Vec<Vec<u32>>,
+    triangle_visible: Vec<bool>,
+    faces_changed: bool,
+    params: ClothParams,
+    pins: Vec<u32>,
+    pin_from: Vec<Vec3>,
+    pin_to: Vec<Vec3>,
+    frame: Affine3A,
+    time: f32,
+    /// Current substep length `h`.
+    h: f32,
+    /// The previous step's `h`, to rescale Verlet's implicit velocity when `h` changes.
+    last_h: f32,
+    substeps: u32,
+    substep_index: u32,
+    under_resolved: bool,
+    auto_cache: Option<(ClothParams, f32, usize, u32)>,
+    torn_this_step: Vec<u32>,
+    torn_count: usize,
+}
+
+impl Cloth {
+    /// Builds a cloth of `shape` placed by `frame` (local → world). For
+    /// [`ClothShape::Mesh`] use [`Cloth::from_mesh`] instead; this returns an error for it.
+    pub fn new(
+        shape: &ClothShape,
+        pins: &Pins,
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        shape.validate()?;
+        match *shape {
+            ClothShape::Grid {
+                width,
+                height,
+                spacing,
+            } => {
+                let half = (width - 1) as f32 * spacing * 0.5;
+                let local: Vec<Vec3> = (0..height)
+                    .flat_map(|j| {
+                        (0..width).map(move |i| {
+                            Vec3::new(i as f32 * spacing - half, -(j as f32) * spacing, 0.0)
+                        })
+                    })
+                    .collect();
+                let pairs = topology::grid_spring_pairs(width, height);
+                let triangles = topology::grid_triangles(width, height);
+                Self::build(
+                    local,
+                    pairs,
+                    triangles,
+                    Some((width, height)),
+                    pins,
+                    params,
+                    frame,
+                )
+            }
+            ClothShape::Mesh => Err(ClothError::BadMesh {
+                reason: "a mesh-shaped cloth is built with `Cloth::from_mesh`".into(),
+            }),
+        }
+    }
+
+    /// Builds a cloth from a triangle mesh: vertices become particles, edges structural
+    /// springs, and the far corners of triangles sharing an edge bend springs.
+    pub fn from_mesh(
+        positions: &[Vec3],
+        triangles: &[[u32; 3]],
+        pins: &Pins,
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        if positions.len() < 3 || triangles.is_empty() {
+            return Err(ClothError::BadMesh {
+                reason: format!(
+                    "{} vertices and {} triangles; at least 3 and 1 are needed",
+                    positions.len(),
+                    triangles.len()
+                ),
+            });
+        }
+        if positions.len() > crate::shape::MAX_PARTICLES {
+            return Err(ClothError::BadMesh {
+                reason: format!("{} vertices is more than the limit", positions.len()),
+            });
+        }
+        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(ClothError::BadMesh {
+                reason: format!("a vertex position is not finite: {p}"),
+            });
+        }
+        if let Some(t) = triangles.iter().find(|t| {
+            t.iter().any(|&v| v as usize >= positions.len())
+                || t[0] == t[1]
+                || t[1] == t[2]
+                || t[0] == t[2]
+        }) {
+            return Err(ClothError::BadMesh {
+                reason: format!("triangle {t:?} is degenerate or indexes past the vertices"),
+            });
+        }
+        let pairs = topology::mesh_spring_pairs(triangles);
+        Self::build(
+            positions.to_vec(),
+            pairs,
+            triangles.to_vec(),
+            None,
+            pins,
+            params,
+            frame,
+        )
+    }
+
+    /// Builds a cloth from explicit structural springs between particles (ropes, single
+    /// springs, custom lattices); it has no triangles, so nothing is drawn for it.
+    pub fn from_springs(
+        positions: &[Vec3],
+        springs: &[[u32; 2]],
+        pins: &Pins,
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
+            return Err(ClothError::BadMesh {
+                reason: format!("a particle position is not finite: {p}"),
+            });
+        }
+        if let Some(s) = springs
+            .iter()
+            .find(|s| s[0] == s[1] || s.iter().any(|&i| i as usize >= positions.len()))
+        {
+            return Err(ClothError::BadMesh {
+                reason: format!("spring {s:?} joins a particle to itself or to none"),
+            });
+        }
+        let pairs = springs
+            .iter()
+            .map(|s| (SpringKind::Structural, s[0], s[1]))
+            .collect();
+        Self::build(
+            positions.to_vec(),
+            pairs,
+            Vec::new(),
+            None,
+            pins,
+            params,
+            frame,
+        )
+    }
+
+    fn build(
+        local: Vec<Vec3>,
+        pairs: Vec<(SpringKind, u32, u32)>,
+        triangles: Vec<[u32; 3]>,
+        grid: Option<(u32, u32)>,
+        pins: &Pins,
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        params.validate()?;
+        let pin_indices = pins.resolve(&local, grid.map(|g| g.0))?;
+        let springs = Springs::from_pairs(pairs, &local);
+        let (triangle_springs, spring_triangles) =
+            topology::triangle_edge_springs(&triangles, &springs);
+        let n = local.len();
+        let mut cloth = Cloth {
+            particles: Particles::with_len(n),
+            torn_this_step: Vec::with_capacity(springs.len()),
+            springs,
+            local_rest: local,
+            grid,
+            triangle_visible: vec![true; triangles.len()],
+            triangles,
+            triangle_springs,
+            spring_triangles,
+            faces_changed: true,
+            params: *params,
+            pin_from: Vec::with_capacity(pin_indices.len()),
+            pin_to: Vec::with_capacity(pin_indices.len()),
+            pins: pin_indices,
+            frame,
+            time: 0.0,
+            h: 0.0,
+            last_h: 0.0,
+            substeps: 1,
+            substep_index: 0,
+            under_resolved: false,
+            auto_cache: None,
+            torn_count: 0,
+        };
+        cloth.reset();
+        Ok(cloth)
+    }
+
+    /// Puts every particle back at its rest position in the current frame, at rest, with
+    /// every spring whole and the clock at zero.
+    pub fn reset(&mut self) {
+        let mass = self.params.node_mass;
+        let p = &mut self.particles;
+        for (i, local) in self.local_rest.iter().enumerate() {
+            let x = self.frame.transform_point3(*local);
+            p.position[i] = x;
+            p.previous[i] = x;
+            p.velocity[i] = Vec3::ZERO;
+            p.force[i] = Vec3::ZERO;
+            p.mass[i] = mass;
+            p.inv_mass[i] = 1.0 / mass;
+        }
+        for &i in &self.pins {
+            p.inv_mass[i as usize] = 0.0;
+        }
+        self.pin_to.clear();
+        self.pin_to
+            .extend(self.pins.iter().map(|&i| p.position[i as usize]));
+        self.pin_from.clone_from(&self.pin_to);
+        self.springs.alive.fill(true);
+        self.triangle_visible.fill(true);
+        self.faces_changed = true;
+        self.torn_count = 0;
+        self.torn_this_step.clear();
+        self.time = 0.0;
+        self.last_h = 0.0;
+    }
+
+    // ----- parameters and frame -------------------------------------------------------
+
+    /// The parameters in use.
+    pub fn params(&self) -> &ClothParams {
+        &self.params
+    }
+
+    /// Replaces the parameters; they act from the next substep. Invalid values are
+    /// refused with an error and the old parameters stay.
+    pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
+        params.validate()?;
+        if params.node_mass != self.params.node_mass {
+            for i in 0..self.particles.len() {
+                self.particles.mass[i] = params.node_mass;
+                if self.particles.inv_mass[i] != 0.0 {
+                    self.particles.inv_mass[i] = 1.0 / params.node_mass;
+                }
+            }
+        }
+        self.params = *params;
+        Ok(())
+    }
+
+    /// The frame (local → world) the pins follow.
+    pub fn frame(&self) -> Affine3A {
+        self.frame
+    }
+
+    /// Moves the pins' frame; pinned particles move there over the next step, smoothly
+    /// across its substeps, and drag the cloth along.
+    pub fn set_frame(&mut self, frame: Affine3A) {
+        self.frame = frame;
+    }
+
+    /// Pins particle `i` at its current position (e.g. a grabbed particle).
+    pub fn pin(&mut self, i: u32) -> Result<(), ClothError> {
+        let count = self.particles.len();
+        if i as usize >= count {
+            return Err(ClothError::PinOutOfRange { index: i, count });
+        }
+        if !self.pins.contains(&i) {
+            let x = self.particles.position[i as usize];
+            self.local_rest[i as usize] = self.frame.inverse().transform_point3(x);
+            self.pins.push(i);
+            self.pin_from.push(x);
+            self.pin_to.push(x);
+            self.particles.inv_mass[i as usize] = 0.0;
+        }
+        Ok(())
+    }
+
+    // ----- the step -------------------------------------------------------------------
+
+    /// Advances the cloth by `dt` seconds: [`begin_step`](Self::begin_step), that many
+    /// [`substep`](Self::substep)s, then [`end_step`](Self::end_step).
+    pub fn step(&mut self, dt: f32, env: &Environment) {
+        let n = self.begin_step(dt);
+        for _ in 0..n {
+            self.substep(env);
+        }
+        self.end_step();
+    }
+
+    /// One substep: forces, integration, constraints.
+    pub fn substep(&mut self, env: &Environment) {
+        self.accumulate_forces(env);
+        self.integrate();
+        self.constrain();
+    }
+
+    /// Prepares a step of `dt` seconds and returns the number of substeps it takes (0 for a
+    /// `dt` that is not positive and finite: nothing happens then).
+    pub fn begin_step(&mut self, dt: f32) -> u32 {
+        if !(dt > 0.0 && dt.is_finite()) {
+            self.substeps = 0;
+            return 0;
+        }
+        let n = match self.params.substeps {
+            crate::params::Substeps::Fixed(n) => {
+                self.under_resolved = false;
+                n.max(1)
+            }
+            crate::params::Substeps::Auto { max } => {
+                let key = (self.params, dt, self.torn_count);
+                let needed = match self.auto_cache {
+                    Some((p, d, t, n)) if (p, d, t) == key => n,
+                    _ => {
+                        let n = self.stable_substeps(dt);
+                        self.auto_cache = Some((key.0, key.1, key.2, n));
+                        n
+                    }
+                };
+                self.under_resolved = needed > max;
+                needed.clamp(1, max.max(1))
+            }
+        };
+        self.substeps = n;
+        self.substep_index = 0;
+        self.h = dt / n as f32;
+        if self.last_h > 0.0 && self.last_h != self.h {
+            self.rescale_verlet_velocity(self.h / self.last_h);
+        }
+        self.last_h = self.h;
+        // Pins move from where they are to where the frame puts them, over the substeps.
+        std::mem::swap(&mut self.pin_from, &mut self.pin_to);
+        for (k, &i) in self.pins.iter().enumerate() {
+            self.pin_to[k] = self.frame.transform_point3(self.local_rest[i as usize]);
+            self.pin_from[k] = self.particles.position[i as usize];
+        }
+        self.torn_this_step.clear();
+        n
+    }
+
+    /// Finishes a step: springs stretched past the tear ratio break and hide the faces
+    /// they border (seed 000 §3.2). Returns the springs torn in this step.
+    pub fn end_step(&mut self) -> &[u32] {
+        if let Some(ratio) = self.params.tear_ratio {
+            let x = &self.particles.position;
+            let s = &mut self.springs;
+            for k in 0..s.len() {
+                if s.alive[k]
+                    && x[s.a[k] as usize].distance_squared(x[s.b[k] as usize])
+                        > (ratio * s.rest_length[k]).powi(2)
+                {
+                    s.alive[k] = false;
+                    self.torn_this_step.push(k as u32);
+                    for &t in &self.spring_triangles[k] {
+                        self.triangle_visible[t as usize] = false;
+                    }
+                    self.faces_changed = true;
+                }
+            }
+            self.torn_count += self.torn_this_step.len();
+        }
+        &self.torn_this_step
+    }
+
+    /// The springs torn by the last `end_step`.
+    pub fn last_torn(&self) -> &[u32] {
+        &self.torn_this_step
+    }
+
+    /// Tears spring `s` by hand (e.g. a cut with the mouse). Returns false if it was
+    /// already torn or does not exist.
+    pub fn tear(&mut self, s: u32) -> bool {
+        let k = s as usize;
+        if k >= self.springs.len() || !self.springs.alive[k] {
+            return false;
+        }
+        self.springs.alive[k] = false;
+        for &t in &self.spring_triangles[k] {
+            self.triangle_visible[t as usize] = false;
+        }
+        self.faces_changed = true;
+        self.torn_count += 1;
+        true
+    }
+
+    /// The number of substeps that keeps an explicit step of `dt` stable for this cloth.
+    ///
+    /// Symplectic Euler (and Verlet, the same recurrence) on `x'' = −ω² x − γ x'` is stable
+    /// while `h²ω² + 2hγ < 4` (Jury's test on its 2×2 update matrix); with no damping this
+    /// is the lattice bound `ω_max·h < 2`. Gershgorin's theorem bounds the lattice's
+    /// largest frequency by `ω_max² ≤ max_i 2·Σ_j k_ij / m_i` and its largest damping
+    /// rate by `γ ≤ max_i (2·Σ_j c_ij + c_drag) / m_i`. A safety factor of 0.8 on the
+    /// right-hand side covers the geometric stiffness of stretched springs.
+    pub fn stable_substeps(&self, dt: f32) -> u32 {
+        let n = self.particles.len();
+        let mut k_sum = vec![0.0f32; n];
+        let mut c_sum = vec![0.0f32; n];
+        let damping = self.params.springs.damping;
+        for kind in SpringKind::ALL {
+            let k = self.stiffness(kind);
+            let c = if k > 0.0 { damping } else { 0.0 };
+            if k == 0.0 && c == 0.0 {
+                continue;
+            }
+            for s in self.springs.ranges[kind as usize].clone() {
+                if self.springs.alive[s] {
+                    for p in [self.springs.a[s], self.springs.b[s]] {
+                        k_sum[p as usize] += k;
+                        c_sum[p as usize] += c;
+                    }
+                }
+            }
+        }
+        let (mut omega2, mut gamma) = (0.0f32, 0.0f32);
+        for i in 0..n {
+            let w = self.particles.inv_mass[i];
+            omega2 = omega2.max(2.0 * k_sum[i] * w);
+            gamma = gamma.max((2.0 * c_sum[i] + self.params.drag) * w);
+        }
+        const SAFETY: f32 = 0.8;
+        let h_max = if omega2 > 0.0 {
+            (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
+        } else if gamma > 0.0 {
+            2.0 * SAFETY / gamma
+        } else {
+            f32::INFINITY
+        };
+        let n = (dt / h_max).ceil();
+        if n.is_finite() && n >= 1.0 {
+            n.min(u32::MAX as f32) as u32
+        } else {
+            1
+        }
+    }
+
+    /// The acting stiffness of a spring kind under the current parameters.
+    pub fn stiffness(&self, kind: SpringKind) -> f32 {
+        let s = &self.params.springs;
+        match kind {
+            SpringKind::Structural => s.structural.effective(),
+            SpringKind::Shear => s.shear.effective(),
+            SpringKind::Bend => s.bend.effective(),
+            SpringKind::BendDiagonal => s.bend_diagonal.effective(),
+        }
+    }
+
+    // ----- queries --------------------------------------------------------------------
+
+    /// Particle state (positions, velocities, masses, forces).
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+
+    /// Mutable particle state, for tools that move particles (grab) between steps.
+    pub fn particles_mut(&mut self) -> &mut Particles {
+        &mut self.particles
+    }
+
+    /// Particle positions in world space.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.particles.position
+    }
+
+    /// The springs, torn ones included (see `Springs::alive`).
+    pub fn springs(&self) -> &Springs {
+        &self.springs
+    }
+
+    /// All triangles, hidden ones included.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
+    /// For each triangle, the springs along its edges (`u32::MAX` where none).
+    pub fn triangle_springs(&self) -> &[[u32; 3]] {
+        &self.triangle_springs
+    }
+
+    /// Whether each triangle is still drawn (false once a spring on its edge tore).
+    pub fn triangle_visible(&self) -> &[bool] {
+        &self.triangle_visible
+    }
+
+    /// True once after faces were hidden (or on a new cloth); clears the flag.
+    pub fn take_faces_changed(&mut self) -> bool {
+        std::mem::take(&mut self.faces_changed)
+    }
+
+    /// The indices of the pinned particles.
+    pub fn pins(&self) -> &[u32] {
+        &self.pins
+    }
+
+    /// `(width, height)` for a grid cloth.
+    pub fn grid_size(&self) -> Option<(u32, u32)> {
+        self.grid
+    }
+
+    /// Number of particles.
+    pub fn particle_count(&self) -> usize {
+        self.particles.len()
+    }
+
+    /// Number of springs that still act (whole and of an enabled family).
+    pub fn spring_count(&self) -> usize {
+        SpringKind::ALL
+            .into_iter()
+            .filter(|&k| self.stiffness(k) > 0.0)
+            .map(|k| {
+                self.springs.ranges[k as usize]
+                    .clone()
+                    .filter(|&s| self.springs.alive[s])
+                    .count()
+            })
+            .sum()
+    }
+
+    /// Number of springs torn since the last reset.
+    pub fn torn_count(&self) -> usize {
+        self.torn_count
+    }
+
+    /// Simulated time since the last reset, in s.
+    pub fn time(&self) -> f32 {
+        self.time
+    }
+
+    /// Substeps used by the last step.
+    pub fn substeps(&self) -> u32 {
+        self.substeps
+    }
+
+    /// True when automatic substeps hit their maximum: the step may be unstable.
+    pub fn under_resolved(&self) -> bool {
+        self.under_resolved
+    }
+
+    /// The failure test of the measurements (DESIGN.md): every position and velocity is
+    /// finite and no structural spring is stretched past 100%.
+    pub fn is_stable(&self) -> bool {
+        self.is_finite() && self.strain().max <= 1.0
+    }
+
+    /// True when every position and velocity is finite.
+    pub fn is_finite(&self) -> bool {
+        self.particles.position.iter().all(|p| p.is_finite())
+            && self.particles.velocity.iter().all(|v| v.is_finite())
+    }
+
+    /// Kinetic, gravitational and spring energy under `env`.
+    pub fn energy(&self, env: &Environment) -> Energy {
+        let g = env.effective_gravity();
+        let p = &self.particles;
+        let mut e = Energy::default();
+        for i in 0..p.len() {
+            if p.inv_mass[i] > 0.0 {
+                e.kinetic += 0.5 * p.mass[i] * p.velocity[i].length_squared();
+                e.gravitational -= p.mass[i] * g.dot(p.position[i]);
+            }
+        }
+        for kind in SpringKind::ALL {
+            let k = self.stiffness(kind);
+            if k == 0.0 {
+                continue;
+            }
+            for s in self.springs.ranges[kind as usize].clone() {
+                if self.springs.alive[s] {
+                    let l = p.position[self.springs.a[s] as usize]
+                        .distance(p.position[self.springs.b[s] as usize]);
+                    e.spring += 0.5 * k * (l - self.springs.rest_length[s]).powi(2);
+                }
+            }
+        }
+        e
+    }
+
+    /// Stretch of the whole structural springs.
+    pub fn strain(&self) -> Strain {
+        let x = &self.particles.position;
+        let s = &self.springs;
+        let mut max = f32::NEG_INFINITY;
+        let (mut sum, mut count) = (0.0f32, 0usize);
+        for k in s.ranges[SpringKind::Structural as usize].clone() {
+            if s.alive[k] {
+                let l = x[s.a[k] as usize].distance(x[s.b[k] as usize]);
+                let e = (l - s.rest_length[k]) / s.rest_length[k];
+                max = max.max(e);
+                sum += e.abs();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return Strain::default();
+        }
+        Strain {
+            max,
+            mean: sum / count as f32,
+        }
+    }
+
+    /// Smooth vertex normals (area-weighted over the visible triangles) into `out`, which
+    /// must hold one entry per particle. Allocates nothing.
+    pub fn normals_into(&self, out: &mut [Vec3]) {
+        out.fill(Vec3::ZERO);
+        let x = &self.particles.position;
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if !self.triangle_visible[t] {
+                continue;
+            }
+            let [a, b, c] = tri.map(|v| v as usize);
+            let n = (x[b] - x[a]).cross(x[c] - x[a]);
+            out[a] += n;
+            out[b] += n;
+            out[c] += n;
+        }
+        for n in out.iter_mut() {
+            *n = n.normalize_or(Vec3::Z);
+        }
+    }
+}

@@ -1,0 +1,49 @@
+//! Particle state as structure-of-arrays.
+
+use bevy::math::Vec3;
+
+/// Every particle's state, one array per quantity (structure-of-arrays).
+#[derive(Clone, Debug, Default)]
+pub struct Particles {
+    /// Position `x` in world space, m.
+    pub position: Vec<Vec3>,
+    /// Position at the start of the last substep (Verlet's `x_{n−1}`).
+    pub previous: Vec<Vec3>,
+    /// Velocity `v` in m/s (integrated by Euler, `(x − x_prev)/h` for Verlet).
+    pub velocity: Vec<Vec3>,
+    /// Mass `m` in kg (kept for pinned particles too, for energies and centres of mass).
+    pub mass: Vec<f32>,
+    /// `1/m`, or 0 for a pinned particle.
+    pub inv_mass: Vec<f32>,
+    /// Force accumulated in the current substep, N.
+    pub force: Vec<Vec3>,
+}
+
+impl Particles {
+    /// `n` particles at the origin.
+    pub fn with_len(n: usize) -> Self {
+        Self {
+            position: vec![Vec3::ZERO; n],
+            previous: vec![Vec3::ZERO; n],
+            velocity: vec![Vec3::ZERO; n],
+            mass: vec![0.0; n],
+            inv_mass: vec![0.0; n],
+            force: vec![Vec3::ZERO; n],
+        }
+    }
+
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.position.len()
+    }
+
+    /// True when there are none.
+    pub fn is_empty(&self) -> bool {
+        self.position.is_empty()
+    }
+
+    /// True when particle `i` is pinned.
+    pub fn is_pinned(&self, i: usize) -> bool {
+        self.inv_mass[i] == 0.0
+    }
+}

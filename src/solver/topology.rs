@@ -1,0 +1,191 @@
+//! Springs and triangles: who is connected to whom, built once per cloth.
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use bevy::math::Vec3;
+
+/// The kind of a spring, which decides its stiffness (seed 000 §2.2, Slika 1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SpringKind {
+    /// Horizontal and vertical neighbours: resist stretch and compression.
+    Structural = 0,
+    /// Diagonal neighbours: resist shear.
+    Shear = 1,
+    /// Every second particle along rows and columns: resist bending.
+    Bend = 2,
+    /// Every second particle along diagonals: optional extra bending resistance.
+    BendDiagonal = 3,
+}
+
+impl SpringKind {
+    /// All kinds, in storage order.
+    pub const ALL: [SpringKind; 4] = [
+        SpringKind::Structural,
+        SpringKind::Shear,
+        SpringKind::Bend,
+        SpringKind::BendDiagonal,
+    ];
+}
+
+/// Springs as structure-of-arrays, sorted by kind so each kind is one contiguous range.
+#[derive(Clone, Debug, Default)]
+pub struct Springs {
+    /// First particle of each spring.
+    pub a: Vec<u32>,
+    /// Second particle of each spring.
+    pub b: Vec<u32>,
+    /// Rest length `l0` of each spring, from the initial layout.
+    pub rest_length: Vec<f32>,
+    /// False once a spring has torn.
+    pub alive: Vec<bool>,
+    /// The index range of each kind, in `SpringKind` order.
+    pub ranges: [Range<usize>; 4],
+}
+
+impl Springs {
+    /// Number of springs, torn ones included.
+    pub fn len(&self) -> usize {
+        self.a.len()
+    }
+
+    /// True when there are no springs.
+    pub fn is_empty(&self) -> bool {
+        self.a.is_empty()
+    }
+
+    /// The kind of spring `s`.
+    pub fn kind(&self, s: usize) -> SpringKind {
+        SpringKind::ALL
+            .into_iter()
+            .find(|k| self.ranges[*k as usize].contains(&s))
+            .unwrap_or(SpringKind::Structural)
+    }
+
+    /// Builds from unsorted `(kind, a, b)` triples with rest lengths from `positions`.
+    /// Duplicate pairs (in either order) of the same kind are kept once.
+    pub fn from_pairs(mut pairs: Vec<(SpringKind, u32, u32)>, positions: &[Vec3]) -> Self {
+        for p in &mut pairs {
+            if p.1 > p.2 {
+                std::mem::swap(&mut p.1, &mut p.2);
+            }
+        }
+        pairs.sort_by_key(|&(k, a, b)| (k as u8, a, b));
+        pairs.dedup();
+        let mut springs = Springs::default();
+        for kind in SpringKind::ALL {
+            let start = springs.a.len();
+            for &(_, a, b) in pairs.iter().filter(|p| p.0 == kind) {
+                springs.a.push(a);
+                springs.b.push(b);
+                springs
+                    .rest_length
+                    .push(positions[a as usize].distance(positions[b as usize]));
+                springs.alive.push(true);
+            }
+            springs.ranges[kind as usize] = start..springs.a.len();
+        }
+        springs
+    }
+}
+
+/// Spring pairs of a `width × height` grid, as in seed 000 §3.2's pseudocode, plus the
+/// optional diagonal bend springs. Particle `(i, j)` has index `j·width + i`.
+pub fn grid_spring_pairs(width: u32, height: u32) -> Vec<(SpringKind, u32, u32)> {
+    let idx = |i: u32, j: u32| j * width + i;
+    let mut pairs = Vec::new();
+    for j in 0..height {
+        for i in 0..width {
+            let p = idx(i, j);
+            if i + 1 < width {
+                pairs.push((SpringKind::Structural, p, idx(i + 1, j)));
+            }
+            if j + 1 < height {
+                pairs.push((SpringKind::Structural, p, idx(i, j + 1)));
+            }
+            if i + 1 < width && j + 1 < height {
+                pairs.push((SpringKind::Shear, p, idx(i + 1, j + 1)));
+                pairs.push((SpringKind::Shear, idx(i + 1, j), idx(i, j + 1)));
+            }
+            if i + 2 < width {
+                pairs.push((SpringKind::Bend, p, idx(i + 2, j)));
+            }
+            if j + 2 < height {
+                pairs.push((SpringKind::Bend, p, idx(i, j + 2)));
+            }
+            if i + 2 < width && j + 2 < height {
+                pairs.push((SpringKind::BendDiagonal, p, idx(i + 2, j + 2)));
+                pairs.push((SpringKind::BendDiagonal, idx(i + 2, j), idx(i, j + 2)));
+            }
+        }
+    }
+    pairs
+}
+
+/// Two triangles per grid quad, counter-clockwise seen from +z (the cloth's front), split
+/// along the quad's anti-diagonal.
+pub fn grid_triangles(width: u32, height: u32) -> Vec<[u32; 3]> {
+    let idx = |i: u32, j: u32| j * width + i;
+    let mut triangles = Vec::with_capacity(2 * (width as usize - 1) * (height as usize - 1));
+    for j in 0..height - 1 {
+        for i in 0..width - 1 {
+            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i, j + 1), idx(i + 1, j + 1));
+            triangles.push([a, c, b]);
+            triangles.push([b, c, d]);
+        }
+    }
+    triangles
+}
+
+/// Spring pairs of a triangle mesh: every edge is a structural spring; for every edge
+/// shared by two triangles, their two far corners are joined by a bend spring.
+pub fn mesh_spring_pairs(triangles: &[[u32; 3]]) -> Vec<(SpringKind, u32, u32)> {
+    let mut opposite: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+    for t in triangles {
+        for e in 0..3 {
+            let (a, b, c) = (t[e], t[(e + 1) % 3], t[(e + 2) % 3]);
+            opposite.entry((a.min(b), a.max(b))).or_default().push(c);
+        }
+    }
+    let mut pairs = Vec::with_capacity(opposite.len() * 2);
+    for (&(a, b), far) in &opposite {
+        pairs.push((SpringKind::Structural, a, b));
+        if let [c, d] = far[..]
+            && c != d
+        {
+            pairs.push((SpringKind::Bend, c, d));
+        }
+    }
+    pairs
+}
+
+/// For each triangle, the springs along its three edges (`u32::MAX` where an edge has no
+/// spring), and for each spring the triangles that use it as an edge. A torn spring hides
+/// the triangles it borders, so the cloth visibly splits.
+pub fn triangle_edge_springs(
+    triangles: &[[u32; 3]],
+    springs: &Springs,
+) -> (Vec<[u32; 3]>, Vec<Vec<u32>>) {
+    let mut by_pair: HashMap<(u32, u32), u32> = HashMap::with_capacity(springs.len());
+    // Prefer the structural or shear spring of an edge (they come first in storage).
+    for s in (0..springs.len()).rev() {
+        by_pair.insert((springs.a[s], springs.b[s]), s as u32);
+    }
+    let mut spring_triangles = vec![Vec::new(); springs.len()];
+    let edges = triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let mut e = [u32::MAX; 3];
+            for k in 0..3 {
+                let (a, b) = (tri[k], tri[(k + 1) % 3]);
+                if let Some(&s) = by_pair.get(&(a.min(b), a.max(b))) {
+                    e[k] = s;
+                    spring_triangles[s as usize].push(t as u32);
+                }
+            }
+            e
+        })
+        .collect();
+    (edges, spring_triangles)
+}

@@ -1,0 +1,368 @@
+//! Headless App tests of `ClothPlugin`: MinimalPlugins, manual time, no window.
+
+use std::time::Duration;
+
+use bevy::asset::AssetPlugin;
+use bevy::ecs::message::Messages;
+use bevy::mesh::{Mesh, Mesh3d, VertexAttributeValues};
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use bevy_cloth::prelude::*;
+
+fn app() -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        ClothPlugin::default(),
+    ))
+    .init_asset::<Mesh>()
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+        16,
+    )));
+    app
+}
+
+/// Default parameters: automatic substeps keep them stable.
+fn quiet_params() -> ClothParams {
+    ClothParams::default()
+}
+
+fn sim_time(app: &App, e: Entity) -> f32 {
+    app.world().get::<ClothSimulation>(e).unwrap().solver.time()
+}
+
+#[test]
+fn one_update_of_16_ms_runs_one_fixed_step_and_five_run_five() {
+    let mut app = app();
+    let e = app
+        .world_mut()
+        .spawn(Cloth::grid(4, 4, 0.1).with_params(quiet_params()))
+        .id();
+    // Run until the cloth is built and has stepped once, so time is flowing.
+    for _ in 0..3 {
+        app.update();
+    }
+    let t0 = sim_time(&app, e);
+    app.update();
+    let t1 = sim_time(&app, e);
+    assert!(
+        (t1 - t0 - 0.016).abs() < 1e-5,
+        "one update stepped {} s",
+        t1 - t0
+    );
+    for _ in 0..5 {
+        app.update();
+    }
+    let t6 = sim_time(&app, e);
+    assert!(
+        (t6 - t1 - 0.080).abs() < 1e-5,
+        "five updates stepped {} s",
+        t6 - t1
+    );
+}
+
+#[test]
+fn mesh_is_created_and_rewritten_in_place() {
+    let mut app = app();
+    let e = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(5, 4, 0.1).with_params(quiet_params()),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+        ))
+        .id();
+    app.update();
+    app.update();
+    let handle = app
+        .world()
+        .get::<Mesh3d>(e)
+        .expect("the plugin adds a mesh")
+        .0
+        .clone();
+    let read = |app: &App| -> Vec<[f32; 3]> {
+        let mesh = app.world().resource::<Assets<Mesh>>().get(&handle).unwrap();
+        match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
+            Some(VertexAttributeValues::Float32x3(p)) => p.clone(),
+            _ => panic!("no positions"),
+        }
+    };
+    let before = read(&app);
+    assert_eq!(before.len(), 20);
+    for _ in 0..10 {
+        app.update();
+    }
+    let after = read(&app);
+    assert_eq!(
+        app.world().get::<Mesh3d>(e).unwrap().0,
+        handle,
+        "a new mesh was made"
+    );
+    assert_ne!(before, after, "the mesh did not follow the cloth");
+    // Positions are local to the entity: solver world position = transform · mesh position.
+    let sim = app.world().get::<ClothSimulation>(e).unwrap();
+    let world = sim.solver.positions()[19];
+    let local = Vec3::from(after[19]);
+    assert!(
+        (local + Vec3::new(0.0, 2.0, 0.0) - world).length() < 1e-4,
+        "local {local} world {world}"
+    );
+    // Pinned corners sit where the grid puts them in the entity's frame.
+    assert!((Vec3::from(after[0]) - Vec3::new(-0.2, 0.0, 0.0)).length() < 1e-5);
+}
+
+#[test]
+fn edits_take_effect_and_grid_changes_rebuild() {
+    let mut app = app();
+    let e = app
+        .world_mut()
+        .spawn(Cloth::grid(4, 4, 0.1).with_params(quiet_params()))
+        .id();
+    app.update();
+    app.update();
+    app.world_mut()
+        .get_mut::<Cloth>(e)
+        .unwrap()
+        .params
+        .springs
+        .structural
+        .stiffness = 321.0;
+    app.update();
+    let sim = app.world().get::<ClothSimulation>(e).unwrap();
+    assert_eq!(sim.solver.params().springs.structural.stiffness, 321.0);
+    assert_eq!(sim.solver.particle_count(), 16);
+    app.world_mut().get_mut::<Cloth>(e).unwrap().shape = ClothShape::Grid {
+        width: 6,
+        height: 3,
+        spacing: 0.1,
+    };
+    app.update();
+    app.update();
+    assert_eq!(
+        app.world()
+            .get::<ClothSimulation>(e)
+            .unwrap()
+            .solver
+            .particle_count(),
+        18
+    );
+}
+
+#[test]
+fn gravity_toggle_changes_the_next_step() {
+    let mut app = app();
+    let e = app
+        .world_mut()
+        .spawn(Cloth::grid(4, 4, 0.1).with_pins(Pins::None))
+        .id();
+    app.world_mut()
+        .resource_mut::<ClothEnvironment>()
+        .gravity_enabled = false;
+    for _ in 0..5 {
+        app.update();
+    }
+    let y = |app: &App| {
+        app.world()
+            .get::<ClothSimulation>(e)
+            .unwrap()
+            .solver
+            .positions()[0]
+            .y
+    };
+    let still = y(&app);
+    app.update();
+    assert_eq!(y(&app), still, "no gravity, no motion");
+    app.world_mut()
+        .resource_mut::<ClothEnvironment>()
+        .gravity_enabled = true;
+    app.update();
+    assert!(y(&app) < still, "gravity on: it falls");
+}
+
+#[test]
+fn pinned_cloth_follows_its_transform() {
+    let mut app = app();
+    let e = app
+        .world_mut()
+        .spawn((Cloth::grid(4, 4, 0.1), Transform::from_xyz(0.0, 1.0, 0.0)))
+        .id();
+    for _ in 0..3 {
+        app.update();
+    }
+    app.world_mut().get_mut::<Transform>(e).unwrap().translation = Vec3::new(1.0, 1.5, 0.0);
+    for _ in 0..3 {
+        app.update();
+    }
+    let sim = app.world().get::<ClothSimulation>(e).unwrap();
+    let corner = sim.solver.positions()[0];
+    assert!(
+        (corner - Vec3::new(1.0 - 0.15, 1.5, 0.0)).length() < 1e-4,
+        "corner at {corner}"
+    );
+}
+
+#[test]
+fn torn_springs_send_messages() {
+    let mut app = app();
+    let params = ClothParams {
+        tear_ratio: Some(1.3),
+        strain_limit: None,
+        ..ClothParams::default()
+    };
+    let e = app
+        .world_mut()
+        .spawn(
+            Cloth::grid(5, 5, 0.1)
+                .with_pins(Pins::TopRow)
+                .with_params(params),
+        )
+        .id();
+    app.world_mut().resource_mut::<ClothEnvironment>().gravity = Vec3::new(0.0, -30_000.0, 0.0);
+    let mut cursor = app.world().resource::<Messages<ClothTorn>>().get_cursor();
+    let mut seen = Vec::new();
+    for _ in 0..30 {
+        app.update();
+        let messages = app.world().resource::<Messages<ClothTorn>>();
+        seen.extend(cursor.read(messages).copied());
+    }
+    let sim = app.world().get::<ClothSimulation>(e).unwrap();
+    assert!(
+        !seen.is_empty(),
+        "strain {:?} torn {}",
+        sim.solver.strain(),
+        sim.solver.torn_count()
+    );
+    assert_eq!(seen.len(), sim.solver.torn_count());
+    assert!(
+        seen.iter()
+            .all(|m| m.cloth == e && !sim.solver.springs().alive[m.spring as usize])
+    );
+}
+
+#[test]
+fn invalid_cloths_are_logged_and_skipped_not_panicked() {
+    let mut app = app();
+    let bad_mass = app
+        .world_mut()
+        .spawn(Cloth::grid(4, 4, 0.1).with_params(ClothParams {
+            node_mass: -1.0,
+            ..default()
+        }))
+        .id();
+    let bad_pin = app
+        .world_mut()
+        .spawn(Cloth::grid(4, 4, 0.1).with_pins(Pins::Indices(vec![99])))
+        .id();
+    let tiny = app.world_mut().spawn(Cloth::grid(1, 4, 0.1)).id();
+    let good = app.world_mut().spawn(Cloth::grid(4, 4, 0.1)).id();
+    for _ in 0..3 {
+        app.update();
+    }
+    for e in [bad_mass, bad_pin, tiny] {
+        assert!(app.world().get::<ClothInvalid>(e).is_some());
+        assert!(app.world().get::<ClothSimulation>(e).is_none());
+    }
+    assert!(app.world().get::<ClothSimulation>(good).is_some());
+    // Fixing the description builds it.
+    app.world_mut()
+        .get_mut::<Cloth>(bad_mass)
+        .unwrap()
+        .params
+        .node_mass = 1e-3;
+    app.update();
+    app.update();
+    assert!(app.world().get::<ClothInvalid>(bad_mass).is_none());
+    assert!(app.world().get::<ClothSimulation>(bad_mass).is_some());
+    // A running cloth given a bad value pauses with the error, and resumes when fixed.
+    app.world_mut().get_mut::<Cloth>(good).unwrap().params.drag = f32::NAN;
+    app.update();
+    let t = sim_time(&app, good);
+    app.update();
+    assert!(app.world().get::<ClothInvalid>(good).is_some());
+    assert_eq!(sim_time(&app, good), t);
+    app.world_mut().get_mut::<Cloth>(good).unwrap().params.drag = 0.0;
+    app.update();
+    app.update();
+    assert!(app.world().get::<ClothInvalid>(good).is_none());
+    assert!(sim_time(&app, good) > t);
+}
+
+#[test]
+fn a_mesh_becomes_a_cloth() {
+    let mut app = app();
+    let plane = Plane3d::new(Vec3::Z, Vec2::splat(0.5))
+        .mesh()
+        .subdivisions(3)
+        .build();
+    let vertices = plane.count_vertices();
+    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(plane);
+    let e = app
+        .world_mut()
+        .spawn((Cloth::from_mesh(), Mesh3d(handle.clone())))
+        .id();
+    for _ in 0..3 {
+        app.update();
+    }
+    let sim = app
+        .world()
+        .get::<ClothSimulation>(e)
+        .expect("built from the mesh");
+    assert_eq!(sim.solver.particle_count(), vertices);
+    assert_eq!(
+        sim.solver.pins().len(),
+        5,
+        "the top row of a 5×5 vertex plane"
+    );
+    assert!(sim.solver.spring_count() > vertices);
+    assert_ne!(
+        app.world().get::<Mesh3d>(e).unwrap().0,
+        handle,
+        "the source mesh is left alone"
+    );
+}
+
+#[test]
+fn several_cloths_step_together() {
+    let mut app = app();
+    let light = app
+        .world_mut()
+        .spawn(Cloth::grid(4, 4, 0.1).with_params(ClothParams {
+            substeps: Substeps::Fixed(40),
+            ..default()
+        }))
+        .id();
+    let heavy = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 8, 0.05).with_params(ClothParams {
+                substeps: Substeps::Fixed(60),
+                ..default()
+            }),
+            Transform::from_xyz(2.0, 0.0, 0.0),
+        ))
+        .id();
+    for _ in 0..10 {
+        app.update();
+    }
+    let time = |e| sim_time(&app, e);
+    assert!((time(light) - time(heavy)).abs() < 1e-5);
+    assert!(time(light) > 0.1);
+    let sim = app.world().get::<ClothSimulation>(heavy).unwrap();
+    assert_eq!(sim.solver.substeps(), 60);
+    assert!(sim.solver.is_stable());
+}
+
+#[test]
+fn pause_stops_every_cloth() {
+    let mut app = app();
+    let e = app.world_mut().spawn(Cloth::grid(4, 4, 0.1)).id();
+    for _ in 0..3 {
+        app.update();
+    }
+    app.world_mut().resource_mut::<ClothPaused>().0 = true;
+    let t = sim_time(&app, e);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(sim_time(&app, e), t);
+}

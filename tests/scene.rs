@@ -1,0 +1,64 @@
+//! Scene files: the shipped ones load; malformed ones name the file, line and field.
+
+use std::path::Path;
+
+use bevy_cloth::prelude::*;
+
+#[test]
+fn shipped_scenes_load() {
+    for entry in std::fs::read_dir("assets/scenes").unwrap() {
+        let path = entry.unwrap().path();
+        let scene = ClothScene::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert!(!scene.cloths.is_empty(), "{}", path.display());
+    }
+    let curtain = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    assert_eq!(curtain.timestep, 0.016);
+    assert_eq!(curtain.cloths[0].cloth.pins, Pins::TopCorners);
+}
+
+fn parse(text: &str) -> Result<ClothScene, SceneError> {
+    ClothScene::parse(text, Path::new("bad.ron"))
+}
+
+#[test]
+fn a_missing_file_names_it() {
+    let e = ClothScene::load("assets/scenes/nope.ron").unwrap_err();
+    assert!(e.to_string().contains("nope.ron"), "{e}");
+}
+
+#[test]
+fn syntax_and_unknown_fields_give_line_and_column() {
+    let text = "(\n  cloths: [\n    (cloth: (shape: Grid(width: 4, height: 4, spacing: 0.1), pinz: TopRow)),\n  ],\n)";
+    match parse(text).unwrap_err() {
+        SceneError::Parse {
+            file,
+            line,
+            message,
+            ..
+        } => {
+            assert_eq!(file, Path::new("bad.ron"));
+            assert_eq!(line, 3);
+            assert!(message.contains("pinz"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let broken = "(\n  cloths: [\n    (cloth: (shape: Grid(width: 4, height: 4, spacing: 0.1)),\n";
+    assert!(matches!(parse(broken), Err(SceneError::Parse { .. })));
+}
+
+#[test]
+fn bad_values_name_the_field_and_line() {
+    let text = "(\n  cloths: [\n    (cloth: (\n      shape: Grid(width: 4, height: 4, spacing: 0.1),\n      params: (\n        node_mass: -2.0,\n      ),\n    )),\n  ],\n)";
+    match parse(text).unwrap_err() {
+        SceneError::Invalid { field, line, .. } => {
+            assert_eq!(field, "cloths[0].cloth.params.node_mass");
+            assert_eq!(line, 6);
+        }
+        other => panic!("{other:?}"),
+    }
+    let tiny = "(cloths: [(cloth: (shape: Grid(width: 1, height: 4, spacing: 0.1)))])";
+    let e = parse(tiny).unwrap_err();
+    assert!(e.to_string().contains("2×2"), "{e}");
+    let dt = "(timestep: 0.0, cloths: [])";
+    assert!(matches!(parse(dt), Err(SceneError::Invalid { .. })));
+}

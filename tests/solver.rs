@@ -1,0 +1,637 @@
+//! Solver tests against answers known independently of the code: free fall, a spring's
+//! period, energy conservation, rest, tearing, the explicit stability bound.
+
+use bevy::math::{Affine3A, Quat, Vec3};
+use bevy_cloth::prelude::*;
+use bevy_cloth::solver::{Cloth as Solver, SpringKind};
+
+const DT: f32 = 0.016;
+
+fn no_springs() -> SpringParams {
+    SpringParams {
+        structural: SpringFamily::off(100.0),
+        shear: SpringFamily::off(50.0),
+        bend: SpringFamily::off(50.0),
+        bend_diagonal: SpringFamily::off(25.0),
+        damping: 0.0,
+    }
+}
+
+/// Parameters with every dissipative or corrective term off.
+fn conservative(integrator: Integrator) -> ClothParams {
+    ClothParams {
+        node_mass: 1e-3,
+        springs: SpringParams::from_structural(50.0),
+        drag: 0.0,
+        integrator,
+        substeps: Substeps::Auto { max: 8192 },
+        strain_limit: None,
+        strain_limit_iterations: 0,
+        tear_ratio: None,
+    }
+}
+
+fn no_wind() -> Environment {
+    Environment::default()
+}
+
+#[test]
+fn free_fall_follows_half_g_t_squared() {
+    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        let params = ClothParams {
+            springs: no_springs(),
+            substeps: Substeps::Fixed(1),
+            ..conservative(integrator)
+        };
+        let mut cloth = Solver::new(
+            &ClothShape::Grid {
+                width: 2,
+                height: 2,
+                spacing: 0.1,
+            },
+            &Pins::None,
+            &params,
+            Affine3A::IDENTITY,
+        )
+        .unwrap();
+        let y0 = cloth.positions()[0].y;
+        let env = no_wind();
+        let g = 9.81f32;
+        let steps = 62; // ≈ 1 s
+        for _ in 0..steps {
+            cloth.step(DT, &env);
+        }
+        let t = steps as f32 * DT;
+        let drop = y0 - cloth.positions()[0].y;
+        let exact = 0.5 * g * t * t;
+        // Both integrators take the first step as x1 = x0 + g h², so they fall
+        // g h² n(n+1)/2: ahead of g t²/2 by g h t/2, their known first-order error.
+        let discrete = 0.5 * g * DT * DT * (steps * (steps + 1)) as f32;
+        assert!(
+            (drop - discrete).abs() < 1e-4 * exact,
+            "{integrator:?}: {drop} vs {discrete}"
+        );
+        assert!(
+            (drop - exact).abs() <= 0.5 * g * DT * t * 1.01,
+            "{integrator:?}"
+        );
+        assert!(
+            (drop - exact).abs() / exact < 0.02,
+            "{integrator:?}: {drop} vs {exact}"
+        );
+    }
+}
+
+/// A particle of mass m on one spring k to a pin, displaced along the spring, oscillates
+/// with period 2π√(m/k).
+#[test]
+fn spring_period_matches_two_pi_sqrt_m_over_k() {
+    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        let (m, k) = (0.01f32, 100.0f32);
+        let params = ClothParams {
+            node_mass: m,
+            springs: SpringParams::from_structural(k),
+            substeps: Substeps::Fixed(1),
+            ..conservative(integrator)
+        };
+        let positions = [Vec3::ZERO, Vec3::new(0.0, -1.0, 0.0)];
+        let mut cloth = Solver::from_springs(
+            &positions,
+            &[[0, 1]],
+            &Pins::Indices(vec![0]),
+            &params,
+            Affine3A::IDENTITY,
+        )
+        .unwrap();
+        let start = Vec3::new(0.0, -1.05, 0.0);
+        let p = cloth.particles_mut();
+        p.position[1] = start;
+        p.previous[1] = start;
+        let env = Environment {
+            gravity_enabled: false,
+            ..no_wind()
+        };
+        let dt = 0.0005;
+        let mut crossings = Vec::new();
+        let mut last = start.y + 1.0;
+        for n in 1..=4000 {
+            cloth.step(dt, &env);
+            let y = cloth.positions()[1].y + 1.0;
+            if last < 0.0 && y >= 0.0 {
+                // Linear interpolation of the upward zero crossing.
+                crossings.push((n as f32 - 1.0 + last / (last - y)) * dt);
+            }
+            last = y;
+        }
+        assert!(
+            crossings.len() >= 5,
+            "{integrator:?}: only {} crossings",
+            crossings.len()
+        );
+        let period = (crossings[crossings.len() - 1] - crossings[0]) / (crossings.len() - 1) as f32;
+        let expected = 2.0 * std::f32::consts::PI * (m / k).sqrt();
+        let error = (period - expected).abs() / expected;
+        assert!(
+            error < 0.02,
+            "{integrator:?}: period {period} vs {expected} ({:.3}%)",
+            error * 100.0
+        );
+    }
+}
+
+/// A cloth held at two corners, released horizontal so it swings.
+fn swinging_cloth(params: &ClothParams) -> Solver {
+    let frame = Affine3A::from_rotation_translation(
+        Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        Vec3::new(0.0, 1.0, 0.0),
+    );
+    Solver::new(
+        &ClothShape::Grid {
+            width: 8,
+            height: 8,
+            spacing: 0.1,
+        },
+        &Pins::TopCorners,
+        params,
+        frame,
+    )
+    .unwrap()
+}
+
+/// Largest |E − E0| over steps `[from, to)` of a swinging cloth with `substeps` fixed.
+fn energy_drift(substeps: u32, steps: usize, from: usize) -> (f32, Solver) {
+    let params = ClothParams {
+        substeps: Substeps::Fixed(substeps),
+        ..conservative(Integrator::Verlet)
+    };
+    let mut cloth = swinging_cloth(&params);
+    let env = no_wind();
+    let pins: Vec<Vec3> = cloth
+        .pins()
+        .iter()
+        .map(|&i| cloth.positions()[i as usize])
+        .collect();
+    let e0 = cloth.energy(&env).total();
+    let mut worst = 0.0f32;
+    for n in 0..steps {
+        cloth.step(DT, &env);
+        if n >= from {
+            worst = worst.max((cloth.energy(&env).total() - e0).abs());
+        }
+        for (k, &i) in cloth.pins().iter().enumerate() {
+            assert_eq!(
+                cloth.positions()[i as usize],
+                pins[k],
+                "pin {i} moved at step {n}"
+            );
+        }
+    }
+    (worst, cloth)
+}
+
+#[test]
+fn undamped_verlet_keeps_energy_bounded_and_pins_still() {
+    // Verlet is symplectic and first order in its velocity estimate: the energy error
+    // oscillates with an amplitude proportional to h and does not grow.
+    let params = conservative(Integrator::Verlet);
+    let scale = 64.0 * params.node_mass * 9.81 * 0.7; // the cloth dropping its own length
+    let n = swinging_cloth(&params).stable_substeps(DT);
+    let (early, _) = energy_drift(n, 1000, 0);
+    let (late, cloth) = energy_drift(n, 10_000, 9000);
+    assert!(cloth.is_stable());
+    assert!(late < 0.1 * scale, "late drift {late} of scale {scale}");
+    assert!(
+        late < 2.0 * early,
+        "energy grows: {early} in the first 1000 steps, {late} in the last"
+    );
+    // Halving h roughly halves the error (first order): it is truncation, not blow-up.
+    let (fine, _) = energy_drift(2 * n, 1000, 0);
+    assert!(fine < 0.75 * early, "halving h: {early} → {fine}");
+}
+
+#[test]
+fn damped_cloth_comes_to_rest() {
+    let params = ClothParams {
+        drag: 2e-3,
+        springs: SpringParams {
+            damping: 0.01,
+            ..SpringParams::from_structural(50.0)
+        },
+        ..conservative(Integrator::SemiImplicitEuler)
+    };
+    let mut cloth = swinging_cloth(&params);
+    let env = no_wind();
+    let mut peak = 0.0f32;
+    for _ in 0..(20.0 / DT) as usize {
+        cloth.step(DT, &env);
+        peak = peak.max(cloth.energy(&env).kinetic);
+    }
+    let kinetic = cloth.energy(&env).kinetic;
+    assert!(peak > 1e-3, "the cloth never moved: {peak}");
+    assert!(
+        kinetic < 1e-6 * peak,
+        "still moving: {kinetic} of peak {peak}"
+    );
+    // At rest it hangs below its pins.
+    let lowest = cloth
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f32::INFINITY, f32::min);
+    assert!(lowest < 1.0 - 0.5, "lowest point {lowest}");
+}
+
+fn tear_test_cloth(tear_ratio: f32, gravity: f32) -> (Solver, Environment) {
+    let params = ClothParams {
+        tear_ratio: Some(tear_ratio),
+        drag: 1e-3,
+        ..conservative(Integrator::Verlet)
+    };
+    let cloth = Solver::new(
+        &ClothShape::Grid {
+            width: 6,
+            height: 6,
+            spacing: 0.1,
+        },
+        &Pins::TopRow,
+        &params,
+        Affine3A::IDENTITY,
+    )
+    .unwrap();
+    let env = Environment {
+        gravity: Vec3::new(0.0, -gravity, 0.0),
+        ..no_wind()
+    };
+    (cloth, env)
+}
+
+#[test]
+fn cloth_tears_past_its_ratio_and_not_below() {
+    // Under normal gravity the top springs stretch by m g (rows below) / k ≈ 5%.
+    let (mut calm, env) = tear_test_cloth(1.5, 9.81);
+    for _ in 0..300 {
+        calm.step(DT, &env);
+    }
+    assert_eq!(calm.torn_count(), 0);
+    assert!(calm.triangle_visible().iter().all(|v| *v));
+
+    // Under 200 g the same springs would stretch by ~1000%: they tear, faces hide.
+    let (mut pulled, env) = tear_test_cloth(1.5, 200.0 * 9.81);
+    let mut torn = Vec::new();
+    for _ in 0..300 {
+        let n = pulled.begin_step(DT);
+        for _ in 0..n {
+            pulled.substep(&env);
+        }
+        torn.extend_from_slice(pulled.end_step());
+    }
+    assert!(!torn.is_empty());
+    assert_eq!(torn.len(), pulled.torn_count());
+    assert!(torn.iter().all(|&s| !pulled.springs().alive[s as usize]));
+    assert!(
+        pulled.triangle_visible().iter().any(|v| !*v),
+        "no face was hidden"
+    );
+    assert!(pulled.is_finite());
+}
+
+/// Seed 002's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
+fn seed_002_extreme(substeps: Substeps) -> (Solver, Environment) {
+    let params = ClothParams {
+        node_mass: 1e-6,
+        springs: SpringParams::from_structural(25_000.0),
+        substeps,
+        ..conservative(Integrator::Verlet)
+    };
+    let cloth = Solver::new(
+        &ClothShape::Grid {
+            width: 4,
+            height: 4,
+            spacing: 0.05,
+        },
+        &Pins::TopCorners,
+        &params,
+        Affine3A::from_rotation_x(-1.2),
+    )
+    .unwrap();
+    let env = Environment {
+        wind: Wind {
+            direction: Vec3::Z,
+            strength: 1e-6,
+            field: WindField::Trigonometric,
+        },
+        ..no_wind()
+    };
+    (cloth, env)
+}
+
+#[test]
+fn stable_substeps_tame_the_stiffest_lightest_seed_material() {
+    let (mut auto, env) = seed_002_extreme(Substeps::Auto { max: 100_000 });
+    let n = auto.stable_substeps(DT);
+    // Gershgorin: ω² ≤ 2·Σk/m = 2·(4·25000 + 4·12500 + 4·12500)/1e-6 for an inner particle.
+    let omega = (2.0f32 * 200_000.0 / 1e-6).sqrt();
+    assert!(
+        n as f32 >= DT * omega / 2.0,
+        "{n} substeps is below the bound"
+    );
+    assert!(
+        (n as f32) < 2.0 * DT * omega / 2.0,
+        "{n} substeps is far above the bound"
+    );
+    for _ in 0..1000 {
+        auto.step(DT, &env);
+    }
+    assert_eq!(auto.substeps(), n);
+    assert!(!auto.under_resolved());
+    assert!(auto.is_stable(), "max strain {}", auto.strain().max);
+
+    let (mut single, env) = seed_002_extreme(Substeps::Fixed(1));
+    let mut failed_at = None;
+    for step in 0..1000 {
+        single.step(DT, &env);
+        if !single.is_stable() {
+            failed_at = Some(step);
+            break;
+        }
+    }
+    assert!(
+        failed_at.is_some(),
+        "one substep of 16 ms should not be stable here"
+    );
+}
+
+#[test]
+fn auto_substeps_report_when_capped() {
+    let (mut capped, env) = seed_002_extreme(Substeps::Auto { max: 16 });
+    capped.step(DT, &env);
+    assert_eq!(capped.substeps(), 16);
+    assert!(capped.under_resolved());
+}
+
+#[test]
+fn changing_substeps_keeps_verlet_velocity() {
+    let params = ClothParams {
+        springs: no_springs(),
+        substeps: Substeps::Fixed(1),
+        ..conservative(Integrator::Verlet)
+    };
+    let mut cloth = Solver::new(
+        &ClothShape::Grid {
+            width: 2,
+            height: 2,
+            spacing: 0.1,
+        },
+        &Pins::None,
+        &params,
+        Affine3A::IDENTITY,
+    )
+    .unwrap();
+    let env = Environment {
+        gravity_enabled: false,
+        ..no_wind()
+    };
+    cloth.particles_mut().velocity.fill(Vec3::X);
+    let p = cloth.particles_mut();
+    for i in 0..p.len() {
+        p.previous[i] = p.position[i] - Vec3::X * DT;
+    }
+    cloth.step(DT, &env);
+    let x1 = cloth.positions()[0].x;
+    cloth
+        .set_params(&ClothParams {
+            substeps: Substeps::Fixed(7),
+            ..params
+        })
+        .unwrap();
+    cloth.step(DT, &env);
+    let x2 = cloth.positions()[0].x;
+    assert!(
+        ((x2 - x1) - DT).abs() < 1e-5,
+        "moved {} instead of {DT}",
+        x2 - x1
+    );
+}
+
+#[test]
+fn pins_follow_the_frame() {
+    let params = conservative(Integrator::Verlet);
+    let mut cloth = swinging_cloth(&params);
+    let env = no_wind();
+    let before: Vec<Vec3> = cloth
+        .pins()
+        .iter()
+        .map(|&i| cloth.positions()[i as usize])
+        .collect();
+    let shift = Vec3::new(0.3, 0.0, -0.2);
+    cloth.set_frame(Affine3A::from_translation(shift) * cloth.frame());
+    cloth.step(DT, &env);
+    for (k, &i) in cloth.pins().iter().enumerate() {
+        assert!((cloth.positions()[i as usize] - (before[k] + shift)).length() < 1e-5);
+    }
+    // The rest of the cloth is dragged along over the following steps.
+    let centre =
+        |c: &Solver| c.positions().iter().copied().sum::<Vec3>() / c.particle_count() as f32;
+    let c0 = centre(&cloth);
+    for _ in 0..200 {
+        cloth.step(DT, &env);
+    }
+    assert!(
+        (centre(&cloth).x - c0.x).abs() < 0.5,
+        "cloth did not stay with its pins"
+    );
+}
+
+#[test]
+fn grid_topology_matches_the_seed() {
+    let cloth = Solver::new(
+        &ClothShape::Grid {
+            width: 5,
+            height: 4,
+            spacing: 0.1,
+        },
+        &Pins::TopRow,
+        &ClothParams {
+            springs: SpringParams {
+                bend_diagonal: SpringFamily::new(10.0),
+                ..SpringParams::default()
+            },
+            ..ClothParams::default()
+        },
+        Affine3A::IDENTITY,
+    )
+    .unwrap();
+    let s = cloth.springs();
+    let count = |k: SpringKind| s.ranges[k as usize].len();
+    let (w, h) = (5, 4);
+    assert_eq!(count(SpringKind::Structural), (w - 1) * h + w * (h - 1));
+    assert_eq!(count(SpringKind::Shear), 2 * (w - 1) * (h - 1));
+    assert_eq!(count(SpringKind::Bend), (w - 2) * h + w * (h - 2));
+    assert_eq!(count(SpringKind::BendDiagonal), 2 * (w - 2) * (h - 2));
+    let rest = |k: SpringKind| s.rest_length[s.ranges[k as usize].start];
+    assert!((rest(SpringKind::Structural) - 0.1).abs() < 1e-6);
+    assert!((rest(SpringKind::Shear) - 0.1 * 2f32.sqrt()).abs() < 1e-6);
+    assert!((rest(SpringKind::Bend) - 0.2).abs() < 1e-6);
+    assert!((rest(SpringKind::BendDiagonal) - 0.2 * 2f32.sqrt()).abs() < 1e-6);
+    assert_eq!(cloth.pins(), &[0, 1, 2, 3, 4]);
+    assert_eq!(cloth.triangles().len(), 2 * (w - 1) * (h - 1));
+    // Switching a family off removes it from the acting springs.
+    let mut c = cloth.clone();
+    let all = c.spring_count();
+    let mut p = *c.params();
+    p.springs.shear.enabled = false;
+    c.set_params(&p).unwrap();
+    assert_eq!(c.spring_count(), all - count(SpringKind::Shear));
+}
+
+#[test]
+fn a_pinned_cloth_at_rest_stays_at_rest_without_gravity() {
+    let mut cloth = Solver::new(
+        &ClothShape::Grid {
+            width: 6,
+            height: 6,
+            spacing: 0.1,
+        },
+        &Pins::TopCorners,
+        &conservative(Integrator::Verlet),
+        Affine3A::IDENTITY,
+    )
+    .unwrap();
+    let start = cloth.positions().to_vec();
+    let env = Environment {
+        gravity_enabled: false,
+        ..no_wind()
+    };
+    for _ in 0..500 {
+        cloth.step(DT, &env);
+    }
+    for (a, b) in start.iter().zip(cloth.positions()) {
+        assert!(a.distance(*b) < 1e-6);
+    }
+    assert!(cloth.energy(&env).total().abs() < 1e-9);
+}
+
+#[test]
+fn bad_parameters_return_their_error() {
+    let grid = ClothShape::Grid {
+        width: 4,
+        height: 4,
+        spacing: 0.1,
+    };
+    let ok = ClothParams::default();
+    let build = |shape: &ClothShape, pins: &Pins, params: &ClothParams| {
+        Solver::new(shape, pins, params, Affine3A::IDENTITY).err()
+    };
+    let field = |e: Option<ClothError>| match e {
+        Some(ClothError::InvalidParameter { field, .. }) => field,
+        other => panic!("expected an invalid parameter, got {other:?}"),
+    };
+    assert_eq!(
+        field(build(
+            &grid,
+            &Pins::None,
+            &ClothParams {
+                node_mass: -1.0,
+                ..ok
+            }
+        )),
+        "node_mass"
+    );
+    assert_eq!(
+        field(build(
+            &grid,
+            &Pins::None,
+            &ClothParams {
+                node_mass: f32::NAN,
+                ..ok
+            }
+        )),
+        "node_mass"
+    );
+    assert_eq!(
+        field(build(
+            &grid,
+            &Pins::None,
+            &ClothParams {
+                node_mass: 0.0,
+                ..ok
+            }
+        )),
+        "node_mass"
+    );
+    let mut stiff = ok;
+    stiff.springs.shear.stiffness = -5.0;
+    assert_eq!(
+        field(build(&grid, &Pins::None, &stiff)),
+        "springs.shear.stiffness"
+    );
+    stiff.springs.shear.stiffness = f32::INFINITY;
+    assert_eq!(
+        field(build(&grid, &Pins::None, &stiff)),
+        "springs.shear.stiffness"
+    );
+    assert_eq!(
+        field(build(&grid, &Pins::None, &ClothParams { drag: -0.1, ..ok })),
+        "drag"
+    );
+    assert_eq!(
+        field(build(
+            &grid,
+            &Pins::None,
+            &ClothParams {
+                tear_ratio: Some(0.9),
+                ..ok
+            }
+        )),
+        "tear_ratio"
+    );
+    assert_eq!(
+        field(build(
+            &grid,
+            &Pins::None,
+            &ClothParams {
+                substeps: Substeps::Fixed(0),
+                ..ok
+            }
+        )),
+        "substeps"
+    );
+    for spacing in [0.0, -0.1, f32::NAN] {
+        let shape = ClothShape::Grid {
+            width: 4,
+            height: 4,
+            spacing,
+        };
+        assert_eq!(field(build(&shape, &Pins::None, &ok)), "shape.spacing");
+    }
+    let thin = ClothShape::Grid {
+        width: 1,
+        height: 5,
+        spacing: 0.1,
+    };
+    assert_eq!(
+        build(&thin, &Pins::None, &ok),
+        Some(ClothError::GridTooSmall {
+            width: 1,
+            height: 5
+        })
+    );
+    assert_eq!(
+        build(&grid, &Pins::Indices(vec![3, 16]), &ok),
+        Some(ClothError::PinOutOfRange {
+            index: 16,
+            count: 16
+        })
+    );
+    // A running cloth refuses bad parameters and keeps its old ones.
+    let mut cloth = Solver::new(&grid, &Pins::None, &ok, Affine3A::IDENTITY).unwrap();
+    assert!(
+        cloth
+            .set_params(&ClothParams {
+                node_mass: -1.0,
+                ..ok
+            })
+            .is_err()
+    );
+    assert_eq!(cloth.params(), &ok);
+}
