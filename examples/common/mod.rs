@@ -124,6 +124,10 @@ pub fn spawn_stage(
         })),
         Name::new("ground"),
     ));
+    commands.insert_resource(GlobalAmbientLight {
+        brightness: 250.0,
+        ..default()
+    });
     commands.spawn((
         DirectionalLight {
             illuminance: 9_000.0,
