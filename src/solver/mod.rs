@@ -77,7 +77,9 @@ pub struct Cloth {
     substeps: u32,
     substep_index: u32,
     under_resolved: bool,
-    auto_cache: Option<(ClothParams, f32, usize, u32)>,
+    /// Automatic substeps for (parameters, dt). Tearing only removes stiffness, so a cached
+    /// count stays stable after a tear and the step never recomputes (or allocates) for it.
+    auto_cache: Option<(ClothParams, f32, u32)>,
     torn_this_step: Vec<u32>,
     torn_count: usize,
 }
@@ -368,12 +370,11 @@ impl Cloth {
                 n.max(1)
             }
             crate::params::Substeps::Auto { max } => {
-                let key = (self.params, dt, self.torn_count);
                 let needed = match self.auto_cache {
-                    Some((p, d, t, n)) if (p, d, t) == key => n,
+                    Some((p, d, n)) if p == self.params && d == dt => n,
                     _ => {
                         let n = self.stable_substeps(dt);
-                        self.auto_cache = Some((key.0, key.1, key.2, n));
+                        self.auto_cache = Some((self.params, dt, n));
                         n
                     }
                 };
