@@ -35,25 +35,25 @@ fn no_wind() -> Environment {
     Environment::default()
 }
 
+/// Four unpinned particles with no springs: each falls freely, one substep per step.
+fn free_particles(integrator: Integrator) -> Solver {
+    let params = ClothParams {
+        springs: no_springs(),
+        substeps: Substeps::Fixed(1),
+        ..conservative(integrator)
+    };
+    let shape = ClothShape::Grid {
+        width: 2,
+        height: 2,
+        spacing: 0.1,
+    };
+    Solver::new(&shape, &Pins::None, &params, Affine3A::IDENTITY).unwrap()
+}
+
 #[test]
 fn free_fall_follows_half_g_t_squared() {
     for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
-        let params = ClothParams {
-            springs: no_springs(),
-            substeps: Substeps::Fixed(1),
-            ..conservative(integrator)
-        };
-        let mut cloth = Solver::new(
-            &ClothShape::Grid {
-                width: 2,
-                height: 2,
-                spacing: 0.1,
-            },
-            &Pins::None,
-            &params,
-            Affine3A::IDENTITY,
-        )
-        .unwrap();
+        let mut cloth = free_particles(integrator);
         let y0 = cloth.positions()[0].y;
         let env = no_wind();
         let g = 9.81f32;
@@ -371,22 +371,8 @@ fn auto_substeps_report_when_capped() {
 
 #[test]
 fn changing_substeps_keeps_verlet_velocity() {
-    let params = ClothParams {
-        springs: no_springs(),
-        substeps: Substeps::Fixed(1),
-        ..conservative(Integrator::Verlet)
-    };
-    let mut cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 2,
-            height: 2,
-            spacing: 0.1,
-        },
-        &Pins::None,
-        &params,
-        Affine3A::IDENTITY,
-    )
-    .unwrap();
+    let mut cloth = free_particles(Integrator::Verlet);
+    let params = *cloth.params();
     let env = Environment {
         gravity_enabled: false,
         ..no_wind()
