@@ -33,6 +33,7 @@
 #![warn(missing_docs)]
 
 pub mod components;
+pub mod controls;
 pub mod error;
 pub mod mesh;
 pub mod params;
@@ -44,8 +45,10 @@ pub mod solver;
 /// The types a user needs to add cloth to an app.
 pub mod prelude {
     pub use crate::components::{
-        Cloth, ClothEnvironment, ClothInvalid, ClothPaused, ClothSimulation, ClothTorn,
+        Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats, ClothTorn,
+        StatSample,
     };
+    pub use crate::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::error::ClothError;
     pub use crate::params::{
         ClothParams, Environment, Integrator, SpringFamily, SpringParams, Substeps, Wind, WindField,

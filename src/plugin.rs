@@ -25,7 +25,7 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
 use crate::components::{
-    Cloth, ClothEnvironment, ClothInvalid, ClothPaused, ClothSimulation, ClothTorn,
+    Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats, ClothTorn,
 };
 use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::params::{
@@ -130,9 +130,9 @@ impl Plugin for ClothPlugin {
             .register_type::<Wind>()
             .register_type::<WindField>()
             .register_type::<ClothEnvironment>()
-            .register_type::<ClothPaused>()
+            .register_type::<ClothPause>()
             .init_resource::<ClothEnvironment>()
-            .init_resource::<ClothPaused>()
+            .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
             .add_message::<ClothTorn>();
 
@@ -302,7 +302,7 @@ struct StepProgress {
 fn begin_steps(
     mut commands: Commands,
     time: Res<Time>,
-    paused: Res<ClothPaused>,
+    mut pause: ResMut<ClothPause>,
     mut plan: ResMut<ClothSubstepPlan>,
     mut cloths: Query<
         (Entity, &mut ClothSimulation, Option<&mut StepProgress>),
@@ -310,15 +310,15 @@ fn begin_steps(
     >,
 ) {
     let dt = time.delta_secs();
+    let run = !pause.paused || pause.pending_steps > 0;
+    if pause.paused && run {
+        pause.pending_steps -= 1;
+    }
     plan.count = 0;
     plan.index = 0;
     for (entity, mut sim, progress) in &mut cloths {
         let start = Instant::now();
-        let substeps = if paused.0 {
-            0
-        } else {
-            sim.solver.begin_step(dt)
-        };
+        let substeps = if run { sim.solver.begin_step(dt) } else { 0 };
         let progress_now = StepProgress {
             substeps,
             elapsed: start.elapsed(),
@@ -378,9 +378,18 @@ fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
 
 fn finish_steps(
     mut torn: MessageWriter<ClothTorn>,
-    mut cloths: Query<(Entity, &mut ClothSimulation, &StepProgress), Without<ClothInvalid>>,
+    env: Res<ClothEnvironment>,
+    mut cloths: Query<
+        (
+            Entity,
+            &mut ClothSimulation,
+            &StepProgress,
+            Option<&mut ClothStats>,
+        ),
+        Without<ClothInvalid>,
+    >,
 ) {
-    for (entity, mut sim, progress) in &mut cloths {
+    for (entity, mut sim, progress, stats) in &mut cloths {
         if progress.substeps == 0 {
             continue;
         }
@@ -398,6 +407,9 @@ fn finish_steps(
         }
         sim.last_step_ms = (progress.elapsed + start.elapsed()).as_secs_f32() * 1e3;
         sim.mesh_dirty = true;
+        if let Some(mut stats) = stats {
+            stats.record(&sim.solver, &env, sim.last_step_ms);
+        }
     }
 }
 

@@ -56,6 +56,13 @@ impl Cloth {
             p.velocity[i] = (target - p.position[i]) / h;
             p.position[i] = target;
         }
+        if let Some(g) = self.grab {
+            let i = g.particle as usize;
+            let target = g.from.lerp(g.target, t);
+            p.previous[i] = p.position[i];
+            p.velocity[i] = (target - p.position[i]) / h;
+            p.position[i] = target;
+        }
         if let Some(limit) = self.params.strain_limit {
             self.limit_strain(limit, h);
         }

@@ -12,9 +12,11 @@
 
 mod forces;
 mod integrate;
+mod interact;
 mod state;
 pub mod topology;
 
+pub use interact::Grab;
 pub use state::Particles;
 pub use topology::{SpringKind, Springs};
 
@@ -82,6 +84,7 @@ pub struct Cloth {
     auto_cache: Option<(ClothParams, f32, u32)>,
     torn_this_step: Vec<u32>,
     torn_count: usize,
+    grab: Option<Grab>,
 }
 
 impl Cloth {
@@ -252,6 +255,7 @@ impl Cloth {
             under_resolved: false,
             auto_cache: None,
             torn_count: 0,
+            grab: None,
         };
         cloth.reset();
         Ok(cloth)
@@ -260,6 +264,7 @@ impl Cloth {
     /// Puts every particle back at its rest position in the current frame, at rest, with
     /// every spring whole and the clock at zero.
     pub fn reset(&mut self) {
+        self.grab = None;
         let mass = self.params.node_mass;
         let p = &mut self.particles;
         for (i, local) in self.local_rest.iter().enumerate() {
@@ -394,6 +399,9 @@ impl Cloth {
         for (k, &i) in self.pins.iter().enumerate() {
             self.pin_to[k] = self.frame.transform_point3(self.local_rest[i as usize]);
             self.pin_from[k] = self.particles.position[i as usize];
+        }
+        if let Some(g) = &mut self.grab {
+            g.from = self.particles.position[g.particle as usize];
         }
         self.torn_this_step.clear();
         n
