@@ -14,6 +14,7 @@
 use std::path::{Path, PathBuf};
 
 use bevy::math::Vec3;
+use bevy::reflect::{GetPath, Reflect};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
@@ -85,6 +86,14 @@ pub enum SceneError {
         /// What the parser expected.
         message: String,
     },
+    /// A `--set key=value` override that does not apply.
+    #[error("--set {spec}: {message}")]
+    Override {
+        /// The override as given.
+        spec: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A value is out of range.
     #[error("{file}:{line}: `{field}`: {message}")]
     Invalid {
@@ -120,6 +129,54 @@ impl ClothScene {
         })?;
         scene.validate(text, file)?;
         Ok(scene)
+    }
+
+    /// Applies an override `key=value`, as the examples' and the command line's `--set`:
+    /// `timestep=0.01`, `environment.wind.strength=0`, `environment.gravity=0,-1.6,0`,
+    /// `cloth.params.node_mass=0.001` (every cloth), `cloths[1].pins=TopRow` (one cloth),
+    /// `cloth.params.substeps=auto` or `=8`, `cloth.params.tear_ratio=none` or `=2.5`,
+    /// `cloth.shape.width=64`. Keys are reflection paths into [`Environment`] and
+    /// [`Cloth`]; the result is checked like a scene file.
+    pub fn apply_override(&mut self, spec: &str) -> Result<(), SceneError> {
+        let fail = |message: String| SceneError::Override {
+            spec: spec.to_string(),
+            message,
+        };
+        let (key, value) = spec
+            .split_once('=')
+            .ok_or_else(|| fail("expected key=value".into()))?;
+        let (key, value) = (key.trim(), value.trim());
+        if key == "timestep" {
+            self.timestep = value
+                .parse()
+                .map_err(|_| fail(format!("`{value}` is not a number")))?;
+        } else if let Some(path) = key.strip_prefix("environment.") {
+            set_by_path(&mut self.environment, path, value).map_err(fail)?;
+        } else if let Some(path) = key.strip_prefix("cloth.") {
+            if self.cloths.is_empty() {
+                return Err(fail("the scene has no cloth".into()));
+            }
+            for entry in &mut self.cloths {
+                set_by_path(&mut entry.cloth, path, value).map_err(fail)?;
+            }
+        } else if let Some(rest) = key.strip_prefix("cloths[") {
+            let (index, path) = rest
+                .split_once("].")
+                .ok_or_else(|| fail("expected cloths[N].field".into()))?;
+            let count = self.cloths.len();
+            let entry = index
+                .parse::<usize>()
+                .ok()
+                .and_then(|i| self.cloths.get_mut(i))
+                .ok_or_else(|| fail(format!("no cloth {index}: the scene has {count}")))?;
+            set_by_path(&mut entry.cloth, path, value).map_err(fail)?;
+        } else {
+            return Err(fail(
+                "keys start with timestep, environment., cloth. or cloths[N].".into(),
+            ));
+        }
+        self.validate("", Path::new(spec))
+            .map_err(|e| fail(e.to_string()))
     }
 
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
@@ -170,6 +227,76 @@ impl ClothScene {
         }
         Ok(())
     }
+}
+
+/// Sets the field at a reflection `path` of `target` from text: numbers, booleans,
+/// vectors `x,y,z`, `none` or a number for optional numbers, `auto` or a count for
+/// substeps, and unit variant names for enums (`TopRow`, `Trigonometric`, `Verlet`).
+fn set_by_path(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), String> {
+    use bevy::reflect::ReflectMut;
+    use bevy::reflect::enums::{DynamicEnum, DynamicVariant};
+
+    use crate::params::Substeps;
+
+    let field = target
+        .reflect_path_mut(path)
+        .map_err(|e| format!("no field `{path}`: {e}"))?;
+    let number = || {
+        value
+            .parse::<f32>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("`{value}` is not a finite number"))
+    };
+    if let Some(f) = field.try_downcast_mut::<f32>() {
+        *f = number()?;
+    } else if let Some(f) = field.try_downcast_mut::<u32>() {
+        *f = value
+            .parse()
+            .map_err(|_| format!("`{value}` is not a whole number ≥ 0"))?;
+    } else if let Some(f) = field.try_downcast_mut::<bool>() {
+        *f = value
+            .parse()
+            .map_err(|_| format!("`{value}` is not true or false"))?;
+    } else if let Some(f) = field.try_downcast_mut::<Vec3>() {
+        let parts: Vec<f32> = value
+            .split(',')
+            .map(|p| p.trim().parse::<f32>())
+            .collect::<Result<_, _>>()
+            .map_err(|_| format!("`{value}` is not a vector x,y,z"))?;
+        match parts[..] {
+            [x, y, z] => *f = Vec3::new(x, y, z),
+            _ => return Err(format!("`{value}` is not a vector x,y,z")),
+        }
+    } else if let Some(f) = field.try_downcast_mut::<Option<f32>>() {
+        *f = if value.eq_ignore_ascii_case("none") {
+            None
+        } else {
+            Some(number()?)
+        };
+    } else if let Some(f) = field.try_downcast_mut::<Substeps>() {
+        *f = if value.eq_ignore_ascii_case("auto") {
+            Substeps::default()
+        } else {
+            Substeps::Fixed(
+                value
+                    .parse()
+                    .map_err(|_| format!("`{value}` is not `auto` or a substep count"))?,
+            )
+        };
+    } else if let ReflectMut::Enum(e) = field.reflect_mut() {
+        let unit = DynamicEnum::new(value, DynamicVariant::Unit);
+        e.try_apply(&unit).map_err(|_| {
+            let names = e
+                .get_represented_enum_info()
+                .map(|info| info.variant_names().join(", "))
+                .unwrap_or_default();
+            format!("`{value}` is not one of {names}")
+        })?;
+    } else {
+        return Err(format!("`{path}` cannot be set from the command line"));
+    }
+    Ok(())
 }
 
 fn error_field(e: &crate::error::ClothError) -> &'static str {

@@ -62,3 +62,57 @@ fn bad_values_name_the_field_and_line() {
     let dt = "(timestep: 0.0, cloths: [])";
     assert!(matches!(parse(dt), Err(SceneError::Invalid { .. })));
 }
+
+#[test]
+fn overrides_set_fields_by_path_and_refuse_bad_ones() {
+    let mut scene = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    scene.apply_override("environment.wind.strength=0").unwrap();
+    scene
+        .apply_override("environment.gravity=0, -1.62, 0")
+        .unwrap();
+    scene
+        .apply_override("environment.wind.field=Constant")
+        .unwrap();
+    scene
+        .apply_override("cloth.params.node_mass=0.001")
+        .unwrap();
+    scene
+        .apply_override("cloth.params.springs.shear.enabled=false")
+        .unwrap();
+    scene.apply_override("cloth.params.substeps=12").unwrap();
+    scene.apply_override("cloth.params.tear_ratio=2.5").unwrap();
+    scene
+        .apply_override("cloth.params.integrator=SemiImplicitEuler")
+        .unwrap();
+    scene.apply_override("cloths[0].pins=TopRow").unwrap();
+    scene.apply_override("cloth.shape.width=12").unwrap();
+    scene.apply_override("timestep=0.01").unwrap();
+    let env = scene.environment;
+    assert_eq!(env.wind.strength, 0.0);
+    assert_eq!(env.gravity.y, -1.62);
+    assert_eq!(env.wind.field, WindField::Constant);
+    let cloth = &scene.cloths[0].cloth;
+    assert_eq!(cloth.params.node_mass, 0.001);
+    assert!(!cloth.params.springs.shear.enabled);
+    assert_eq!(cloth.params.substeps, Substeps::Fixed(12));
+    assert_eq!(cloth.params.tear_ratio, Some(2.5));
+    assert_eq!(cloth.params.integrator, Integrator::SemiImplicitEuler);
+    assert_eq!(cloth.pins, Pins::TopRow);
+    assert!(matches!(cloth.shape, ClothShape::Grid { width: 12, .. }));
+    assert_eq!(scene.timestep, 0.01);
+
+    for bad in [
+        "wind=0",
+        "environment.wind.speed=3",
+        "cloth.params.node_mass=-1",
+        "cloth.params.node_mass=heavy",
+        "cloth.pins=Middle",
+        "cloths[4].pins=TopRow",
+        "cloth.shape.width=1",
+        "environment.gravity=1,2",
+        "timestep=0",
+    ] {
+        let e = scene.clone().apply_override(bad).unwrap_err();
+        assert!(matches!(e, SceneError::Override { .. }), "{bad}: {e}");
+    }
+}
