@@ -1,7 +1,9 @@
 //! The curtain of seed 000 §3.2: a cloth hanging from its two top corners, swaying under
-//! gravity and wind, with an orbit camera (left-drag rotates, right-drag pans, wheel zooms).
+//! gravity and wind. Orbit camera (left-drag away from the cloth rotates, middle-drag pans,
+//! wheel zooms), the seed's keys, mouse tools (left-drag on the cloth grabs, right-drag
+//! cuts) and an egui inspector for every parameter.
 //!
-//! `cargo run --example curtain [-- --scene FILE] [--screenshot out.png --frames 120]`
+//! `cargo run --example curtain [-- --scene FILE] [--set key=value]… [--screenshot out.png --frames 120]…`
 
 mod common;
 
@@ -9,6 +11,8 @@ use bevy::prelude::*;
 use bevy_cloth::prelude::*;
 use bevy_egui::EguiPlugin;
 use bevy_panorbit_camera::PanOrbitCameraPlugin;
+use common::inspector::InspectorPlugin;
+use common::tools::ToolsPlugin;
 use common::{ExampleArgs, ScreenshotPlugin};
 
 fn main() {
@@ -20,6 +24,9 @@ fn main() {
             EguiPlugin::default(),
             PanOrbitCameraPlugin,
             ClothPlugin::default(),
+            ClothControlsPlugin,
+            InspectorPlugin,
+            ToolsPlugin,
             ScreenshotPlugin,
         ))
         .insert_resource(args)

@@ -8,30 +8,38 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_dis
 use bevy_cloth::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 
-/// Options every example accepts:
-/// `--scene FILE`, `--screenshot PATH --frames N` (also `CLOTH_SCREENSHOT`, `CLOTH_FRAMES`).
+pub mod inspector;
+pub mod tools;
+
+/// Options every example accepts: `--scene FILE`, `--set key=value` (repeatable, see
+/// `ClothScene::apply_override`), and `--screenshot PATH --frames N` (repeatable: one PNG
+/// per pair, then exit; also `CLOTH_SCREENSHOT` / `CLOTH_FRAMES` for one).
 #[derive(Resource, Clone, Debug)]
 pub struct ExampleArgs {
     /// The scene file to load.
     pub scene: PathBuf,
-    /// Save a PNG of the window here after `frames` frames, then exit.
-    pub screenshot: Option<PathBuf>,
-    /// Frames to run before the screenshot.
-    pub frames: u32,
+    /// Overrides applied to the scene after loading.
+    pub overrides: Vec<String>,
+    /// `(frame, path)`: save a PNG of the window at that frame; exit after the last.
+    pub screenshots: Vec<(u32, PathBuf)>,
 }
 
 impl ExampleArgs {
     /// Reads the options from the command line and environment; `default_scene` is the
     /// scene file used without `--scene`. Exits with code 2 on a malformed option.
     pub fn parse(default_scene: &str) -> Self {
+        let env_frames = std::env::var("CLOTH_FRAMES")
+            .ok()
+            .and_then(|f| f.parse().ok());
         let mut args = ExampleArgs {
             scene: PathBuf::from(default_scene),
-            screenshot: std::env::var_os("CLOTH_SCREENSHOT").map(PathBuf::from),
-            frames: std::env::var("CLOTH_FRAMES")
-                .ok()
-                .and_then(|f| f.parse().ok())
-                .unwrap_or(120),
+            overrides: Vec::new(),
+            screenshots: std::env::var_os("CLOTH_SCREENSHOT")
+                .map(|p| vec![(env_frames.unwrap_or(120), PathBuf::from(p))])
+                .unwrap_or_default(),
         };
+        let mut pending_path: Option<PathBuf> = None;
+        let mut pending_frames: Option<u32> = None;
         let mut it = std::env::args().skip(1);
         while let Some(flag) = it.next() {
             let mut value = || {
@@ -40,24 +48,42 @@ impl ExampleArgs {
             };
             match flag.as_str() {
                 "--scene" => args.scene = PathBuf::from(value()),
-                "--screenshot" => args.screenshot = Some(PathBuf::from(value())),
+                "--set" => args.overrides.push(value()),
+                "--screenshot" => pending_path = Some(PathBuf::from(value())),
                 "--frames" => {
                     let v = value();
-                    args.frames = v.parse().unwrap_or_else(|_| {
-                        fail(&format!("--frames: `{v}` is not a whole number"))
-                    });
+                    let frames = v.parse().ok().filter(|f| *f > 0);
+                    pending_frames = Some(frames.unwrap_or_else(|| {
+                        fail(&format!("--frames: `{v}` is not a whole number > 0"))
+                    }));
                 }
                 other => fail(&format!(
-                    "unknown option `{other}` (try --scene, --screenshot, --frames)"
+                    "unknown option `{other}` (try --scene, --set, --screenshot, --frames)"
                 )),
             }
+            if pending_path.is_some() && pending_frames.is_some() {
+                let (frames, path) = (pending_frames.take(), pending_path.take());
+                args.screenshots.extend(frames.zip(path));
+            }
         }
+        if let Some(path) = pending_path {
+            args.screenshots
+                .push((pending_frames.or(env_frames).unwrap_or(120), path));
+        }
+        args.screenshots.sort_by_key(|(frame, _)| *frame);
         args
     }
 
-    /// Loads the scene, or exits with code 2 and the error (file, line, field).
+    /// Loads the scene and applies the overrides, or exits with code 2 and the error
+    /// (file, line, field).
     pub fn load_scene(&self) -> ClothScene {
-        ClothScene::load(&self.scene).unwrap_or_else(|e| fail(&e.to_string()))
+        let mut scene = ClothScene::load(&self.scene).unwrap_or_else(|e| fail(&e.to_string()));
+        for spec in &self.overrides {
+            scene
+                .apply_override(spec)
+                .unwrap_or_else(|e| fail(&e.to_string()));
+        }
+        scene
     }
 }
 
@@ -88,21 +114,15 @@ pub fn spawn_scene(
     commands.insert_resource(ClothEnvironment(scene.environment));
     commands.insert_resource(Time::<Fixed>::from_seconds(scene.timestep as f64));
     for entry in &scene.cloths {
-        let [r, g, b] = entry.color;
+        let look = inspector::ClothLook::from_color(entry.color);
         commands.spawn((
             entry.cloth.clone(),
+            ClothStats::default(),
+            look,
             Name::new(entry.name.clone()),
             Transform::from_translation(entry.translation)
                 .with_rotation(Quat::from_rotation_y(entry.yaw_degrees.to_radians())),
-            MeshMaterial3d(materials.add(StandardMaterial {
-                base_color: Color::linear_rgb(r, g, b),
-                perceptual_roughness: 0.75,
-                reflectance: 0.3,
-                // Back faces get flipped normals: lit as back faces, not as the front.
-                double_sided: true,
-                cull_mode: None,
-                ..default()
-            })),
+            MeshMaterial3d(materials.add(look.material())),
         ));
     }
 }
@@ -150,45 +170,54 @@ pub fn spawn_stage(
     ));
 }
 
-/// Screenshot mode: after `frames` frames, save the window to a PNG and exit.
+/// Screenshot mode: at each requested frame, save the window to a PNG; exit after the last.
 pub struct ScreenshotPlugin;
 
 #[derive(Resource, Default)]
 struct ScreenshotState {
     frame: u32,
-    saved: bool,
+    saved: usize,
 }
+
+#[derive(Component)]
+struct PendingScreenshot;
 
 impl Plugin for ScreenshotPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<ScreenshotState>()
-            .add_systems(Last, take_screenshot);
+            .add_systems(Last, take_screenshots);
     }
 }
 
-fn take_screenshot(
+fn take_screenshots(
     mut commands: Commands,
     args: Res<ExampleArgs>,
     mut state: ResMut<ScreenshotState>,
     mut exit: MessageWriter<AppExit>,
 ) {
-    let Some(path) = &args.screenshot else {
+    if args.screenshots.is_empty() {
         return;
-    };
+    }
     state.frame += 1;
-    if state.saved {
+    if state.saved == args.screenshots.len() {
         exit.write(AppExit::Success);
-    } else if state.frame == args.frames {
-        commands
-            .spawn(Screenshot::primary_window())
-            .observe(save_to_disk(path.clone()))
-            .observe(
-                |_: On<ScreenshotCaptured>, mut state: ResMut<ScreenshotState>| {
-                    state.saved = true;
-                },
-            );
-    } else if state.frame > args.frames + 600 {
-        error!("no screenshot after 600 frames");
+        return;
+    }
+    for (frame, path) in &args.screenshots {
+        if *frame == state.frame {
+            commands
+                .spawn((Screenshot::primary_window(), PendingScreenshot))
+                .observe(save_to_disk(path.clone()))
+                .observe(
+                    |_: On<ScreenshotCaptured>, mut state: ResMut<ScreenshotState>| {
+                        state.saved += 1;
+                    },
+                );
+        }
+    }
+    let last = args.screenshots.last().map_or(0, |(f, _)| *f);
+    if state.frame > last + 600 {
+        error!("screenshots not captured 600 frames after they were asked for");
         exit.write(AppExit::error());
     }
 }

@@ -1,0 +1,424 @@
+//! The egui side panel: every model parameter live (seed 000 §4), the environment, the
+//! look (seed 002 §1.4: colour, diffuse and specular coefficients 0–1; light), live
+//! statistics with a plot, and a button for bevy-inspector-egui's world inspector.
+//! Every widget has a range and clamps what is typed into it.
+
+use bevy::prelude::*;
+use bevy_cloth::prelude::*;
+use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
+use bevy_inspector_egui::quick::WorldInspectorPlugin;
+
+/// Colour and seed 002's reflection coefficients of a cloth.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct ClothLook {
+    /// Base colour, linear RGB.
+    pub color: [f32; 3],
+    /// Diffuse coefficient k_d, 0–1.
+    pub diffuse: f32,
+    /// Specular coefficient k_s, 0–1.
+    pub specular: f32,
+}
+
+impl ClothLook {
+    /// A look of this colour with matte cotton's coefficients.
+    pub fn from_color(color: [f32; 3]) -> Self {
+        Self {
+            color,
+            diffuse: 0.9,
+            specular: 0.2,
+        }
+    }
+
+    /// Seed 002's Phong coefficients on a PBR material: the diffuse coefficient scales the
+    /// albedo; the specular coefficient raises the reflectance (F0) and lowers the
+    /// roughness, so the highlight grows stronger and tighter. Double-sided: back faces
+    /// are lit with their own normals (seed 000 §3.5), not as a mirror of the front.
+    pub fn material(&self) -> StandardMaterial {
+        let [r, g, b] = self.color.map(|c| c * self.diffuse);
+        StandardMaterial {
+            base_color: Color::linear_rgb(r, g, b),
+            reflectance: self.specular,
+            perceptual_roughness: 1.0 - 0.75 * self.specular,
+            double_sided: true,
+            cull_mode: None,
+            ..default()
+        }
+    }
+}
+
+/// The directional light's direction and strength, as the panel edits them.
+#[derive(Resource, Clone, Copy, Debug, PartialEq)]
+pub struct LightControls {
+    /// Angle about the vertical, degrees.
+    pub yaw: f32,
+    /// Height above the horizon, degrees.
+    pub elevation: f32,
+    /// Illuminance, lux.
+    pub illuminance: f32,
+}
+
+impl Default for LightControls {
+    fn default() -> Self {
+        Self {
+            yaw: 30.0,
+            elevation: 45.0,
+            illuminance: 9_000.0,
+        }
+    }
+}
+
+#[derive(Resource, Default)]
+struct ShowWorldInspector(bool);
+
+/// The panel, the look and light updates, and the world inspector behind a button.
+pub struct InspectorPlugin;
+
+impl Plugin for InspectorPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_resource::<ShowWorldInspector>()
+            .init_resource::<LightControls>()
+            .add_plugins(WorldInspectorPlugin::new().run_if(|show: Res<ShowWorldInspector>| show.0))
+            .add_systems(EguiPrimaryContextPass, panel)
+            .add_systems(Update, (apply_looks, apply_light));
+    }
+}
+
+fn apply_looks(
+    looks: Query<(&ClothLook, &MeshMaterial3d<StandardMaterial>), Changed<ClothLook>>,
+    mut materials: ResMut<Assets<StandardMaterial>>,
+) {
+    for (look, handle) in &looks {
+        if let Some(mut material) = materials.get_mut(&handle.0) {
+            *material = look.material();
+        }
+    }
+}
+
+fn apply_light(
+    controls: Res<LightControls>,
+    mut lights: Query<(&mut Transform, &mut DirectionalLight)>,
+) {
+    if !controls.is_changed() {
+        return;
+    }
+    for (mut transform, mut light) in &mut lights {
+        let (yaw, elevation) = (controls.yaw.to_radians(), controls.elevation.to_radians());
+        let toward_light = Vec3::new(
+            yaw.sin() * elevation.cos(),
+            elevation.sin(),
+            yaw.cos() * elevation.cos(),
+        );
+        *transform =
+            Transform::from_translation(toward_light * 8.0).looking_at(Vec3::ZERO, Vec3::Y);
+        light.illuminance = controls.illuminance;
+    }
+}
+
+const HELP: &str = "W/A/S/D/Q/E rotate · keypad +/− zoom · O/P wind · keypad 2/4/6/8 wind direction · \
+G gravity · Space pause · N step · R reset · left-drag grab · right-drag cut · Esc quit";
+
+#[allow(clippy::too_many_arguments)]
+fn panel(
+    mut contexts: EguiContexts,
+    mut cloths: Query<(
+        &mut Cloth,
+        Option<&ClothStats>,
+        Option<&mut ClothLook>,
+        Option<&ClothInvalid>,
+    )>,
+    mut env: ResMut<ClothEnvironment>,
+    mut pause: ResMut<ClothPause>,
+    mut light: ResMut<LightControls>,
+    mut show_world: ResMut<ShowWorldInspector>,
+    mut time: ResMut<Time<Fixed>>,
+) -> Result {
+    let ctx = contexts.ctx_mut()?;
+    let mut viewport = egui::Ui::new(
+        ctx.clone(),
+        "viewport".into(),
+        egui::UiBuilder::new()
+            .layer_id(egui::LayerId::background())
+            .max_rect(ctx.viewport_rect()),
+    );
+    egui::Panel::bottom("help").show_inside(&mut viewport, |ui| {
+        ui.label(HELP);
+    });
+    egui::Panel::left("inspector")
+        .default_size(300.0)
+        .show_inside(&mut viewport, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| {
+                ui.horizontal(|ui| {
+                    if ui
+                        .button(if pause.paused { "▶ Run" } else { "⏸ Pause" })
+                        .clicked()
+                    {
+                        pause.toggle();
+                    }
+                    if ui
+                        .add_enabled(pause.paused, egui::Button::new("Step"))
+                        .clicked()
+                    {
+                        pause.step_once();
+                    }
+                    ui.toggle_value(&mut show_world.0, "World inspector");
+                });
+                let mut step_ms = time.timestep().as_secs_f32() * 1e3;
+                if ui
+                    .add(egui::Slider::new(&mut step_ms, 4.0..=33.0).text("fixed step, ms"))
+                    .changed()
+                {
+                    time.set_timestep_seconds(step_ms as f64 / 1e3);
+                }
+                for (mut cloth, stats, look, invalid) in &mut cloths {
+                    ui.separator();
+                    if let Some(ClothInvalid(error)) = invalid {
+                        ui.colored_label(
+                            egui::Color32::LIGHT_RED,
+                            format!("not simulated: {error}"),
+                        );
+                    }
+                    let mut edited = cloth.clone();
+                    cloth_controls(ui, &mut edited);
+                    if edited != *cloth {
+                        *cloth = edited;
+                    }
+                    if let Some(mut look) = look {
+                        let mut edited = *look;
+                        look_controls(ui, &mut edited);
+                        if edited != *look {
+                            *look = edited;
+                        }
+                    }
+                    if let Some(stats) = stats {
+                        statistics(ui, stats);
+                    }
+                }
+                ui.separator();
+                let mut edited = env.0;
+                environment_controls(ui, &mut edited);
+                if edited != env.0 {
+                    env.0 = edited;
+                }
+                let mut edited = *light;
+                ui.collapsing("Light", |ui| {
+                    ui.add(egui::Slider::new(&mut edited.yaw, -180.0..=180.0).text("direction, °"));
+                    ui.add(
+                        egui::Slider::new(&mut edited.elevation, 5.0..=90.0).text("elevation, °"),
+                    );
+                    ui.add(
+                        egui::Slider::new(&mut edited.illuminance, 0.0..=30_000.0)
+                            .text("intensity, lux"),
+                    );
+                });
+                if edited != *light {
+                    *light = edited;
+                }
+            });
+        });
+    Ok(())
+}
+
+fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily) {
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut family.enabled, name);
+        ui.add(
+            egui::Slider::new(&mut family.stiffness, 0.0..=25_000.0)
+                .logarithmic(true)
+                .text("N/m"),
+        );
+    });
+}
+
+fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
+    ui.heading("Cloth");
+    if let ClothShape::Grid {
+        width,
+        height,
+        spacing,
+    } = &mut cloth.shape
+    {
+        ui.add(egui::Slider::new(width, 2..=256).text("width (rebuilds)"));
+        ui.add(egui::Slider::new(height, 2..=256).text("height (rebuilds)"));
+        ui.add(
+            egui::Slider::new(spacing, 0.005..=0.5)
+                .logarithmic(true)
+                .text("spacing, m"),
+        );
+    }
+    egui::ComboBox::from_label("pins")
+        .selected_text(format!("{:?}", cloth.pins))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut cloth.pins, Pins::TopCorners, "TopCorners");
+            ui.selectable_value(&mut cloth.pins, Pins::TopRow, "TopRow");
+            ui.selectable_value(&mut cloth.pins, Pins::None, "None");
+        });
+    let p = &mut cloth.params;
+    let mut grams = p.node_mass * 1e3;
+    ui.add(
+        egui::Slider::new(&mut grams, 0.001..=1.0)
+            .logarithmic(true)
+            .text("node mass, g"),
+    );
+    p.node_mass = grams * 1e-3;
+    family(ui, "structural", &mut p.springs.structural);
+    family(ui, "shear", &mut p.springs.shear);
+    family(ui, "bend", &mut p.springs.bend);
+    family(ui, "diag. bend", &mut p.springs.bend_diagonal);
+    ui.add(egui::Slider::new(&mut p.springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
+    ui.add(egui::Slider::new(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));
+    egui::ComboBox::from_label("integrator")
+        .selected_text(format!("{:?}", p.integrator))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut p.integrator, Integrator::Verlet, "Verlet");
+            ui.selectable_value(
+                &mut p.integrator,
+                Integrator::SemiImplicitEuler,
+                "SemiImplicitEuler",
+            );
+        });
+    ui.horizontal(|ui| {
+        let mut auto = matches!(p.substeps, Substeps::Auto { .. });
+        ui.checkbox(&mut auto, "auto substeps");
+        match (&mut p.substeps, auto) {
+            (Substeps::Fixed(_), true) => p.substeps = Substeps::default(),
+            (Substeps::Auto { .. }, false) => p.substeps = Substeps::Fixed(8),
+            (Substeps::Fixed(n), false) => {
+                ui.add(egui::Slider::new(n, 1..=256).logarithmic(true));
+            }
+            (Substeps::Auto { max }, true) => {
+                ui.add(
+                    egui::Slider::new(max, 1..=16_384)
+                        .logarithmic(true)
+                        .text("max"),
+                );
+            }
+        }
+    });
+    optional(ui, "strain limit", &mut p.strain_limit, 0.1, 0.01..=1.0);
+    ui.add(egui::Slider::new(&mut p.strain_limit_iterations, 0..=16).text("limit sweeps"));
+    optional(ui, "tear ratio", &mut p.tear_ratio, 2.0, 1.05..=10.0);
+}
+
+fn optional(
+    ui: &mut egui::Ui,
+    name: &str,
+    value: &mut Option<f32>,
+    default: f32,
+    range: std::ops::RangeInclusive<f32>,
+) {
+    ui.horizontal(|ui| {
+        let mut on = value.is_some();
+        ui.checkbox(&mut on, name);
+        match (on, value.as_mut()) {
+            (true, Some(v)) => {
+                ui.add(egui::Slider::new(v, range));
+            }
+            (true, None) => *value = Some(default),
+            (false, _) => *value = None,
+        }
+    });
+}
+
+fn look_controls(ui: &mut egui::Ui, look: &mut ClothLook) {
+    ui.collapsing("Look", |ui| {
+        ui.horizontal(|ui| {
+            ui.label("colour");
+            ui.color_edit_button_rgb(&mut look.color);
+        });
+        ui.add(egui::Slider::new(&mut look.diffuse, 0.0..=1.0).text("diffuse k_d"));
+        ui.add(egui::Slider::new(&mut look.specular, 0.0..=1.0).text("specular k_s"));
+    });
+}
+
+fn environment_controls(ui: &mut egui::Ui, env: &mut Environment) {
+    ui.heading("Environment");
+    ui.horizontal(|ui| {
+        ui.checkbox(&mut env.gravity_enabled, "gravity");
+        ui.add(egui::Slider::new(&mut env.gravity.y, -30.0..=0.0).text("m/s²"));
+    });
+    let w = &mut env.wind;
+    ui.add(egui::Slider::new(&mut w.strength, 0.0..=0.02).text("wind, N per particle"));
+    let mut heading = w.direction.x.atan2(w.direction.z).to_degrees();
+    if ui
+        .add(egui::Slider::new(&mut heading, -180.0..=180.0).text("wind direction, °"))
+        .changed()
+    {
+        let h = heading.to_radians();
+        w.direction = Vec3::new(h.sin(), w.direction.y, h.cos()).normalize_or(Vec3::Z);
+    }
+    let mut trig = w.field == WindField::Trigonometric;
+    if ui
+        .checkbox(&mut trig, "gusts (seed 002 trigonometric field)")
+        .changed()
+    {
+        w.field = if trig {
+            WindField::Trigonometric
+        } else {
+            WindField::Constant
+        };
+    }
+}
+
+fn statistics(ui: &mut egui::Ui, stats: &ClothStats) {
+    ui.heading("Statistics");
+    egui::Grid::new(ui.next_auto_id())
+        .num_columns(2)
+        .show(ui, |ui| {
+            let mut row = |name: &str, value: String| {
+                ui.label(name);
+                ui.label(value);
+                ui.end_row();
+            };
+            row("particles", stats.particles.to_string());
+            row("springs", stats.springs.to_string());
+            row("torn springs", stats.torn.to_string());
+            row(
+                "step time (median 1 s)",
+                format!("{:.3} ms", stats.step_ms_median),
+            );
+            let warn = if stats.under_resolved {
+                " (capped: may be unstable)"
+            } else {
+                ""
+            };
+            row("substeps", format!("{}{warn}", stats.substeps));
+            row("max strain", format!("{:.1} %", stats.max_strain * 100.0));
+            row("total energy", format!("{:.4} J", stats.energy.total()));
+        });
+    plot(ui, stats);
+}
+
+/// Step time (orange) and total energy (blue) over the last seconds, each scaled to its
+/// own range, drawn with egui's painter.
+fn plot(ui: &mut egui::Ui, stats: &ClothStats) {
+    let (response, painter) =
+        ui.allocate_painter(egui::vec2(ui.available_width(), 80.0), egui::Sense::hover());
+    let rect = response.rect;
+    painter.rect_filled(rect, 2.0, egui::Color32::from_gray(30));
+    let samples = &stats.history;
+    let (Some(first), Some(last)) = (samples.front(), samples.back()) else {
+        return;
+    };
+    let span = (last.time - first.time).max(1e-3);
+    let series = |value: fn(&StatSample) -> f32, color: egui::Color32| {
+        let (lo, hi) = samples
+            .iter()
+            .map(value)
+            .fold((f32::MAX, f32::MIN), |(lo, hi), v| (lo.min(v), hi.max(v)));
+        let range = (hi - lo).max(1e-9);
+        let points = samples
+            .iter()
+            .map(|s| {
+                let x = rect.left() + rect.width() * (s.time - first.time) / span;
+                let y = rect.bottom() - rect.height() * (value(s) - lo) / range;
+                egui::pos2(x, y)
+            })
+            .collect();
+        painter.line(points, egui::Stroke::new(1.5, color));
+    };
+    series(|s| s.step_ms, egui::Color32::from_rgb(240, 160, 60));
+    series(|s| s.energy, egui::Color32::from_rgb(90, 160, 240));
+    ui.label(format!(
+        "orange: step time · blue: energy · last {span:.0} s"
+    ));
+}
