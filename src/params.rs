@@ -175,7 +175,7 @@ impl Default for ClothParams {
             integrator: Integrator::Verlet,
             substeps: Substeps::default(),
             strain_limit: Some(0.1),
-            strain_limit_iterations: 2,
+            strain_limit_iterations: 4,
             tear_ratio: None,
         }
     }

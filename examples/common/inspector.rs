@@ -117,7 +117,7 @@ fn apply_light(
 const HELP: &str = "W/A/S/D/Q/E rotate · keypad +/− zoom · O/P wind · keypad 2/4/6/8 wind direction · \
 G gravity · Space pause · N step · R reset · left-drag grab · right-drag cut · Esc quit";
 
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn panel(
     mut contexts: EguiContexts,
     mut cloths: Query<(
