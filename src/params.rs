@@ -143,10 +143,136 @@ impl Default for Substeps {
     }
 }
 
-/// Parameters of the mass-spring model of one cloth. Edits take effect on the next step.
+/// How shape matching finds the rotation of a cluster.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
+pub enum RotationMethod {
+    /// Seed 000 eq. 6–9 and its pseudocode: the rotation of each particle's rest offset
+    /// onto its current offset as a quaternion, averaged component-wise. Fast; an
+    /// approximation that is exact for rotations about the cloth's normal and degrades for
+    /// large rotations about in-plane axes (see the tests' report).
+    QuaternionAverage {
+        /// Normalise the running sum after every particle, as the pseudocode does;
+        /// otherwise once at the end (the thesis's faster alternative).
+        normalize_each: bool,
+    },
+    /// Seed 000 eq. 14–16: the rotation part of `A_pq = Σ m p qᵀ`, found by the iterative
+    /// method of Müller et al. 2016 (robust for the rank-2 `A_pq` of a flat cloth and
+    /// rank-1 of a strip; never a reflection; warm-started from the last step).
+    #[default]
+    PolarDecomposition,
+}
+
+/// How a particle is pulled toward its goal.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
+pub enum GoalUpdate {
+    /// A force `α (|d|/L)^(p−1) d` toward the goal (`d = g − x`, L = the cloth's
+    /// spacing), as seed 000 §4 describes: exponent p in [0.5, 3], stiffness α in N/m,
+    /// integrated with the other forces.
+    #[default]
+    Force,
+    /// Müller et al. 2005: after integration `x += α (g − x)`, velocity likewise; α in
+    /// [0, 1] is the fraction of the way to the goal per substep. Cannot overshoot.
+    Velocity,
+}
+
+/// Parameters of the meshless shape-matching model (seed 000 §2.3, §3.3; Müller 2005).
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ShapeMatchingParams {
+    /// How the rotation is found.
+    pub rotation: RotationMethod,
+    /// How particles move toward their goals.
+    pub update: GoalUpdate,
+    /// Stiffness α: N/m for `Force`, a fraction 0–1 per substep for `Velocity`.
+    pub stiffness: f32,
+    /// Exponent p of the force law (seed 000 §4: 0.5–3); 1 is a linear spring.
+    pub exponent: f32,
+    /// Damping of each particle's velocity, N·s/m (seed 000 §4's particle damping).
+    pub damping: f32,
+    /// Müller's β: goals from `β A + (1 − β) R`, letting the card shear and stretch a
+    /// little (an extension beyond the thesis). 0 = rigid goals.
+    pub beta: f32,
+    /// k: the grid is covered by k×k overlapping clusters (the start of lattice shape
+    /// matching). 1 = one cluster for the whole cloth, as in the thesis.
+    pub clusters: u32,
+}
+
+impl Default for ShapeMatchingParams {
+    fn default() -> Self {
+        Self {
+            rotation: RotationMethod::PolarDecomposition,
+            update: GoalUpdate::Force,
+            stiffness: 2.0,
+            exponent: 1.0,
+            damping: 2e-4,
+            beta: 0.0,
+            clusters: 1,
+        }
+    }
+}
+
+impl ShapeMatchingParams {
+    fn validate(&self) -> Result<(), ClothError> {
+        check(
+            "model.stiffness",
+            self.stiffness,
+            self.stiffness >= 0.0,
+            "a stiffness ≥ 0",
+        )?;
+        if self.update == GoalUpdate::Velocity {
+            check(
+                "model.stiffness",
+                self.stiffness,
+                self.stiffness <= 1.0,
+                "a fraction 0–1 for the Velocity update",
+            )?;
+        }
+        check(
+            "model.exponent",
+            self.exponent,
+            (0.5..=3.0).contains(&self.exponent),
+            "an exponent in [0.5, 3] (seed 000 §4)",
+        )?;
+        check(
+            "model.damping",
+            self.damping,
+            self.damping >= 0.0,
+            "a damping ≥ 0",
+        )?;
+        check(
+            "model.beta",
+            self.beta,
+            (0.0..=1.0).contains(&self.beta),
+            "a β in [0, 1]",
+        )?;
+        if self.clusters == 0 || self.clusters > 64 {
+            return Err(ClothError::InvalidParameter {
+                field: "model.clusters",
+                value: self.clusters as f32,
+                expected: "1 to 64 clusters per side",
+            });
+        }
+        Ok(())
+    }
+}
+
+/// Which cloth model moves the particles.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
+pub enum Model {
+    /// Springs between particles (seed 000 §2.2, §3.2; seed 002).
+    #[default]
+    MassSpring,
+    /// Each particle pulled toward a goal from the best rigid fit of the rest shape
+    /// (seed 000 §2.3, §3.3). No springs act, so nothing tears.
+    ShapeMatching(ShapeMatchingParams),
+}
+
+/// Parameters of the model of one cloth. Edits take effect on the next step.
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClothParams {
+    /// The cloth model; spring parameters are used by the mass-spring model.
+    pub model: Model,
     /// Mass of one particle in kg (seed 002 §1.4: 0.001–1 g, i.e. 1e-6–1e-3 kg).
     pub node_mass: f32,
     /// Spring families and spring damping.
@@ -169,6 +295,7 @@ pub struct ClothParams {
 impl Default for ClothParams {
     fn default() -> Self {
         Self {
+            model: Model::MassSpring,
             node_mass: 0.5e-3,
             springs: SpringParams::default(),
             drag: 0.5e-3,
@@ -250,6 +377,9 @@ impl ClothParams {
         }
         if let Some(ratio) = self.tear_ratio {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
+        }
+        if let Model::ShapeMatching(sm) = &self.model {
+            sm.validate()?;
         }
         Ok(())
     }

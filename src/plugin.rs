@@ -29,7 +29,8 @@ use crate::components::{
 };
 use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::params::{
-    ClothParams, Environment, Integrator, SpringFamily, SpringParams, Substeps, Wind, WindField,
+    ClothParams, Environment, GoalUpdate, Integrator, Model, RotationMethod, ShapeMatchingParams,
+    SpringFamily, SpringParams, Substeps, Wind, WindField,
 };
 use crate::shape::{ClothShape, Pins};
 use crate::solver;
@@ -126,6 +127,10 @@ impl Plugin for ClothPlugin {
             .register_type::<SpringFamily>()
             .register_type::<Integrator>()
             .register_type::<Substeps>()
+            .register_type::<Model>()
+            .register_type::<ShapeMatchingParams>()
+            .register_type::<RotationMethod>()
+            .register_type::<GoalUpdate>()
             .register_type::<Environment>()
             .register_type::<Wind>()
             .register_type::<WindField>()
@@ -150,6 +155,7 @@ impl Plugin for ClothPlugin {
         substep.add_systems((
             accumulate_forces.in_set(ClothSystems::AccumulateForces),
             integrate.in_set(ClothSystems::Integrate),
+            fit_targets.in_set(ClothSystems::FitTargets),
             constrain.in_set(ClothSystems::Constrain),
         ));
         app.add_schedule(substep);
@@ -370,6 +376,10 @@ fn accumulate_forces(
 
 fn integrate(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
     for_each_active(&plan, &mut cloths, solver::Cloth::integrate);
+}
+
+fn fit_targets(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    for_each_active(&plan, &mut cloths, solver::Cloth::fit_targets);
 }
 
 fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {

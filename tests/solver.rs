@@ -20,6 +20,7 @@ fn no_springs() -> SpringParams {
 /// Parameters with every dissipative or corrective term off.
 fn conservative(integrator: Integrator) -> ClothParams {
     ClothParams {
+        model: Model::MassSpring,
         node_mass: 1e-3,
         springs: SpringParams::from_structural(50.0),
         drag: 0.0,

@@ -1,7 +1,7 @@
 //! Phase 1 of a substep: every force from the old state.
 
 use super::{Cloth, SpringKind};
-use crate::params::Environment;
+use crate::params::{Environment, GoalUpdate, Model, ShapeMatchingParams};
 
 impl Cloth {
     /// Clears and accumulates the forces on every free particle: gravity (seed 002
@@ -20,6 +20,10 @@ impl Cloth {
                 f += wind.force_at(p.position[i], time);
             }
             p.force[i] = f;
+        }
+        if let Model::ShapeMatching(sm) = self.params.model {
+            self.goal_forces(&sm);
+            return;
         }
         let damping = self.params.springs.damping;
         for kind in SpringKind::ALL {
@@ -55,6 +59,33 @@ impl Cloth {
             let f = dir * magnitude;
             p.force[a] += f;
             p.force[b] -= f;
+        }
+    }
+
+    /// Shape matching's pull toward the goals (seed 000 §3.3, §4): particle damping
+    /// `−c v`, and for the force update `α (|d|/L)^(p−1) d` with `d = g − x` from goals of
+    /// the current positions.
+    fn goal_forces(&mut self, sm: &ShapeMatchingParams) {
+        let force_update = sm.update == GoalUpdate::Force;
+        if force_update && let Some(state) = &mut self.shape_matching {
+            state.compute_goals(&self.particles.position, &self.particles.mass, sm);
+        }
+        let p = &mut self.particles;
+        for i in 0..p.position.len() {
+            p.force[i] -= sm.damping * p.velocity[i];
+        }
+        let (Some(state), true) = (&self.shape_matching, force_update) else {
+            return;
+        };
+        let (l, exponent) = (self.length_scale, sm.exponent);
+        for i in 0..p.position.len() {
+            let d = state.goals[i] - p.position[i];
+            let scale = if exponent == 1.0 {
+                1.0
+            } else {
+                (d.length() / l).max(0.05).powf(exponent - 1.0)
+            };
+            p.force[i] += d * (sm.stiffness * scale);
         }
     }
 

@@ -1,7 +1,7 @@
 //! Phases 2 and 3 of a substep: integration and constraints.
 
 use super::{Cloth, SpringKind};
-use crate::params::Integrator;
+use crate::params::{GoalUpdate, Integrator, Model};
 
 impl Cloth {
     /// Advances every free particle by one substep `h` from its accumulated force.
@@ -39,6 +39,31 @@ impl Cloth {
                     p.position[i] += v * h;
                 }
             }
+        }
+    }
+
+    /// Müller et al. 2005's update for shape matching: after integration, every free
+    /// particle moves the fraction α of the way to its goal (goals from the predicted
+    /// positions), and its velocity takes the same change over `h`. Nothing for the other
+    /// models.
+    pub fn fit_targets(&mut self) {
+        let (Model::ShapeMatching(sm), Some(state)) = (self.params.model, &mut self.shape_matching)
+        else {
+            return;
+        };
+        if sm.update != GoalUpdate::Velocity {
+            return;
+        }
+        let p = &mut self.particles;
+        state.compute_goals(&p.position, &p.mass, &sm);
+        let h = self.h;
+        for i in 0..p.position.len() {
+            if p.inv_mass[i] == 0.0 {
+                continue;
+            }
+            let delta = (state.goals[i] - p.position[i]) * sm.stiffness;
+            p.position[i] += delta;
+            p.velocity[i] += delta / h;
         }
     }
 

@@ -6,13 +6,15 @@
 //! changes):
 //! 1. [`Cloth::accumulate_forces`] — gravity, wind, drag, springs;
 //! 2. [`Cloth::integrate`] — Verlet or semi-implicit Euler;
-//! 3. [`Cloth::constrain`] — pins, Provot strain limiting.
+//! 3. [`Cloth::fit_targets`] — pull toward model goals (shape matching's velocity update);
+//! 4. [`Cloth::constrain`] — pins, Provot strain limiting.
 //!
 //! After the substeps, [`Cloth::end_step`] tears over-stretched springs.
 
 mod forces;
 mod integrate;
 mod interact;
+pub mod shape_matching;
 mod state;
 pub mod topology;
 
@@ -23,8 +25,9 @@ pub use topology::{SpringKind, Springs};
 use bevy::math::{Affine3A, Vec3};
 
 use crate::error::ClothError;
-use crate::params::{ClothParams, Environment};
+use crate::params::{ClothParams, Environment, GoalUpdate, Model, ShapeMatchingParams};
 use crate::shape::{ClothShape, Pins};
+use shape_matching::ShapeMatching;
 
 /// Energies of a cloth in J, for measurement (see [`Cloth::energy`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -85,6 +88,11 @@ pub struct Cloth {
     torn_this_step: Vec<u32>,
     torn_count: usize,
     grab: Option<Grab>,
+    /// Clusters and goals while the model is shape matching.
+    shape_matching: Option<ShapeMatching>,
+    /// The cloth's characteristic length L (mean structural rest length), for the
+    /// shape-matching force law.
+    length_scale: f32,
 }
 
 impl Cloth {
@@ -256,7 +264,16 @@ impl Cloth {
             auto_cache: None,
             torn_count: 0,
             grab: None,
+            shape_matching: None,
+            length_scale: 1.0,
         };
+        let structural = cloth.springs.ranges[SpringKind::Structural as usize].clone();
+        if !structural.is_empty() {
+            cloth.length_scale = cloth.springs.rest_length[structural.clone()]
+                .iter()
+                .sum::<f32>()
+                / structural.len() as f32;
+        }
         cloth.reset();
         Ok(cloth)
     }
@@ -265,6 +282,9 @@ impl Cloth {
     /// every spring whole and the clock at zero.
     pub fn reset(&mut self) {
         self.grab = None;
+        if let Some(sm) = &mut self.shape_matching {
+            sm.reset();
+        }
         let mass = self.params.node_mass;
         let p = &mut self.particles;
         for (i, local) in self.local_rest.iter().enumerate() {
@@ -359,6 +379,7 @@ impl Cloth {
     pub fn substep(&mut self, env: &Environment) {
         self.accumulate_forces(env);
         self.integrate();
+        self.fit_targets();
         self.constrain();
     }
 
@@ -369,6 +390,7 @@ impl Cloth {
             self.substeps = 0;
             return 0;
         }
+        self.prepare_model();
         let n = match self.params.substeps {
             crate::params::Substeps::Fixed(n) => {
                 self.under_resolved = false;
@@ -376,6 +398,8 @@ impl Cloth {
             }
             crate::params::Substeps::Auto { max } => {
                 let needed = match self.auto_cache {
+                    // Shape matching's stiffness depends on the deformation: no cache.
+                    _ if self.shape_matching.is_some() => self.stable_substeps(dt),
                     Some((p, d, n)) if p == self.params && d == dt => n,
                     _ => {
                         let n = self.stable_substeps(dt);
@@ -410,7 +434,7 @@ impl Cloth {
     /// Finishes a step: springs stretched past the tear ratio break and hide the faces
     /// they border (seed 000 §3.2). Returns the springs torn in this step.
     pub fn end_step(&mut self) -> &[u32] {
-        if let Some(ratio) = self.params.tear_ratio {
+        if let (Some(ratio), Model::MassSpring) = (self.params.tear_ratio, self.params.model) {
             let x = &self.particles.position;
             let s = &mut self.springs;
             for k in 0..s.len() {
@@ -461,6 +485,28 @@ impl Cloth {
     /// rate by `γ ≤ max_i (2·Σ_j c_ij + c_drag) / m_i`. A safety factor of 0.8 on the
     /// right-hand side covers the geometric stiffness of stretched springs.
     pub fn stable_substeps(&self, dt: f32) -> u32 {
+        let (omega2, gamma) = match (&self.params.model, &self.shape_matching) {
+            (Model::ShapeMatching(sm), Some(state)) => self.goal_frequency(sm, state),
+            _ => self.spring_frequency(),
+        };
+        const SAFETY: f32 = 0.8;
+        let h_max = if omega2 > 0.0 {
+            (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
+        } else if gamma > 0.0 {
+            2.0 * SAFETY / gamma
+        } else {
+            f32::INFINITY
+        };
+        let n = (dt / h_max).ceil();
+        if n.is_finite() && n >= 1.0 {
+            n.min(u32::MAX as f32) as u32
+        } else {
+            1
+        }
+    }
+
+    /// Gershgorin bounds `(ω_max², γ_max)` of the spring lattice.
+    fn spring_frequency(&self) -> (f32, f32) {
         let n = self.particles.len();
         let mut k_sum = vec![0.0f32; n];
         let mut c_sum = vec![0.0f32; n];
@@ -486,24 +532,88 @@ impl Cloth {
             omega2 = omega2.max(2.0 * k_sum[i] * w);
             gamma = gamma.max((2.0 * c_sum[i] + self.params.drag) * w);
         }
-        const SAFETY: f32 = 0.8;
-        let h_max = if omega2 > 0.0 {
-            (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
-        } else if gamma > 0.0 {
-            2.0 * SAFETY / gamma
+        (omega2, gamma)
+    }
+
+    /// `(ω_max², γ_max)` of the goal forces at the current deformation: the force
+    /// `α (d/L)^(p−1) d` has stiffness `p α (d/L)^(p−1)` along `d`; the goal itself moves
+    /// with the particle through the centre of mass and rotation, bounded by a factor 2.
+    /// Müller's velocity update cannot overshoot: only drag and damping bound its step.
+    fn goal_frequency(&self, sm: &ShapeMatchingParams, state: &ShapeMatching) -> (f32, f32) {
+        let (mut omega2, mut gamma) = (0.0f32, 0.0f32);
+        let p = &self.particles;
+        for i in 0..p.len() {
+            let w = p.inv_mass[i];
+            if w == 0.0 {
+                continue;
+            }
+            if sm.update == GoalUpdate::Force {
+                let d = state.goals[i].distance(p.position[i]);
+                let k = sm.exponent * sm.stiffness * self.goal_scale(d, sm.exponent);
+                omega2 = omega2.max(2.0 * k * w);
+            }
+            gamma = gamma.max((sm.damping + self.params.drag) * w);
+        }
+        (omega2, gamma)
+    }
+
+    /// `(d/L)^(p−1)`, with `d/L` kept ≥ 0.05 so that `p < 1` stays finite at the goal.
+    #[inline]
+    fn goal_scale(&self, d: f32, exponent: f32) -> f32 {
+        if exponent == 1.0 {
+            1.0
         } else {
-            f32::INFINITY
-        };
-        let n = (dt / h_max).ceil();
-        if n.is_finite() && n >= 1.0 {
-            n.min(u32::MAX as f32) as u32
-        } else {
-            1
+            (d / self.length_scale).max(0.05).powf(exponent - 1.0)
         }
     }
 
-    /// The acting stiffness of a spring kind under the current parameters.
+    /// Builds or drops the shape-matching state to match the model (only when it changes),
+    /// and computes the goals of the current state.
+    fn prepare_model(&mut self) {
+        match self.params.model {
+            Model::ShapeMatching(sm) => {
+                let k = sm.clusters;
+                if self
+                    .shape_matching
+                    .as_ref()
+                    .is_none_or(|s| s.built_for != k)
+                {
+                    self.shape_matching = Some(ShapeMatching::new(
+                        &self.local_rest,
+                        &self.particles.mass,
+                        self.grid,
+                        k,
+                    ));
+                }
+                if let Some(state) = &mut self.shape_matching {
+                    state.compute_goals(&self.particles.position, &self.particles.mass, &sm);
+                }
+            }
+            Model::MassSpring => self.shape_matching = None,
+        }
+    }
+
+    /// The shape-matching goals (after the last goal computation), if that is the model.
+    pub fn goals(&self) -> Option<&[Vec3]> {
+        self.shape_matching.as_ref().map(|s| &s.goals[..])
+    }
+
+    /// The shape-matching state, if that is the model.
+    pub fn shape_matching(&self) -> Option<&ShapeMatching> {
+        self.shape_matching.as_ref()
+    }
+
+    /// Computes the shape-matching goals of the current positions now (outside a step).
+    pub fn update_goals(&mut self) {
+        self.prepare_model();
+    }
+
+    /// The acting stiffness of a spring kind under the current parameters (0 for every
+    /// kind when the model has no springs).
     pub fn stiffness(&self, kind: SpringKind) -> f32 {
+        if self.params.model != Model::MassSpring {
+            return 0.0;
+        }
         let s = &self.params.springs;
         match kind {
             SpringKind::Structural => s.structural.effective(),
@@ -626,6 +736,21 @@ impl Cloth {
                 e.kinetic += 0.5 * p.mass[i] * p.velocity[i].length_squared();
                 e.gravitational -= p.mass[i] * g.dot(p.position[i]);
             }
+        }
+        if let (Model::ShapeMatching(sm), Some(state)) = (&self.params.model, &self.shape_matching)
+        {
+            // Potential of the goal force: α L² (d/L)^(p+1) / (p+1); ½ α d² for p = 1.
+            if sm.update == GoalUpdate::Force {
+                let l = self.length_scale;
+                for i in 0..p.len() {
+                    if p.inv_mass[i] > 0.0 {
+                        let d = state.goals[i].distance(p.position[i]) / l;
+                        e.spring +=
+                            sm.stiffness * l * l * d.powf(sm.exponent + 1.0) / (sm.exponent + 1.0);
+                    }
+                }
+            }
+            return e;
         }
         for kind in SpringKind::ALL {
             let k = self.stiffness(kind);
