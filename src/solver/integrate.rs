@@ -88,7 +88,8 @@ impl Cloth {
             p.velocity[i] = (target - p.position[i]) / h;
             p.position[i] = target;
         }
-        if let Some(limit) = self.params.strain_limit {
+        // Strain limiting corrects springs; a model without acting springs has none.
+        if let (Some(limit), Model::MassSpring) = (self.params.strain_limit, self.params.model) {
             self.limit_strain(limit, h);
         }
         self.time += h;
