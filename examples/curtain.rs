@@ -7,44 +7,13 @@
 
 mod common;
 
-use bevy::prelude::*;
-use bevy_cloth::prelude::*;
-use bevy_egui::EguiPlugin;
-use bevy_panorbit_camera::PanOrbitCameraPlugin;
-use common::inspector::InspectorPlugin;
-use common::tools::ToolsPlugin;
-use common::{ExampleArgs, ScreenshotPlugin};
+use bevy::math::Vec3;
 
 fn main() {
-    let args = ExampleArgs::parse("assets/scenes/curtain.ron");
-    let scene = args.load_scene();
-    App::new()
-        .add_plugins((
-            DefaultPlugins.set(common::window_plugin("bevy_cloth — curtain")),
-            EguiPlugin::default(),
-            PanOrbitCameraPlugin,
-            ClothPlugin::default(),
-            ClothControlsPlugin,
-            InspectorPlugin,
-            ToolsPlugin,
-            ScreenshotPlugin,
-        ))
-        .insert_resource(args)
-        .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
-        .add_systems(
-            Startup,
-            move |mut commands: Commands,
-                  mut meshes: ResMut<Assets<Mesh>>,
-                  mut materials: ResMut<Assets<StandardMaterial>>| {
-                common::spawn_scene(&scene, &mut commands, &mut materials);
-                common::spawn_stage(
-                    &mut commands,
-                    &mut meshes,
-                    &mut materials,
-                    Vec3::new(0.0, 1.4, 0.0),
-                    3.4,
-                );
-            },
-        )
-        .run();
+    common::run(
+        "bevy_cloth — curtain",
+        "assets/scenes/curtain.ron",
+        Vec3::new(0.0, 1.4, 0.0),
+        3.4,
+    );
 }

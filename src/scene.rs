@@ -182,8 +182,10 @@ impl ClothScene {
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
         let invalid = |field: String, key: &str, message: String, after: usize| {
             // Point at the line of the offending key, searching from the cloth's entry.
-            let offset = text[after.min(text.len())..]
-                .find(&format!("{key}:"))
+            let after = after.min(text.len());
+            let offset = text
+                .get(after..)
+                .and_then(|rest| rest.find(&format!("{key}:")))
                 .map_or(after, |o| after + o);
             SceneError::Invalid {
                 file: file.to_path_buf(),
@@ -211,8 +213,9 @@ impl ClothScene {
         }
         let mut search_from = text.find("cloths").unwrap_or(0);
         for (i, entry) in self.cloths.iter().enumerate() {
-            let entry_start = text[search_from..]
-                .find("cloth:")
+            let entry_start = text
+                .get(search_from..)
+                .and_then(|rest| rest.find("cloth:"))
                 .map_or(search_from, |o| search_from + o);
             if let Err(e) = entry.cloth.validate() {
                 let field = error_field(&e);

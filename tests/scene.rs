@@ -116,3 +116,19 @@ fn overrides_set_fields_by_path_and_refuse_bad_ones() {
         assert!(matches!(e, SceneError::Override { .. }), "{bad}: {e}");
     }
 }
+
+#[test]
+fn overrides_on_a_scene_of_several_cloths() {
+    let mut scene = ClothScene::load("assets/scenes/card.ron").unwrap();
+    assert_eq!(scene.cloths.len(), 2);
+    scene.apply_override("environment.wind.strength=0").unwrap();
+    scene
+        .apply_override("cloths[1].params.node_mass=0.0001")
+        .unwrap();
+    assert_eq!(scene.cloths[1].cloth.params.node_mass, 1e-4);
+    assert_eq!(scene.cloths[0].cloth.params.node_mass, 2e-5);
+    let e = scene
+        .apply_override("cloths[1].params.drag=-1")
+        .unwrap_err();
+    assert!(e.to_string().contains("cloths[1]"), "{e}");
+}

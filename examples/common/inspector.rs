@@ -121,6 +121,8 @@ G gravity · Space pause · N step · R reset · left-drag grab · right-drag cu
 fn panel(
     mut contexts: EguiContexts,
     mut cloths: Query<(
+        Entity,
+        Option<&Name>,
         &mut Cloth,
         Option<&ClothStats>,
         Option<&mut ClothLook>,
@@ -169,29 +171,38 @@ fn panel(
                 {
                     time.set_timestep_seconds(step_ms as f64 / 1e3);
                 }
-                for (mut cloth, stats, look, invalid) in &mut cloths {
+                for (n, (entity, name, mut cloth, stats, look, invalid)) in
+                    cloths.iter_mut().enumerate()
+                {
                     ui.separator();
-                    if let Some(ClothInvalid(error)) = invalid {
-                        ui.colored_label(
-                            egui::Color32::LIGHT_RED,
-                            format!("not simulated: {error}"),
-                        );
-                    }
-                    let mut edited = cloth.clone();
-                    cloth_controls(ui, &mut edited);
-                    if edited != *cloth {
-                        *cloth = edited;
-                    }
-                    if let Some(mut look) = look {
-                        let mut edited = *look;
-                        look_controls(ui, &mut edited);
-                        if edited != *look {
-                            *look = edited;
-                        }
-                    }
-                    if let Some(stats) = stats {
-                        statistics(ui, stats);
-                    }
+                    let title = name.map_or_else(|| format!("Cloth {entity}"), |n| n.to_string());
+                    // One id scope per cloth, so two cloths' widgets never share an id.
+                    egui::CollapsingHeader::new(egui::RichText::new(title).heading())
+                        .id_salt(entity)
+                        .default_open(n == 0)
+                        .show(ui, |ui| {
+                            if let Some(ClothInvalid(error)) = invalid {
+                                ui.colored_label(
+                                    egui::Color32::LIGHT_RED,
+                                    format!("not simulated: {error}"),
+                                );
+                            }
+                            let mut edited = cloth.clone();
+                            cloth_controls(ui, &mut edited);
+                            if edited != *cloth {
+                                *cloth = edited;
+                            }
+                            if let Some(mut look) = look {
+                                let mut edited = *look;
+                                look_controls(ui, &mut edited);
+                                if edited != *look {
+                                    *look = edited;
+                                }
+                            }
+                            if let Some(stats) = stats {
+                                statistics(ui, stats);
+                            }
+                        });
                 }
                 ui.separator();
                 let mut edited = env.0;
@@ -230,7 +241,6 @@ fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily) {
 }
 
 fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
-    ui.heading("Cloth");
     if let ClothShape::Grid {
         width,
         height,
@@ -260,11 +270,33 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             .text("node mass, g"),
     );
     p.node_mass = grams * 1e-3;
-    family(ui, "structural", &mut p.springs.structural);
-    family(ui, "shear", &mut p.springs.shear);
-    family(ui, "bend", &mut p.springs.bend);
-    family(ui, "diag. bend", &mut p.springs.bend_diagonal);
-    ui.add(egui::Slider::new(&mut p.springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
+    let is_sm = matches!(p.model, Model::ShapeMatching(_));
+    egui::ComboBox::from_label("model")
+        .selected_text(if is_sm {
+            "shape matching"
+        } else {
+            "mass-spring"
+        })
+        .show_ui(ui, |ui| {
+            if ui.selectable_label(!is_sm, "mass-spring").clicked() {
+                p.model = Model::MassSpring;
+            }
+            if ui.selectable_label(is_sm, "shape matching").clicked() && !is_sm {
+                p.model = Model::ShapeMatching(ShapeMatchingParams::default());
+            }
+        });
+    match &mut p.model {
+        Model::MassSpring => {
+            family(ui, "structural", &mut p.springs.structural);
+            family(ui, "shear", &mut p.springs.shear);
+            family(ui, "bend", &mut p.springs.bend);
+            family(ui, "diag. bend", &mut p.springs.bend_diagonal);
+            ui.add(
+                egui::Slider::new(&mut p.springs.damping, 0.0..=0.05).text("spring damping, N·s/m"),
+            );
+        }
+        Model::ShapeMatching(sm) => shape_matching_controls(ui, sm),
+    }
     ui.add(egui::Slider::new(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));
     egui::ComboBox::from_label("integrator")
         .selected_text(format!("{:?}", p.integrator))
@@ -297,6 +329,62 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
     optional(ui, "strain limit", &mut p.strain_limit, 0.1, 0.01..=1.0);
     ui.add(egui::Slider::new(&mut p.strain_limit_iterations, 0..=16).text("limit sweeps"));
     optional(ui, "tear ratio", &mut p.tear_ratio, 2.0, 1.05..=10.0);
+}
+
+fn shape_matching_controls(ui: &mut egui::Ui, sm: &mut ShapeMatchingParams) {
+    let quaternion = RotationMethod::QuaternionAverage {
+        normalize_each: false,
+    };
+    let quaternion_each = RotationMethod::QuaternionAverage {
+        normalize_each: true,
+    };
+    egui::ComboBox::from_label("rotation")
+        .selected_text(match sm.rotation {
+            RotationMethod::PolarDecomposition => "polar decomposition",
+            RotationMethod::QuaternionAverage {
+                normalize_each: false,
+            } => "quaternion average",
+            RotationMethod::QuaternionAverage {
+                normalize_each: true,
+            } => "quaternion avg. (normalise each)",
+        })
+        .show_ui(ui, |ui| {
+            ui.selectable_value(
+                &mut sm.rotation,
+                RotationMethod::PolarDecomposition,
+                "polar decomposition",
+            );
+            ui.selectable_value(&mut sm.rotation, quaternion, "quaternion average");
+            ui.selectable_value(
+                &mut sm.rotation,
+                quaternion_each,
+                "quaternion avg. (normalise each)",
+            );
+        });
+    egui::ComboBox::from_label("update")
+        .selected_text(format!("{:?}", sm.update))
+        .show_ui(ui, |ui| {
+            ui.selectable_value(&mut sm.update, GoalUpdate::Force, "Force (α, p)");
+            ui.selectable_value(&mut sm.update, GoalUpdate::Velocity, "Velocity (Müller)");
+        });
+    match sm.update {
+        GoalUpdate::Force => {
+            sm.stiffness = sm.stiffness.max(0.0);
+            ui.add(
+                egui::Slider::new(&mut sm.stiffness, 0.0..=100.0)
+                    .logarithmic(true)
+                    .text("α, N/m"),
+            );
+            ui.add(egui::Slider::new(&mut sm.exponent, 0.5..=3.0).text("exponent p"));
+        }
+        GoalUpdate::Velocity => {
+            sm.stiffness = sm.stiffness.clamp(0.0, 1.0);
+            ui.add(egui::Slider::new(&mut sm.stiffness, 0.0..=1.0).text("α per substep"));
+        }
+    }
+    ui.add(egui::Slider::new(&mut sm.damping, 0.0..=0.001).text("particle damping, N·s/m"));
+    ui.add(egui::Slider::new(&mut sm.beta, 0.0..=1.0).text("β (linear deformation)"));
+    ui.add(egui::Slider::new(&mut sm.clusters, 1..=8).text("clusters k×k"));
 }
 
 fn optional(

@@ -6,10 +6,42 @@ use std::path::PathBuf;
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
 use bevy_cloth::prelude::*;
-use bevy_panorbit_camera::PanOrbitCamera;
+use bevy_egui::EguiPlugin;
+use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
 
 pub mod inspector;
 pub mod tools;
+
+/// Runs an example scene: the window, the plugins every example shares (cloth, controls,
+/// inspector, tools, screenshots, orbit camera), the scene from `default_scene` (or
+/// `--scene`) and a camera looking at `focus` from `radius` m.
+pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
+    let args = ExampleArgs::parse(default_scene);
+    let scene = args.load_scene();
+    App::new()
+        .add_plugins((
+            DefaultPlugins.set(window_plugin(title)),
+            EguiPlugin::default(),
+            PanOrbitCameraPlugin,
+            ClothPlugin::default(),
+            ClothControlsPlugin,
+            inspector::InspectorPlugin,
+            tools::ToolsPlugin,
+            ScreenshotPlugin,
+        ))
+        .insert_resource(args)
+        .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
+        .add_systems(
+            Startup,
+            move |mut commands: Commands,
+                  mut meshes: ResMut<Assets<Mesh>>,
+                  mut materials: ResMut<Assets<StandardMaterial>>| {
+                spawn_scene(&scene, &mut commands, &mut materials);
+                spawn_stage(&mut commands, &mut meshes, &mut materials, focus, radius);
+            },
+        )
+        .run();
+}
 
 /// Options every example accepts: `--scene FILE`, `--set key=value` (repeatable, see
 /// `ClothScene::apply_override`), and `--screenshot PATH --frames N` (repeatable: one PNG
