@@ -51,7 +51,7 @@ pub mod prelude {
     pub use crate::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::error::ClothError;
     pub use crate::params::{
-        ClothParams, Environment, GoalUpdate, Integrator, Model, RotationMethod,
+        ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, RotationMethod,
         ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
     };
     pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSystems};

@@ -256,6 +256,87 @@ impl ShapeMatchingParams {
     }
 }
 
+/// Parameters of the hybrid patch model (seed 000 §3.4).
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PatchParams {
+    /// Particles across one part (1–16); parts at the right edge may be narrower.
+    pub part_width: u32,
+    /// Particles down one part (1–16); parts at the bottom may be shorter.
+    pub part_height: u32,
+    /// Stiffness α of the pull toward the targets, N/m (as shape matching's force).
+    pub stiffness: f32,
+    /// Exponent p of the pull (seed 000 §4: 0.5–3).
+    pub exponent: f32,
+    /// Particle damping as a fraction of critical damping `2√(α m)` (seed 000 §4 keeps
+    /// particle damping separate from part damping).
+    pub particle_damping_ratio: f32,
+    /// Extra damping of the part centres, N·s/m per particle (added to the drag).
+    pub part_damping: f32,
+    /// The thesis's proposed correction: shift each part's targets by the offset from
+    /// their centre of mass to the part's centre, less with distance from the centre.
+    pub center_correction: bool,
+    /// "Tiles" (Slika 12): particles sit exactly on their targets, no oscillation.
+    pub tiles: bool,
+}
+
+impl Default for PatchParams {
+    fn default() -> Self {
+        Self {
+            part_width: 4,
+            part_height: 4,
+            stiffness: 60.0,
+            exponent: 1.0,
+            particle_damping_ratio: 1.0,
+            part_damping: 0.0,
+            center_correction: true,
+            tiles: false,
+        }
+    }
+}
+
+impl PatchParams {
+    fn validate(&self) -> Result<(), ClothError> {
+        for (field, size) in [
+            ("model.part_width", self.part_width),
+            ("model.part_height", self.part_height),
+        ] {
+            if !(1..=16).contains(&size) {
+                return Err(ClothError::InvalidParameter {
+                    field,
+                    value: size as f32,
+                    expected: "a part size of 1 to 16 particles",
+                });
+            }
+        }
+        check(
+            "model.stiffness",
+            self.stiffness,
+            self.stiffness > 0.0,
+            "a stiffness > 0",
+        )?;
+        check(
+            "model.exponent",
+            self.exponent,
+            (0.5..=3.0).contains(&self.exponent),
+            "an exponent in [0.5, 3] (seed 000 §4)",
+        )?;
+        check(
+            "model.particle_damping_ratio",
+            self.particle_damping_ratio,
+            self.particle_damping_ratio >= 0.0,
+            "a ratio ≥ 0",
+        )?;
+        check(
+            "model.part_damping",
+            self.part_damping,
+            self.part_damping >= 0.0,
+            "a damping ≥ 0",
+        )?;
+        Ok(())
+    }
+}
+
 /// Which cloth model moves the particles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
 pub enum Model {
@@ -265,6 +346,9 @@ pub enum Model {
     /// Each particle pulled toward a goal from the best rigid fit of the rest shape
     /// (seed 000 §2.3, §3.3). No springs act, so nothing tears.
     ShapeMatching(ShapeMatchingParams),
+    /// Parts of w×h particles whose centres form a mass-spring lattice; particles follow
+    /// targets interpolated between neighbouring centres (seed 000 §3.4). Grids only.
+    Patches(PatchParams),
 }
 
 /// Parameters of the model of one cloth. Edits take effect on the next step.
@@ -378,8 +462,10 @@ impl ClothParams {
         if let Some(ratio) = self.tear_ratio {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
         }
-        if let Model::ShapeMatching(sm) = &self.model {
-            sm.validate()?;
+        match &self.model {
+            Model::ShapeMatching(sm) => sm.validate()?,
+            Model::Patches(patches) => patches.validate()?,
+            Model::MassSpring => {}
         }
         Ok(())
     }

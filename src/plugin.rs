@@ -29,8 +29,8 @@ use crate::components::{
 };
 use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::params::{
-    ClothParams, Environment, GoalUpdate, Integrator, Model, RotationMethod, ShapeMatchingParams,
-    SpringFamily, SpringParams, Substeps, Wind, WindField,
+    ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, RotationMethod,
+    ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
 };
 use crate::shape::{ClothShape, Pins};
 use crate::solver;
@@ -129,6 +129,7 @@ impl Plugin for ClothPlugin {
             .register_type::<Substeps>()
             .register_type::<Model>()
             .register_type::<ShapeMatchingParams>()
+            .register_type::<PatchParams>()
             .register_type::<RotationMethod>()
             .register_type::<GoalUpdate>()
             .register_type::<Environment>()

@@ -9,7 +9,6 @@
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
 
 use image::RgbImage;
 
@@ -23,31 +22,43 @@ fn example_binary(name: &str) -> PathBuf {
 struct Xvfb(Child);
 
 impl Drop for Xvfb {
+    /// SIGTERM (not `Child::kill`'s SIGKILL), so Xvfb removes its lock and socket.
     fn drop(&mut self) {
-        let _ = self.0.kill();
+        let _ = Command::new("kill").arg(self.0.id().to_string()).status();
         let _ = self.0.wait();
     }
 }
 
-/// A private X display, or `None` when Xvfb is not installed.
-fn start_xvfb(display: &str) -> Option<Xvfb> {
-    let child = Command::new("Xvfb")
-        .args([display, "-screen", "0", "1280x720x24", "-nolisten", "tcp"])
-        .stdout(Stdio::null())
+/// A private X display on a free display number (Xvfb picks it and prints it with
+/// `-displayfd`, so stale locks of earlier runs do not matter), or `None` when Xvfb is
+/// not installed.
+fn start_xvfb() -> Option<(Xvfb, String)> {
+    use std::io::{BufRead, BufReader};
+    let mut child = Command::new("Xvfb")
+        .args([
+            "-displayfd",
+            "1",
+            "-screen",
+            "0",
+            "1280x720x24",
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .ok()?;
+    let stdout = child.stdout.take().expect("piped");
     let xvfb = Xvfb(child);
-    let socket = format!("/tmp/.X11-unix/X{}", display.trim_start_matches(':'));
-    let start = Instant::now();
-    while !Path::new(&socket).exists() {
-        assert!(
-            start.elapsed() < Duration::from_secs(10),
-            "Xvfb did not start on {display}"
-        );
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    Some(xvfb)
+    let mut line = String::new();
+    BufReader::new(stdout)
+        .read_line(&mut line)
+        .expect("Xvfb reports its display");
+    let number: u32 = line
+        .trim()
+        .parse()
+        .unwrap_or_else(|_| panic!("Xvfb printed `{line}`"));
+    Some((xvfb, format!(":{number}")))
 }
 
 /// Cloth pixels: strongly coloured (the sky, the ground and the panel are greyish), in the
@@ -66,8 +77,8 @@ fn cloth_mask(image: &RgbImage) -> Vec<bool> {
 /// Runs `example` with `args` under a private Xvfb, screenshots at frames 30 and 90, and
 /// checks the cloth covers `coverage` of the window around the middle of the 3D view and
 /// that it moved in between.
-fn renders_and_moves(example: &str, display: &str, args: &[&str], coverage: std::ops::Range<f32>) {
-    let _xvfb = match start_xvfb(display) {
+fn renders_and_moves(example: &str, args: &[&str], coverage: std::ops::Range<f32>) {
+    let (_xvfb, display) = match start_xvfb() {
         Some(x) => x,
         None if std::env::var_os("CI").is_some() => {
             panic!("Xvfb is missing: install xvfb mesa-vulkan-drivers")
@@ -86,7 +97,7 @@ fn renders_and_moves(example: &str, display: &str, args: &[&str], coverage: std:
     assert!(binary.exists(), "{} was not built", binary.display());
     let output = Command::new(&binary)
         .current_dir(env!("CARGO_MANIFEST_DIR"))
-        .env("DISPLAY", display)
+        .env("DISPLAY", &display)
         .env_remove("WAYLAND_DISPLAY")
         .args(args)
         .args(["--screenshot", early.to_str().unwrap(), "--frames", "30"])
@@ -151,7 +162,6 @@ fn renders_and_moves(example: &str, display: &str, args: &[&str], coverage: std:
 fn curtain_renders_and_moves() {
     renders_and_moves(
         "curtain",
-        ":97",
         &["--set", "environment.wind.strength=0.003"],
         0.05..0.6,
     );
@@ -163,7 +173,6 @@ fn card_renders_and_moves() {
     // spin, and can be edge-on at any frame).
     renders_and_moves(
         "card",
-        ":96",
         &["--set", "environment.wind.strength=0"],
         0.005..0.4,
     );

@@ -270,19 +270,23 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             .text("node mass, g"),
     );
     p.node_mass = grams * 1e-3;
-    let is_sm = matches!(p.model, Model::ShapeMatching(_));
+    let names = ["mass-spring", "shape matching", "patches"];
+    let current = match p.model {
+        Model::MassSpring => 0,
+        Model::ShapeMatching(_) => 1,
+        Model::Patches(_) => 2,
+    };
     egui::ComboBox::from_label("model")
-        .selected_text(if is_sm {
-            "shape matching"
-        } else {
-            "mass-spring"
-        })
+        .selected_text(names[current])
         .show_ui(ui, |ui| {
-            if ui.selectable_label(!is_sm, "mass-spring").clicked() {
-                p.model = Model::MassSpring;
-            }
-            if ui.selectable_label(is_sm, "shape matching").clicked() && !is_sm {
-                p.model = Model::ShapeMatching(ShapeMatchingParams::default());
+            for (k, name) in names.iter().enumerate() {
+                if ui.selectable_label(k == current, *name).clicked() && k != current {
+                    p.model = match k {
+                        0 => Model::MassSpring,
+                        1 => Model::ShapeMatching(ShapeMatchingParams::default()),
+                        _ => Model::Patches(PatchParams::default()),
+                    };
+                }
             }
         });
     match &mut p.model {
@@ -296,6 +300,33 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             );
         }
         Model::ShapeMatching(sm) => shape_matching_controls(ui, sm),
+        Model::Patches(patch) => {
+            ui.add(egui::Slider::new(&mut patch.part_width, 1..=16).text("part width"));
+            ui.add(egui::Slider::new(&mut patch.part_height, 1..=16).text("part height"));
+            ui.add(
+                egui::Slider::new(&mut patch.stiffness, 0.01..=100.0)
+                    .logarithmic(true)
+                    .text("pull α, N/m"),
+            );
+            ui.add(egui::Slider::new(&mut patch.exponent, 0.5..=3.0).text("exponent p"));
+            ui.add(
+                egui::Slider::new(&mut patch.particle_damping_ratio, 0.0..=2.0)
+                    .text("particle damping (× critical)"),
+            );
+            ui.add(
+                egui::Slider::new(&mut patch.part_damping, 0.0..=0.01).text("part damping, N·s/m"),
+            );
+            ui.checkbox(&mut patch.center_correction, "centre correction");
+            ui.checkbox(&mut patch.tiles, "tiles (no oscillation)");
+            ui.label("part springs:");
+            family(ui, "structural", &mut p.springs.structural);
+            family(ui, "shear", &mut p.springs.shear);
+            family(ui, "bend", &mut p.springs.bend);
+            family(ui, "diag. bend", &mut p.springs.bend_diagonal);
+            ui.add(
+                egui::Slider::new(&mut p.springs.damping, 0.0..=0.05).text("spring damping, N·s/m"),
+            );
+        }
     }
     ui.add(egui::Slider::new(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));
     egui::ComboBox::from_label("integrator")

@@ -1,13 +1,18 @@
 //! Phase 1 of a substep: every force from the old state.
 
 use super::{Cloth, SpringKind};
-use crate::params::{Environment, GoalUpdate, Model, ShapeMatchingParams};
+use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams};
 
 impl Cloth {
     /// Clears and accumulates the forces on every free particle: gravity (seed 002
     /// eq. 1.6), wind, linear drag `−c v` (seed 000 eq. 31) and the springs. Reads only the
     /// old state, so the result does not depend on particle order (seed 000 §3.2).
     pub fn accumulate_forces(&mut self, env: &Environment) {
+        if let Model::Patches(patch) = self.params.model {
+            // External forces act on the part centres (one-way coupling, see patches.rs).
+            self.pull_forces(env, &patch);
+            return;
+        }
         let g = env.effective_gravity();
         let drag = self.params.drag;
         let time = self.time;
@@ -15,9 +20,9 @@ impl Cloth {
         let has_wind = wind.strength > 0.0 && wind.direction != bevy::math::Vec3::ZERO;
         let p = &mut self.particles;
         for i in 0..p.position.len() {
-            let mut f = p.mass[i] * g - drag * p.velocity[i];
+            let mut f = p.mass[i] * g - drag * p.lump[i] * p.velocity[i];
             if has_wind {
-                f += wind.force_at(p.position[i], time);
+                f += wind.force_at(p.position[i], time) * p.lump[i];
             }
             p.force[i] = f;
         }
@@ -25,6 +30,7 @@ impl Cloth {
             self.goal_forces(&sm);
             return;
         }
+
         let damping = self.params.springs.damping;
         for kind in SpringKind::ALL {
             let k = self.stiffness(kind);
@@ -86,6 +92,27 @@ impl Cloth {
                 (d.length() / l).max(0.05).powf(exponent - 1.0)
             };
             p.force[i] += d * (sm.stiffness * scale);
+        }
+    }
+
+    /// The patch model: the part lattice's forces, and each particle's pull toward its
+    /// target `α (|d|/L)^(p−1) d` damped at `ratio · 2√(α m)`.
+    fn pull_forces(&mut self, env: &Environment, patch: &PatchParams) {
+        let Some(patches) = &mut self.patches else {
+            return;
+        };
+        patches.parts.accumulate_forces(env);
+        let (l, exponent) = (self.length_scale, patch.exponent);
+        let p = &mut self.particles;
+        for i in 0..p.position.len() {
+            let d = patches.targets[i] - p.position[i];
+            let scale = if exponent == 1.0 {
+                1.0
+            } else {
+                (d.length() / l).max(0.05).powf(exponent - 1.0)
+            };
+            let damping = patch.particle_damping_ratio * 2.0 * (patch.stiffness * p.mass[i]).sqrt();
+            p.force[i] = d * (patch.stiffness * scale) - damping * p.velocity[i];
         }
     }
 

@@ -6,6 +6,11 @@ use crate::params::{GoalUpdate, Integrator, Model};
 impl Cloth {
     /// Advances every free particle by one substep `h` from its accumulated force.
     pub fn integrate(&mut self) {
+        if let Some(patches) = &mut self.patches {
+            // The part lattice takes its whole substep first; particles follow.
+            patches.parts.integrate();
+            patches.parts.constrain();
+        }
         let h = self.h;
         let h2 = h * h;
         let p = &mut self.particles;
@@ -47,6 +52,21 @@ impl Cloth {
     /// positions), and its velocity takes the same change over `h`. Nothing for the other
     /// models.
     pub fn fit_targets(&mut self) {
+        if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
+            let p = &mut self.particles;
+            patches.compute_targets(&p.position, &patch);
+            let h = self.h;
+            for i in 0..p.position.len() {
+                // Tiles (Slika 12): every particle on its target; otherwise only the
+                // particles that are parts of their own.
+                if p.inv_mass[i] != 0.0 && (patch.tiles || patches.is_single(i)) {
+                    let target = patches.targets[i];
+                    p.velocity[i] = (target - p.previous[i]) / h;
+                    p.position[i] = target;
+                }
+            }
+            return;
+        }
         let (Model::ShapeMatching(sm), Some(state)) = (self.params.model, &mut self.shape_matching)
         else {
             return;

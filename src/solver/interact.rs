@@ -76,7 +76,7 @@ impl Cloth {
             self.particles.inv_mass[g.particle as usize] = if g.inv_mass == 0.0 {
                 0.0
             } else {
-                1.0 / self.params.node_mass
+                1.0 / self.particles.mass[g.particle as usize]
             };
         }
     }

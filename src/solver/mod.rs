@@ -14,6 +14,7 @@
 mod forces;
 mod integrate;
 mod interact;
+pub mod patches;
 pub mod shape_matching;
 mod state;
 pub mod topology;
@@ -25,8 +26,11 @@ pub use topology::{SpringKind, Springs};
 use bevy::math::{Affine3A, Vec3};
 
 use crate::error::ClothError;
-use crate::params::{ClothParams, Environment, GoalUpdate, Model, ShapeMatchingParams};
+use crate::params::{
+    ClothParams, Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams,
+};
 use crate::shape::{ClothShape, Pins};
+use patches::Patches;
 use shape_matching::ShapeMatching;
 
 /// Energies of a cloth in J, for measurement (see [`Cloth::energy`]).
@@ -90,6 +94,8 @@ pub struct Cloth {
     grab: Option<Grab>,
     /// Clusters and goals while the model is shape matching.
     shape_matching: Option<ShapeMatching>,
+    /// The part lattice and targets while the model is the patch model.
+    patches: Option<Patches>,
     /// The cloth's characteristic length L (mean structural rest length), for the
     /// shape-matching force law.
     length_scale: f32,
@@ -234,6 +240,11 @@ impl Cloth {
         frame: Affine3A,
     ) -> Result<Self, ClothError> {
         params.validate()?;
+        if matches!(params.model, Model::Patches(_)) && grid.is_none() {
+            return Err(ClothError::BadMesh {
+                reason: "the patch model needs a grid cloth".into(),
+            });
+        }
         let pin_indices = pins.resolve(&local, grid.map(|g| g.0))?;
         let springs = Springs::from_pairs(pairs, &local);
         let (triangle_springs, spring_triangles) =
@@ -265,6 +276,7 @@ impl Cloth {
             torn_count: 0,
             grab: None,
             shape_matching: None,
+            patches: None,
             length_scale: 1.0,
         };
         let structural = cloth.springs.ranges[SpringKind::Structural as usize].clone();
@@ -285,6 +297,7 @@ impl Cloth {
         if let Some(sm) = &mut self.shape_matching {
             sm.reset();
         }
+        self.patches = None; // rebuilt from the rest state by the next step
         let mass = self.params.node_mass;
         let p = &mut self.particles;
         for (i, local) in self.local_rest.iter().enumerate() {
@@ -293,8 +306,8 @@ impl Cloth {
             p.previous[i] = x;
             p.velocity[i] = Vec3::ZERO;
             p.force[i] = Vec3::ZERO;
-            p.mass[i] = mass;
-            p.inv_mass[i] = 1.0 / mass;
+            p.mass[i] = mass * p.lump[i];
+            p.inv_mass[i] = 1.0 / p.mass[i];
         }
         for &i in &self.pins {
             p.inv_mass[i as usize] = 0.0;
@@ -323,11 +336,16 @@ impl Cloth {
     /// refused with an error and the old parameters stay.
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
+        if matches!(params.model, Model::Patches(_)) && self.grid.is_none() {
+            return Err(ClothError::BadMesh {
+                reason: "the patch model needs a grid cloth".into(),
+            });
+        }
         if params.node_mass != self.params.node_mass {
             for i in 0..self.particles.len() {
-                self.particles.mass[i] = params.node_mass;
+                self.particles.mass[i] = params.node_mass * self.particles.lump[i];
                 if self.particles.inv_mass[i] != 0.0 {
-                    self.particles.inv_mass[i] = 1.0 / params.node_mass;
+                    self.particles.inv_mass[i] = 1.0 / self.particles.mass[i];
                 }
             }
         }
@@ -398,8 +416,9 @@ impl Cloth {
             }
             crate::params::Substeps::Auto { max } => {
                 let needed = match self.auto_cache {
-                    // Shape matching's stiffness depends on the deformation: no cache.
-                    _ if self.shape_matching.is_some() => self.stable_substeps(dt),
+                    // Shape matching's stiffness (and the patch pull's for p ≠ 1) depends on
+                    // the deformation: no cache.
+                    _ if self.state_dependent_stiffness() => self.stable_substeps(dt),
                     Some((p, d, n)) if p == self.params && d == dt => n,
                     _ => {
                         let n = self.stable_substeps(dt);
@@ -418,6 +437,11 @@ impl Cloth {
             self.rescale_verlet_velocity(self.h / self.last_h);
         }
         self.last_h = self.h;
+        if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
+            patches.set_params(&self.params, &patch, n);
+            patches.parts.set_frame(self.frame);
+            patches.parts.begin_step(dt);
+        }
         // Pins move from where they are to where the frame puts them, over the substeps.
         std::mem::swap(&mut self.pin_from, &mut self.pin_to);
         for (k, &i) in self.pins.iter().enumerate() {
@@ -434,6 +458,9 @@ impl Cloth {
     /// Finishes a step: springs stretched past the tear ratio break and hide the faces
     /// they border (seed 000 §3.2). Returns the springs torn in this step.
     pub fn end_step(&mut self) -> &[u32] {
+        if let Some(patches) = &mut self.patches {
+            patches.parts.end_step();
+        }
         if let (Some(ratio), Model::MassSpring) = (self.params.tear_ratio, self.params.model) {
             let x = &self.particles.position;
             let s = &mut self.springs;
@@ -485,24 +512,43 @@ impl Cloth {
     /// rate by `γ ≤ max_i (2·Σ_j c_ij + c_drag) / m_i`. A safety factor of 0.8 on the
     /// right-hand side covers the geometric stiffness of stretched springs.
     pub fn stable_substeps(&self, dt: f32) -> u32 {
-        let (omega2, gamma) = match (&self.params.model, &self.shape_matching) {
-            (Model::ShapeMatching(sm), Some(state)) => self.goal_frequency(sm, state),
+        let (omega2, gamma) = match (&self.params.model, &self.shape_matching, &self.patches) {
+            (Model::ShapeMatching(sm), Some(state), _) => self.goal_frequency(sm, state),
+            (Model::Patches(patch), _, Some(patches)) => {
+                let pull = self.pull_frequency(patch, patches);
+                let lattice = patches.parts.stable_substeps(dt);
+                return substeps_for(dt, pull.0, pull.1).max(lattice);
+            }
             _ => self.spring_frequency(),
         };
-        const SAFETY: f32 = 0.8;
-        let h_max = if omega2 > 0.0 {
-            (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
-        } else if gamma > 0.0 {
-            2.0 * SAFETY / gamma
-        } else {
-            f32::INFINITY
-        };
-        let n = (dt / h_max).ceil();
-        if n.is_finite() && n >= 1.0 {
-            n.min(u32::MAX as f32) as u32
-        } else {
-            1
+        substeps_for(dt, omega2, gamma)
+    }
+
+    /// True when the explicit bound depends on the current deformation.
+    fn state_dependent_stiffness(&self) -> bool {
+        match self.params.model {
+            Model::ShapeMatching(_) => true,
+            Model::Patches(p) => p.exponent != 1.0,
+            Model::MassSpring => false,
         }
+    }
+
+    /// `(ω², γ)` of the patch model's pull toward the targets (as `goal_frequency`), with
+    /// its damping at `ratio · 2√(α m)`.
+    fn pull_frequency(&self, patch: &PatchParams, patches: &Patches) -> (f32, f32) {
+        let (mut omega2, mut gamma) = (0.0f32, 0.0f32);
+        let p = &self.particles;
+        for i in 0..p.len() {
+            let w = p.inv_mass[i];
+            if w == 0.0 {
+                continue;
+            }
+            let d = patches.targets[i].distance(p.position[i]);
+            let k = patch.exponent * patch.stiffness * self.goal_scale(d, patch.exponent);
+            omega2 = omega2.max(2.0 * k * w);
+            gamma = gamma.max(patch.particle_damping_ratio * 2.0 * (patch.stiffness * w).sqrt());
+        }
+        (omega2, gamma)
     }
 
     /// Gershgorin bounds `(ω_max², γ_max)` of the spring lattice.
@@ -530,7 +576,7 @@ impl Cloth {
         for i in 0..n {
             let w = self.particles.inv_mass[i];
             omega2 = omega2.max(2.0 * k_sum[i] * w);
-            gamma = gamma.max((2.0 * c_sum[i] + self.params.drag) * w);
+            gamma = gamma.max((2.0 * c_sum[i] + self.params.drag * self.particles.lump[i]) * w);
         }
         (omega2, gamma)
     }
@@ -572,6 +618,7 @@ impl Cloth {
     fn prepare_model(&mut self) {
         match self.params.model {
             Model::ShapeMatching(sm) => {
+                self.patches = None;
                 let k = sm.clusters;
                 if self
                     .shape_matching
@@ -589,8 +636,36 @@ impl Cloth {
                     state.compute_goals(&self.particles.position, &self.particles.mass, &sm);
                 }
             }
-            Model::MassSpring => self.shape_matching = None,
+            Model::Patches(patch) => {
+                self.shape_matching = None;
+                let size = (patch.part_width, patch.part_height);
+                if self.patches.as_ref().is_none_or(|p| p.built_for != size)
+                    && let Some(grid) = self.grid
+                {
+                    self.patches = Patches::new(
+                        &self.local_rest,
+                        grid,
+                        &self.pins,
+                        &self.params,
+                        &patch,
+                        self.frame,
+                    )
+                    .ok();
+                }
+                if let Some(patches) = &mut self.patches {
+                    patches.compute_targets(&self.particles.position, &patch);
+                }
+            }
+            Model::MassSpring => {
+                self.shape_matching = None;
+                self.patches = None;
+            }
         }
+    }
+
+    /// The patch model's state (part lattice and targets), if that is the model.
+    pub fn patches(&self) -> Option<&Patches> {
+        self.patches.as_ref()
     }
 
     /// The shape-matching goals (after the last goal computation), if that is the model.
@@ -682,6 +757,9 @@ impl Cloth {
 
     /// Number of springs that still act (whole and of an enabled family).
     pub fn spring_count(&self) -> usize {
+        if let Some(patches) = &self.patches {
+            return patches.spring_count();
+        }
         SpringKind::ALL
             .into_iter()
             .filter(|&k| self.stiffness(k) > 0.0)
@@ -696,7 +774,7 @@ impl Cloth {
 
     /// Number of springs torn since the last reset.
     pub fn torn_count(&self) -> usize {
-        self.torn_count
+        self.torn_count + self.patches.as_ref().map_or(0, Patches::torn_count)
     }
 
     /// Simulated time since the last reset, in s.
@@ -728,6 +806,10 @@ impl Cloth {
 
     /// Kinetic, gravitational and spring energy under `env`.
     pub fn energy(&self, env: &Environment) -> Energy {
+        if let Some(patches) = &self.patches {
+            // The patch model's mechanics is its part lattice; particles only follow.
+            return patches.parts.energy(env);
+        }
         let g = env.effective_gravity();
         let p = &self.particles;
         let mut e = Energy::default();
@@ -810,5 +892,24 @@ impl Cloth {
         for n in out.iter_mut() {
             *n = n.normalize_or(Vec3::Z);
         }
+    }
+}
+
+/// Substeps that keep `h = dt/N` inside the explicit bound `h²ω² + 2hγ < 4` with a safety
+/// factor of 0.8 (see [`Cloth::stable_substeps`]).
+fn substeps_for(dt: f32, omega2: f32, gamma: f32) -> u32 {
+    const SAFETY: f32 = 0.8;
+    let h_max = if omega2 > 0.0 {
+        (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
+    } else if gamma > 0.0 {
+        2.0 * SAFETY / gamma
+    } else {
+        f32::INFINITY
+    };
+    let n = (dt / h_max).ceil();
+    if n.is_finite() && n >= 1.0 {
+        n.min(u32::MAX as f32) as u32
+    } else {
+        1
     }
 }

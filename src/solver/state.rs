@@ -17,6 +17,9 @@ pub struct Particles {
     pub inv_mass: Vec<f32>,
     /// Force accumulated in the current substep, N.
     pub force: Vec<Vec3>,
+    /// How many particles' worth each node is (1 for a particle; a part centre of the
+    /// patch model counts its particles): scales mass, wind and drag.
+    pub lump: Vec<f32>,
 }
 
 impl Particles {
@@ -29,6 +32,7 @@ impl Particles {
             mass: vec![0.0; n],
             inv_mass: vec![0.0; n],
             force: vec![Vec3::ZERO; n],
+            lump: vec![1.0; n],
         }
     }
 

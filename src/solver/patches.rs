@@ -1,0 +1,284 @@
+//! The hybrid patch model (seed 000 §3.4): the grid is split into parts of w×h particles;
+//! the parts' centres of mass form a mass-spring lattice (a [`Cloth`] of its own, each
+//! node a lump of its particles) that feels gravity, wind, drag and the part springs; the
+//! particles follow targets interpolated between neighbouring part centres.
+//!
+//! Coupling rule (the thesis warns that parts fly apart when the two are not matched):
+//! the coupling is one-way. External forces act on the part centres, which carry the
+//! particles' mass; particles feel only the pull toward their targets, damped at a
+//! fraction of critical (`2√(α m)`), so they follow their parts and cannot push them
+//! apart. Automatic substeps cover both the part lattice and the pull.
+
+use bevy::math::{Affine3A, Vec3};
+
+use super::{Cloth, SpringKind, topology};
+use crate::error::ClothError;
+use crate::params::{ClothParams, Model, PatchParams, Substeps};
+use crate::shape::Pins;
+
+/// One part: a block of the particle grid.
+#[derive(Clone, Copy, Debug)]
+struct Part {
+    i0: u32,
+    j0: u32,
+    width: u32,
+    height: u32,
+}
+
+/// The part lattice and the particles' targets.
+#[derive(Clone, Debug)]
+pub struct Patches {
+    /// The part centres as a mass-spring cloth.
+    pub parts: Box<Cloth>,
+    part_grid: (u32, u32),
+    layout: Vec<Part>,
+    grid: (u32, u32),
+    /// Target of every particle (after the last `compute_targets`).
+    pub targets: Vec<Vec3>,
+    /// Weight of the centre correction per particle: 1 at the part's centre, falling off
+    /// with rest distance from it.
+    correction_weight: Vec<f32>,
+    /// True for particles that are a part of their own (1×1 parts).
+    single: Vec<bool>,
+    /// `(part_width, part_height)` these were built for.
+    pub(super) built_for: (u32, u32),
+}
+
+/// The part lattice's own parameters: the cloth's springs, integrator, strain limit and
+/// tearing, with the part damping added to the drag.
+fn lattice_params(params: &ClothParams, patch: &PatchParams, substeps: u32) -> ClothParams {
+    ClothParams {
+        model: Model::MassSpring,
+        drag: params.drag + patch.part_damping,
+        substeps: Substeps::Fixed(substeps.max(1)),
+        ..*params
+    }
+}
+
+impl Patches {
+    /// Splits a `grid` whose particles rest at `local_rest` into parts of `patch`'s size;
+    /// a part holding a pinned particle has its centre pinned.
+    pub fn new(
+        local_rest: &[Vec3],
+        grid: (u32, u32),
+        pins: &[u32],
+        params: &ClothParams,
+        patch: &PatchParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        let (w, h) = grid;
+        let (pw, ph) = (patch.part_width.min(w), patch.part_height.min(h));
+        let (nx, ny) = (w.div_ceil(pw), h.div_ceil(ph));
+        let mut layout = Vec::with_capacity((nx * ny) as usize);
+        let mut centres = Vec::with_capacity(layout.capacity());
+        let mut lumps = Vec::with_capacity(layout.capacity());
+        let mut correction_weight = vec![1.0; local_rest.len()];
+        let mut single = vec![false; local_rest.len()];
+        for py in 0..ny {
+            for px in 0..nx {
+                let part = Part {
+                    i0: px * pw,
+                    j0: py * ph,
+                    width: pw.min(w - px * pw),
+                    height: ph.min(h - py * ph),
+                };
+                let members: Vec<usize> = part_particles(&part, w).collect();
+                let centre =
+                    members.iter().map(|&k| local_rest[k]).sum::<Vec3>() / members.len() as f32;
+                let reach = members
+                    .iter()
+                    .map(|&k| local_rest[k].distance(centre))
+                    .fold(0.0, f32::max);
+                let spacing = local_rest[0].distance(local_rest[1]);
+                for &k in &members {
+                    correction_weight[k] = 1.0 - local_rest[k].distance(centre) / (reach + spacing);
+                    single[k] = members.len() == 1;
+                }
+                centres.push(centre);
+                lumps.push(members.len() as f32);
+                layout.push(part);
+            }
+        }
+        let part_of = |k: u32| {
+            let (i, j) = (k % w, k / w);
+            (j / ph) * nx + i / pw
+        };
+        let mut pinned_parts: Vec<u32> = pins.iter().map(|&k| part_of(k)).collect();
+        pinned_parts.sort_unstable();
+        pinned_parts.dedup();
+        let pairs = topology::grid_spring_pairs(nx, ny);
+        let mut parts = Cloth::build(
+            centres,
+            pairs,
+            Vec::new(),
+            Some((nx, ny)),
+            &Pins::Indices(pinned_parts),
+            &lattice_params(params, patch, 1),
+            frame,
+        )?;
+        parts.particles.lump = lumps;
+        parts.reset();
+        Ok(Patches {
+            parts: Box::new(parts),
+            part_grid: (nx, ny),
+            layout,
+            grid,
+            targets: local_rest
+                .iter()
+                .map(|x| frame.transform_point3(*x))
+                .collect(),
+            correction_weight,
+            single,
+            built_for: (patch.part_width, patch.part_height),
+        })
+    }
+
+    /// Updates the lattice's parameters (springs, drag, integrator, tearing) and substeps.
+    pub fn set_params(&mut self, params: &ClothParams, patch: &PatchParams, substeps: u32) {
+        // Validated with the cloth's parameters already; the lattice's differ only in
+        // model, drag (+ a validated damping) and substeps.
+        let _ = self
+            .parts
+            .set_params(&lattice_params(params, patch, substeps));
+    }
+
+    /// True when particle `i` is a part of its own (its position is its part's centre).
+    pub fn is_single(&self, i: usize) -> bool {
+        self.single[i]
+    }
+
+    /// Number of parts.
+    pub fn part_count(&self) -> usize {
+        self.layout.len()
+    }
+
+    /// Targets of every particle from the part centres (seed 000 §3.4, Slika 7–9), given
+    /// the particles' current positions `x` (used only when the cloth is one part wide or
+    /// high). Allocates nothing.
+    pub fn compute_targets(&mut self, x: &[Vec3], patch: &PatchParams) {
+        let (nx, ny) = self.part_grid;
+        let w = self.grid.0;
+        let centres = &self.parts.particles.position;
+        for py in 0..ny {
+            for px in 0..nx {
+                let k = (py * nx + px) as usize;
+                let part = self.layout[k];
+                let c = centres[k];
+                if part.width == 1 && part.height == 1 {
+                    // A part of one particle is that particle: the model is mass-spring.
+                    self.targets[(part.j0 * w + part.i0) as usize] = c;
+                    continue;
+                }
+                let size =
+                    |p: Part, horizontal: bool| if horizontal { p.width } else { p.height } as f32;
+                // Neighbour centres and their rest distances in particle spacings; a missing
+                // neighbour is a "ghost" mirrored through this centre (Slika 9).
+                let neighbour = |dx: i32, dy: i32| -> Option<(Vec3, f32)> {
+                    let (qx, qy) = (px as i32 + dx, py as i32 + dy);
+                    if qx < 0 || qy < 0 || qx >= nx as i32 || qy >= ny as i32 {
+                        return None;
+                    }
+                    let q = (qy as u32 * nx + qx as u32) as usize;
+                    let horizontal = dx != 0;
+                    Some((
+                        centres[q],
+                        0.5 * (size(part, horizontal) + size(self.layout[q], horizontal)),
+                    ))
+                };
+                let axis = |minus: Option<(Vec3, f32)>,
+                            plus: Option<(Vec3, f32)>,
+                            horizontal: bool| match (minus, plus) {
+                    (Some(m), Some(p)) => (m, p),
+                    (Some((m, d)), None) => ((m, d), (2.0 * c - m, d)),
+                    (None, Some((p, d))) => ((2.0 * c - p, d), (p, d)),
+                    // One part across: measure the direction from the part's own particles.
+                    (None, None) => {
+                        let step = own_step(&part, x, w, horizontal);
+                        let n = size(part, horizontal);
+                        ((c - step * n, n), (c + step * n, n))
+                    }
+                };
+                let ((l, dl), (r, dr)) = axis(neighbour(-1, 0), neighbour(1, 0), true);
+                let ((t, dt), (b, db)) = axis(neighbour(0, -1), neighbour(0, 1), false);
+                // Seed 000's pseudocode, generalised to unequal neighbours (edge parts):
+                // horizontal = (right − left) / (2w), vertical = (bottom − top) / (2h),
+                // start = (top + left)/2 shifted by half a step; target = start + j·v + i·h.
+                let horizontal = (r - l) / (dl + dr);
+                let vertical = (b - t) / (dt + db);
+                let start = 0.5 * (t + l)
+                    + horizontal * (0.5 * (dl - part.width as f32 + 1.0))
+                    + vertical * (0.5 * (dt - part.height as f32 + 1.0));
+                for j in 0..part.height {
+                    for i in 0..part.width {
+                        let index = ((part.j0 + j) * w + part.i0 + i) as usize;
+                        self.targets[index] = start + horizontal * i as f32 + vertical * j as f32;
+                    }
+                }
+                if patch.center_correction {
+                    // The thesis's proposed correction: move the targets' centre of mass
+                    // onto the part's centre, fully at the centre, less toward the edges.
+                    let count = (part.width * part.height) as f32;
+                    let mean = part_particles(&part, w)
+                        .map(|q| self.targets[q])
+                        .sum::<Vec3>()
+                        / count;
+                    let offset = c - mean;
+                    for q in part_particles(&part, w) {
+                        self.targets[q] += offset * self.correction_weight[q];
+                    }
+                }
+            }
+        }
+    }
+
+    /// Springs of the part lattice torn so far.
+    pub fn torn_count(&self) -> usize {
+        self.parts.torn_count()
+    }
+
+    /// Acting springs of the part lattice.
+    pub fn spring_count(&self) -> usize {
+        SpringKind::ALL
+            .into_iter()
+            .filter(|&k| self.parts.stiffness(k) > 0.0)
+            .map(|k| {
+                let s = &self.parts.springs;
+                s.ranges[k as usize].clone().filter(|&i| s.alive[i]).count()
+            })
+            .sum()
+    }
+}
+
+fn part_particles(part: &Part, w: u32) -> impl Iterator<Item = usize> + '_ {
+    let p = *part;
+    (p.j0..p.j0 + p.height)
+        .flat_map(move |j| (p.i0..p.i0 + p.width).map(move |i| (j * w + i) as usize))
+}
+
+/// For a cloth one part across: the step between neighbouring particle columns (or rows)
+/// of the part, from the mean positions of its first and last column (row).
+fn own_step(part: &Part, x: &[Vec3], w: u32, horizontal: bool) -> Vec3 {
+    let n = if horizontal { part.width } else { part.height };
+    if n < 2 {
+        return Vec3::ZERO;
+    }
+    let line_mean = |k: u32| {
+        let (count, sum) = if horizontal {
+            (
+                part.height,
+                (0..part.height)
+                    .map(|j| x[((part.j0 + j) * w + part.i0 + k) as usize])
+                    .sum::<Vec3>(),
+            )
+        } else {
+            (
+                part.width,
+                (0..part.width)
+                    .map(|i| x[((part.j0 + k) * w + part.i0 + i) as usize])
+                    .sum::<Vec3>(),
+            )
+        };
+        sum / count as f32
+    };
+    (line_mean(n - 1) - line_mean(0)) / (n - 1) as f32
+}
