@@ -277,6 +277,18 @@ fn set_by_path(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), 
         } else {
             Some(number()?)
         };
+    } else if let Some(f) = field.try_downcast_mut::<crate::params::Model>() {
+        use crate::params::{Model, PatchParams, ShapeMatchingParams};
+        *f = match value {
+            "MassSpring" => Model::MassSpring,
+            "ShapeMatching" => Model::ShapeMatching(ShapeMatchingParams::default()),
+            "Patches" => Model::Patches(PatchParams::default()),
+            _ => {
+                return Err(format!(
+                    "`{value}` is not MassSpring, ShapeMatching or Patches"
+                ));
+            }
+        };
     } else if let Some(f) = field.try_downcast_mut::<Substeps>() {
         *f = if value.eq_ignore_ascii_case("auto") {
             Substeps::default()

@@ -281,3 +281,46 @@ fn patches_need_a_grid_and_valid_sizes() {
         .is_err()
     );
 }
+
+#[test]
+fn switching_to_patches_mid_motion_keeps_the_cloth_in_place_and_grabs_pull_parts() {
+    let mut c = grid(
+        16,
+        12,
+        ClothParams::default(),
+        Pins::TopCorners,
+        Affine3A::IDENTITY,
+    );
+    let env = Environment::default();
+    for _ in 0..60 {
+        c.step(DT, &env);
+    }
+    let before = c.positions().to_vec();
+    let mut params = *c.params();
+    params.model = Model::Patches(patch(4, 4));
+    c.set_params(&params).unwrap();
+    c.step(DT, &env);
+    let jump = before
+        .iter()
+        .zip(c.positions())
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f32::max);
+    assert!(
+        jump < 0.05,
+        "switching models moved a particle by {jump} m in one step"
+    );
+    // Grabbing a bottom particle and pulling it forward moves its whole part.
+    let corner = 11 * 16 + 8;
+    let start = c.positions()[corner];
+    let neighbour = c.positions()[corner - 16 - 1];
+    assert!(c.grab(corner as u32));
+    for _ in 0..40 {
+        c.drag_grab(start + Vec3::Z * 0.3);
+        c.step(DT, &env);
+    }
+    assert!(c.positions()[corner].distance(start + Vec3::Z * 0.3) < 1e-4);
+    assert!(
+        c.positions()[corner - 16 - 1].z - neighbour.z > 0.1,
+        "the part did not follow the grab"
+    );
+}

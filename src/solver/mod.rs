@@ -651,8 +651,24 @@ impl Cloth {
                         self.frame,
                     )
                     .ok();
+                    if let Some(patches) = &mut self.patches {
+                        patches.adopt_state(&self.particles);
+                    }
                 }
                 if let Some(patches) = &mut self.patches {
+                    // A grabbed particle drags its part along (particles only follow parts).
+                    match self.grab {
+                        Some(g) => {
+                            let part = patches.part_of(g.particle) as u32;
+                            let offset = patches.parts.positions()[part as usize]
+                                - self.particles.position[g.particle as usize];
+                            if patches.parts.grabbed().is_none_or(|pg| pg.particle != part) {
+                                patches.parts.grab(part);
+                            }
+                            patches.parts.drag_grab(g.target + offset);
+                        }
+                        None => patches.parts.release_grab(),
+                    }
                     patches.compute_targets(&self.particles.position, &patch);
                 }
             }

@@ -133,6 +133,32 @@ impl Patches {
         })
     }
 
+    /// Puts each part centre at the centre of mass of its particles' current state
+    /// (position, previous position, velocity), so switching models mid-motion keeps the
+    /// cloth where it is.
+    pub fn adopt_state(&mut self, particles: &super::Particles) {
+        let w = self.grid.0;
+        let parts = &mut self.parts.particles;
+        for (k, part) in self.layout.iter().enumerate() {
+            if parts.inv_mass[k] == 0.0 {
+                continue; // pinned centres stay with their pins
+            }
+            let n = (part.width * part.height) as f32;
+            let mean = |v: &[Vec3]| part_particles(part, w).map(|q| v[q]).sum::<Vec3>() / n;
+            parts.position[k] = mean(&particles.position);
+            parts.previous[k] = mean(&particles.previous);
+            parts.velocity[k] = mean(&particles.velocity);
+        }
+    }
+
+    /// The part holding particle `i`.
+    pub fn part_of(&self, i: u32) -> usize {
+        let (w, nx) = (self.grid.0, self.part_grid.0);
+        let first = self.layout[0];
+        let (pw, ph) = (first.width, first.height);
+        (((i / w) / ph) * nx + (i % w) / pw) as usize
+    }
+
     /// Updates the lattice's parameters (springs, drag, integrator, tearing) and substeps.
     pub fn set_params(&mut self, params: &ClothParams, patch: &PatchParams, substeps: u32) {
         // Validated with the cloth's parameters already; the lattice's differ only in
