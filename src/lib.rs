@@ -51,8 +51,8 @@ pub mod prelude {
     pub use crate::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::error::ClothError;
     pub use crate::params::{
-        ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, RotationMethod,
-        ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
+        ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
+        RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
     };
     pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSystems};
     pub use crate::scene::{ClothScene, SceneCloth, SceneError};

@@ -256,6 +256,21 @@ impl ShapeMatchingParams {
     }
 }
 
+/// How the patch model places particle targets between part centres.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
+pub enum PatchTargets {
+    /// Seed 000 §3.4's pseudocode: an affine map per part from its four neighbours.
+    /// Neighbouring parts disagree along their border when the lattice bends (the
+    /// thesis's visible borders, Slika 22).
+    Seed,
+    /// Bilinear interpolation between the four part centres around each particle
+    /// (extrapolated past the outer centres, like the seed's ghosts): continuous across
+    /// part borders; the same as the seed's for a flat, rigidly moved cloth. Not in the
+    /// thesis. A cloth only one part across uses the seed's targets.
+    #[default]
+    Bilinear,
+}
+
 /// Parameters of the hybrid patch model (seed 000 §3.4).
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -273,11 +288,13 @@ pub struct PatchParams {
     pub particle_damping_ratio: f32,
     /// Extra damping of the part centres, N·s/m per particle (added to the drag).
     pub part_damping: f32,
-    /// The thesis's proposed correction: shift each part's targets by the offset from
-    /// their centre of mass to the part's centre, less with distance from the centre.
+    /// The thesis's proposed correction (seed targets only): shift each part's targets by
+    /// the offset from their centre of mass to the part's centre, less with distance.
     pub center_correction: bool,
     /// "Tiles" (Slika 12): particles sit exactly on their targets, no oscillation.
     pub tiles: bool,
+    /// The target interpolation.
+    pub targets: PatchTargets,
 }
 
 impl Default for PatchParams {
@@ -291,6 +308,7 @@ impl Default for PatchParams {
             part_damping: 0.0,
             center_correction: true,
             tiles: false,
+            targets: PatchTargets::Bilinear,
         }
     }
 }

@@ -130,6 +130,7 @@ impl Plugin for ClothPlugin {
             .register_type::<Model>()
             .register_type::<ShapeMatchingParams>()
             .register_type::<PatchParams>()
+            .register_type::<crate::params::PatchTargets>()
             .register_type::<RotationMethod>()
             .register_type::<GoalUpdate>()
             .register_type::<Environment>()

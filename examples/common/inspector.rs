@@ -316,7 +316,24 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             ui.add(
                 egui::Slider::new(&mut patch.part_damping, 0.0..=0.01).text("part damping, N·s/m"),
             );
-            ui.checkbox(&mut patch.center_correction, "centre correction");
+            egui::ComboBox::from_label("targets")
+                .selected_text(format!("{:?}", patch.targets))
+                .show_ui(ui, |ui| {
+                    ui.selectable_value(
+                        &mut patch.targets,
+                        PatchTargets::Bilinear,
+                        "Bilinear (continuous)",
+                    );
+                    ui.selectable_value(
+                        &mut patch.targets,
+                        PatchTargets::Seed,
+                        "Seed (per part, §3.4)",
+                    );
+                });
+            ui.checkbox(
+                &mut patch.center_correction,
+                "centre correction (seed targets)",
+            );
             ui.checkbox(&mut patch.tiles, "tiles (no oscillation)");
             ui.label("part springs:");
             family(ui, "structural", &mut p.springs.structural);

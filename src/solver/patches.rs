@@ -13,7 +13,7 @@ use bevy::math::{Affine3A, Vec3};
 
 use super::{Cloth, SpringKind, topology};
 use crate::error::ClothError;
-use crate::params::{ClothParams, Model, PatchParams, Substeps};
+use crate::params::{ClothParams, Model, PatchParams, PatchTargets, Substeps};
 use crate::shape::Pins;
 
 /// One part: a block of the particle grid.
@@ -40,6 +40,9 @@ pub struct Patches {
     correction_weight: Vec<f32>,
     /// True for particles that are a part of their own (1×1 parts).
     single: Vec<bool>,
+    /// Bilinear stencil per particle: the four centres (x0y0, x1y0, x0y1, x1y1) and the
+    /// weights along x and y (outside [0, 1] beyond the outer centres).
+    stencil: Vec<([u32; 4], f32, f32)>,
     /// `(part_width, part_height)` these were built for.
     pub(super) built_for: (u32, u32),
 }
@@ -99,6 +102,41 @@ impl Patches {
                 layout.push(part);
             }
         }
+        // Rest coordinates of the centres along each axis, in particle indices.
+        let column_centre: Vec<f32> = (0..nx)
+            .map(|px| (px * pw) as f32 + (pw.min(w - px * pw) - 1) as f32 * 0.5)
+            .collect();
+        let row_centre: Vec<f32> = (0..ny)
+            .map(|py| (py * ph) as f32 + (ph.min(h - py * ph) - 1) as f32 * 0.5)
+            .collect();
+        let bracket = |centres: &[f32], u: f32| -> (u32, u32, f32) {
+            if centres.len() == 1 {
+                return (0, 0, 0.0);
+            }
+            let last = centres.len() - 1;
+            let a = centres
+                .iter()
+                .rposition(|&c| c <= u)
+                .unwrap_or(0)
+                .min(last - 1);
+            (
+                a as u32,
+                a as u32 + 1,
+                (u - centres[a]) / (centres[a + 1] - centres[a]),
+            )
+        };
+        let stencil = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .map(|(i, j)| {
+                let (x0, x1, s) = bracket(&column_centre, i as f32);
+                let (y0, y1, t) = bracket(&row_centre, j as f32);
+                (
+                    [y0 * nx + x0, y0 * nx + x1, y1 * nx + x0, y1 * nx + x1],
+                    s,
+                    t,
+                )
+            })
+            .collect();
         let part_of = |k: u32| {
             let (i, j) = (k % w, k / w);
             (j / ph) * nx + i / pw
@@ -129,6 +167,7 @@ impl Patches {
                 .collect(),
             correction_weight,
             single,
+            stencil,
             built_for: (patch.part_width, patch.part_height),
         })
     }
@@ -183,6 +222,14 @@ impl Patches {
     /// high). Allocates nothing.
     pub fn compute_targets(&mut self, x: &[Vec3], patch: &PatchParams) {
         let (nx, ny) = self.part_grid;
+        if patch.targets == PatchTargets::Bilinear && nx > 1 && ny > 1 {
+            let c = &self.parts.particles.position;
+            for (target, &([a, b, d, e], s, t)) in self.targets.iter_mut().zip(&self.stencil) {
+                let [a, b, d, e] = [a, b, d, e].map(|k| c[k as usize]);
+                *target = (a * (1.0 - s) + b * s) * (1.0 - t) + (d * (1.0 - s) + e * s) * t;
+            }
+            return;
+        }
         let w = self.grid.0;
         let centres = &self.parts.particles.position;
         for py in 0..ny {
