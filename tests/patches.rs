@@ -350,3 +350,27 @@ fn switching_to_patches_mid_motion_keeps_the_cloth_in_place_and_grabs_pull_parts
         "the part did not follow the grab"
     );
 }
+
+#[test]
+fn torn_part_springs_split_the_drawn_cloth() {
+    let params = ClothParams {
+        model: Model::Patches(patch(4, 4)),
+        tear_ratio: Some(1.3),
+        strain_limit: None,
+        ..ClothParams::default()
+    };
+    let mut c = grid(16, 16, params, Pins::TopRow, Affine3A::IDENTITY);
+    let env = Environment {
+        gravity: Vec3::new(0.0, -3000.0, 0.0),
+        ..Environment::default()
+    };
+    for _ in 0..100 {
+        c.step(DT, &env);
+    }
+    assert!(c.torn_count() > 0, "nothing tore under 300 g");
+    assert!(
+        c.triangle_visible().iter().any(|v| !*v),
+        "a torn part spring hid no face"
+    );
+    assert!(c.is_finite());
+}

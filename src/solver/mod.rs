@@ -459,7 +459,23 @@ impl Cloth {
     /// they border (seed 000 §3.2). Returns the springs torn in this step.
     pub fn end_step(&mut self) -> &[u32] {
         if let Some(patches) = &mut self.patches {
+            // A torn part spring splits the cloth between its two parts: hide the faces
+            // that straddle them (on tear events only).
             patches.parts.end_step();
+            let lattice = &patches.parts.springs;
+            for &k in patches.parts.last_torn() {
+                let (a, b) = (
+                    lattice.a[k as usize] as usize,
+                    lattice.b[k as usize] as usize,
+                );
+                for (t, tri) in self.triangles.iter().enumerate() {
+                    let parts = tri.map(|v| patches.part_of(v));
+                    if parts.contains(&a) && parts.contains(&b) {
+                        self.triangle_visible[t] = false;
+                        self.faces_changed = true;
+                    }
+                }
+            }
         }
         if let (Some(ratio), Model::MassSpring) = (self.params.tear_ratio, self.params.model) {
             let x = &self.particles.position;
