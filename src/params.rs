@@ -143,6 +143,16 @@ impl Default for Substeps {
     }
 }
 
+/// Seed 000 §4: exponents of the pull toward a goal stay within [0.5, 3].
+fn check_exponent(exponent: f32) -> Result<(), ClothError> {
+    check(
+        "model.exponent",
+        exponent,
+        (0.5..=3.0).contains(&exponent),
+        "an exponent in [0.5, 3] (seed 000 §4)",
+    )
+}
+
 /// How shape matching finds the rotation of a cluster.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum RotationMethod {
@@ -227,12 +237,7 @@ impl ShapeMatchingParams {
                 "a fraction 0–1 for the Velocity update",
             )?;
         }
-        check(
-            "model.exponent",
-            self.exponent,
-            (0.5..=3.0).contains(&self.exponent),
-            "an exponent in [0.5, 3] (seed 000 §4)",
-        )?;
+        check_exponent(self.exponent)?;
         check(
             "model.damping",
             self.damping,
@@ -333,12 +338,7 @@ impl PatchParams {
             self.stiffness > 0.0,
             "a stiffness > 0",
         )?;
-        check(
-            "model.exponent",
-            self.exponent,
-            (0.5..=3.0).contains(&self.exponent),
-            "an exponent in [0.5, 3] (seed 000 §4)",
-        )?;
+        check_exponent(self.exponent)?;
         check(
             "model.particle_damping_ratio",
             self.particle_damping_ratio,

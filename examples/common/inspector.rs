@@ -240,6 +240,14 @@ fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily) {
     });
 }
 
+fn spring_controls(ui: &mut egui::Ui, springs: &mut SpringParams) {
+    family(ui, "structural", &mut springs.structural);
+    family(ui, "shear", &mut springs.shear);
+    family(ui, "bend", &mut springs.bend);
+    family(ui, "diag. bend", &mut springs.bend_diagonal);
+    ui.add(egui::Slider::new(&mut springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
+}
+
 fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
     if let ClothShape::Grid {
         width,
@@ -291,13 +299,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
         });
     match &mut p.model {
         Model::MassSpring => {
-            family(ui, "structural", &mut p.springs.structural);
-            family(ui, "shear", &mut p.springs.shear);
-            family(ui, "bend", &mut p.springs.bend);
-            family(ui, "diag. bend", &mut p.springs.bend_diagonal);
-            ui.add(
-                egui::Slider::new(&mut p.springs.damping, 0.0..=0.05).text("spring damping, N·s/m"),
-            );
+            spring_controls(ui, &mut p.springs);
         }
         Model::ShapeMatching(sm) => shape_matching_controls(ui, sm),
         Model::Patches(patch) => {
@@ -336,13 +338,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             );
             ui.checkbox(&mut patch.tiles, "tiles (no oscillation)");
             ui.label("part springs:");
-            family(ui, "structural", &mut p.springs.structural);
-            family(ui, "shear", &mut p.springs.shear);
-            family(ui, "bend", &mut p.springs.bend);
-            family(ui, "diag. bend", &mut p.springs.bend_diagonal);
-            ui.add(
-                egui::Slider::new(&mut p.springs.damping, 0.0..=0.05).text("spring damping, N·s/m"),
-            );
+            spring_controls(ui, &mut p.springs);
         }
     }
     ui.add(egui::Slider::new(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));

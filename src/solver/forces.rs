@@ -1,6 +1,6 @@
 //! Phase 1 of a substep: every force from the old state.
 
-use super::{Cloth, SpringKind};
+use super::{Cloth, SpringKind, pull_scale};
 use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams};
 
 impl Cloth {
@@ -86,12 +86,7 @@ impl Cloth {
         let (l, exponent) = (self.length_scale, sm.exponent);
         for i in 0..p.position.len() {
             let d = state.goals[i] - p.position[i];
-            let scale = if exponent == 1.0 {
-                1.0
-            } else {
-                (d.length() / l).max(0.05).powf(exponent - 1.0)
-            };
-            p.force[i] += d * (sm.stiffness * scale);
+            p.force[i] += d * (sm.stiffness * pull_scale(d.length(), l, exponent));
         }
     }
 
@@ -106,11 +101,7 @@ impl Cloth {
         let p = &mut self.particles;
         for i in 0..p.position.len() {
             let d = patches.targets[i] - p.position[i];
-            let scale = if exponent == 1.0 {
-                1.0
-            } else {
-                (d.length() / l).max(0.05).powf(exponent - 1.0)
-            };
+            let scale = pull_scale(d.length(), l, exponent);
             let damping = patch.particle_damping_ratio * 2.0 * (patch.stiffness * p.mass[i]).sqrt();
             p.force[i] = d * (patch.stiffness * scale) - damping * p.velocity[i];
         }

@@ -619,14 +619,10 @@ impl Cloth {
         (omega2, gamma)
     }
 
-    /// `(d/L)^(p−1)`, with `d/L` kept ≥ 0.05 so that `p < 1` stays finite at the goal.
+    /// `(d/L)^(p−1)` for this cloth's length scale (see [`pull_scale`]).
     #[inline]
     fn goal_scale(&self, d: f32, exponent: f32) -> f32 {
-        if exponent == 1.0 {
-            1.0
-        } else {
-            (d / self.length_scale).max(0.05).powf(exponent - 1.0)
-        }
+        pull_scale(d, self.length_scale, exponent)
     }
 
     /// Builds or drops the shape-matching state to match the model (only when it changes),
@@ -943,5 +939,17 @@ fn substeps_for(dt: f32, omega2: f32, gamma: f32) -> u32 {
         n.min(u32::MAX as f32) as u32
     } else {
         1
+    }
+}
+
+/// The scale `(d/L)^(p−1)` of the pull `α (d/L)^(p−1) d` toward a goal or target used by
+/// shape matching and the patch model (seed 000 §4's exponent p), with `d/L` kept ≥ 0.05
+/// so that `p < 1` stays finite at the goal.
+#[inline]
+pub(crate) fn pull_scale(d: f32, length_scale: f32, exponent: f32) -> f32 {
+    if exponent == 1.0 {
+        1.0
+    } else {
+        (d / length_scale).max(0.05).powf(exponent - 1.0)
     }
 }

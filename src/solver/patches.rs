@@ -11,7 +11,7 @@
 
 use bevy::math::{Affine3A, Vec3};
 
-use super::{Cloth, SpringKind, topology};
+use super::{Cloth, topology};
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model, PatchParams, PatchTargets, Substeps};
 use crate::shape::Pins;
@@ -311,14 +311,7 @@ impl Patches {
 
     /// Acting springs of the part lattice.
     pub fn spring_count(&self) -> usize {
-        SpringKind::ALL
-            .into_iter()
-            .filter(|&k| self.parts.stiffness(k) > 0.0)
-            .map(|k| {
-                let s = &self.parts.springs;
-                s.ranges[k as usize].clone().filter(|&i| s.alive[i]).count()
-            })
-            .sum()
+        self.parts.spring_count()
     }
 }
 
