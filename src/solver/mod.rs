@@ -409,6 +409,11 @@ impl Cloth {
             return 0;
         }
         self.prepare_model();
+        if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
+            // The lattice gets this step's parameters before its substeps are chosen.
+            patches.set_params(&self.params, &patch, 1);
+            patches.refresh_lattice_substeps(dt);
+        }
         let n = match self.params.substeps {
             crate::params::Substeps::Fixed(n) => {
                 self.under_resolved = false;
@@ -532,7 +537,7 @@ impl Cloth {
             (Model::ShapeMatching(sm), Some(state), _) => self.goal_frequency(sm, state),
             (Model::Patches(patch), _, Some(patches)) => {
                 let pull = self.pull_frequency(patch, patches);
-                let lattice = patches.parts.stable_substeps(dt);
+                let lattice = patches.lattice_substeps(dt);
                 return substeps_for(dt, pull.0, pull.1).max(lattice);
             }
             _ => self.spring_frequency(),

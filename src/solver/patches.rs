@@ -45,6 +45,9 @@ pub struct Patches {
     stencil: Vec<([u32; 4], f32, f32)>,
     /// `(part_width, part_height)` these were built for.
     pub(super) built_for: (u32, u32),
+    /// The lattice's stable substeps for (its parameters, dt): they do not depend on the
+    /// state, so a state-dependent pull (p ≠ 1) does not recompute (and allocate) them.
+    lattice_substeps: Option<(ClothParams, f32, u32)>,
 }
 
 /// The part lattice's own parameters: the cloth's springs, integrator, strain limit and
@@ -168,6 +171,7 @@ impl Patches {
             correction_weight,
             single,
             stencil,
+            lattice_substeps: None,
             built_for: (patch.part_width, patch.part_height),
         })
     }
@@ -210,6 +214,32 @@ impl Patches {
     /// True when particle `i` is a part of its own (its position is its part's centre).
     pub fn is_single(&self, i: usize) -> bool {
         self.single[i]
+    }
+
+    /// The lattice's parameters without the substep count it is handed each step.
+    fn lattice_key(&self) -> ClothParams {
+        ClothParams {
+            substeps: Substeps::Fixed(1),
+            ..*self.parts.params()
+        }
+    }
+
+    /// Computes and caches the lattice's stable substeps for `dt` if its parameters or
+    /// `dt` changed since the last time.
+    pub fn refresh_lattice_substeps(&mut self, dt: f32) {
+        let key = self.lattice_key();
+        if !matches!(self.lattice_substeps, Some((p, d, _)) if p == key && d == dt) {
+            self.lattice_substeps = Some((key, dt, self.parts.stable_substeps(dt)));
+        }
+    }
+
+    /// Stable substeps of the part lattice for a step of `dt`: the cached value when it
+    /// is current, otherwise computed now.
+    pub fn lattice_substeps(&self, dt: f32) -> u32 {
+        match self.lattice_substeps {
+            Some((p, d, n)) if p == self.lattice_key() && d == dt => n,
+            _ => self.parts.stable_substeps(dt),
+        }
     }
 
     /// Number of parts.
