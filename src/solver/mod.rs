@@ -364,23 +364,6 @@ impl Cloth {
         self.frame = frame;
     }
 
-    /// Pins particle `i` at its current position (e.g. a grabbed particle).
-    pub fn pin(&mut self, i: u32) -> Result<(), ClothError> {
-        let count = self.particles.len();
-        if i as usize >= count {
-            return Err(ClothError::PinOutOfRange { index: i, count });
-        }
-        if !self.pins.contains(&i) {
-            let x = self.particles.position[i as usize];
-            self.local_rest[i as usize] = self.frame.inverse().transform_point3(x);
-            self.pins.push(i);
-            self.pin_from.push(x);
-            self.pin_to.push(x);
-            self.particles.inv_mass[i as usize] = 0.0;
-        }
-        Ok(())
-    }
-
     // ----- the step -------------------------------------------------------------------
 
     /// Advances the cloth by `dt` seconds: [`begin_step`](Self::begin_step), that many
@@ -408,7 +391,10 @@ impl Cloth {
             self.substeps = 0;
             return 0;
         }
-        self.prepare_model();
+        // The automatic substep bound of a deformation-dependent pull needs this state's
+        // goals or targets; otherwise the substeps compute their own.
+        let auto = matches!(self.params.substeps, crate::params::Substeps::Auto { .. });
+        self.prepare_model(auto && self.state_dependent_stiffness());
         if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
             // The lattice gets this step's parameters before its substeps are chosen.
             patches.set_params(&self.params, &patch, 1);
@@ -630,18 +616,19 @@ impl Cloth {
         pull_scale(d, self.length_scale, exponent)
     }
 
-    /// Builds or drops the shape-matching state to match the model (only when it changes),
-    /// and computes the goals of the current state.
-    fn prepare_model(&mut self) {
+    /// Builds or drops the model state (shape-matching clusters, patch lattice) when the
+    /// model changes. Goals or targets of the current state are computed when `compute`
+    /// asks for them or the state was just built; the substeps compute their own.
+    fn prepare_model(&mut self, compute: bool) {
         match self.params.model {
             Model::ShapeMatching(sm) => {
                 self.patches = None;
                 let k = sm.clusters;
-                if self
+                let built = self
                     .shape_matching
                     .as_ref()
-                    .is_none_or(|s| s.built_for != k)
-                {
+                    .is_none_or(|s| s.built_for != k);
+                if built {
                     self.shape_matching = Some(ShapeMatching::new(
                         &self.local_rest,
                         &self.particles.mass,
@@ -649,16 +636,17 @@ impl Cloth {
                         k,
                     ));
                 }
-                if let Some(state) = &mut self.shape_matching {
+                if let Some(state) = &mut self.shape_matching
+                    && (compute || built)
+                {
                     state.compute_goals(&self.particles.position, &self.particles.mass, &sm);
                 }
             }
             Model::Patches(patch) => {
                 self.shape_matching = None;
                 let size = (patch.part_width, patch.part_height);
-                if self.patches.as_ref().is_none_or(|p| p.built_for != size)
-                    && let Some(grid) = self.grid
-                {
+                let built = self.patches.as_ref().is_none_or(|p| p.built_for != size);
+                if built && let Some(grid) = self.grid {
                     self.patches = Patches::new(
                         &self.local_rest,
                         grid,
@@ -686,7 +674,9 @@ impl Cloth {
                         }
                         None => patches.parts.release_grab(),
                     }
-                    patches.compute_targets(&self.particles.position, &patch);
+                    if compute || built {
+                        patches.compute_targets(&self.particles.position, &patch);
+                    }
                 }
             }
             Model::MassSpring => {
@@ -713,7 +703,7 @@ impl Cloth {
 
     /// Computes the shape-matching goals of the current positions now (outside a step).
     pub fn update_goals(&mut self) {
-        self.prepare_model();
+        self.prepare_model(true);
     }
 
     /// The acting stiffness of a spring kind under the current parameters (0 for every
