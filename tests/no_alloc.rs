@@ -37,15 +37,29 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static GLOBAL: Counting = Counting;
 
+/// A 16×16 cloth of 5 cm, pinned at its top corners.
+fn grid_cloth(params: &ClothParams) -> Solver {
+    let shape = ClothShape::Grid {
+        width: 16,
+        height: 16,
+        spacing: 0.05,
+    };
+    Solver::new(&shape, &Pins::TopCorners, params, Affine3A::IDENTITY).unwrap()
+}
+
+/// Allocations this thread makes while running `f`.
+fn allocations_during(f: impl FnOnce()) -> usize {
+    let before = allocations();
+    f();
+    allocations() - before
+}
+
 #[test]
 fn the_counter_sees_this_threads_allocations() {
-    let before = allocations();
-    let v: Vec<u64> = std::hint::black_box(Vec::with_capacity(16));
-    assert!(
-        allocations() > before,
-        "the counting allocator counted nothing"
-    );
-    drop(v);
+    let counted = allocations_during(|| {
+        std::hint::black_box(Vec::<u64>::with_capacity(16));
+    });
+    assert!(counted > 0, "the counting allocator counted nothing");
 }
 
 #[test]
@@ -58,17 +72,7 @@ fn steps_allocate_nothing() {
         },
         ..ClothParams::default()
     };
-    let mut cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 16,
-            height: 16,
-            spacing: 0.05,
-        },
-        &Pins::TopCorners,
-        &params,
-        Affine3A::IDENTITY,
-    )
-    .unwrap();
+    let mut cloth = grid_cloth(&params);
     let env = Environment {
         wind: Wind {
             direction: Vec3::Z,
@@ -79,25 +83,20 @@ fn steps_allocate_nothing() {
     };
     let mut normals = vec![Vec3::ZERO; cloth.particle_count()];
     cloth.step(0.016, &env); // warm-up: automatic substeps are computed and cached
-    let before = allocations();
-    for _ in 0..100 {
-        cloth.step(0.016, &env);
-        cloth.normals_into(&mut normals);
-        std::hint::black_box(cloth.energy(&env));
-        std::hint::black_box(cloth.strain());
-    }
-    let after = allocations();
+    let allocated = allocations_during(|| {
+        for _ in 0..100 {
+            cloth.step(0.016, &env);
+            cloth.normals_into(&mut normals);
+            std::hint::black_box(cloth.energy(&env));
+            std::hint::black_box(cloth.strain());
+        }
+    });
     assert!(cloth.substeps() > 1);
     assert!(
         cloth.torn_count() > 0,
         "tearing is part of the step under test"
     );
-    assert_eq!(
-        after - before,
-        0,
-        "{} allocations in 100 steps",
-        after - before
-    );
+    assert_eq!(allocated, 0, "{allocated} allocations in 100 steps");
 }
 
 #[test]
@@ -106,32 +105,17 @@ fn patch_steps_allocate_nothing_even_with_a_state_dependent_pull() {
         exponent: 2.0,
         ..PatchParams::default()
     });
-    let mut cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 16,
-            height: 16,
-            spacing: 0.05,
-        },
-        &Pins::TopCorners,
-        &ClothParams {
-            model,
-            ..ClothParams::default()
-        },
-        Affine3A::IDENTITY,
-    )
-    .unwrap();
+    let mut cloth = grid_cloth(&ClothParams {
+        model,
+        ..ClothParams::default()
+    });
     let env = Environment::default();
     cloth.step(0.016, &env); // warm-up: the patch lattice is built on the first step
-    let before = allocations();
-    for _ in 0..50 {
-        cloth.step(0.016, &env);
-    }
-    let after = allocations();
+    let allocated = allocations_during(|| {
+        for _ in 0..50 {
+            cloth.step(0.016, &env);
+        }
+    });
     assert!(cloth.patches().is_some());
-    assert_eq!(
-        after - before,
-        0,
-        "{} allocations in 50 patch steps",
-        after - before
-    );
+    assert_eq!(allocated, 0, "{allocated} allocations in 50 patch steps");
 }

@@ -540,22 +540,33 @@ impl Cloth {
         }
     }
 
-    /// `(ω², γ)` of the patch model's pull toward the targets (as `goal_frequency`), with
-    /// its damping at `ratio · 2√(α m)`.
+    /// `(ω², γ)` of the patch model's pull toward the targets, damped at
+    /// `ratio · 2√(α m)`.
     fn pull_frequency(&self, patch: &PatchParams, patches: &Patches) -> (f32, f32) {
-        let (mut omega2, mut gamma) = (0.0f32, 0.0f32);
-        let p = &self.particles;
-        for i in 0..p.len() {
-            let w = p.inv_mass[i];
-            if w == 0.0 {
-                continue;
-            }
-            let d = patches.targets[i].distance(p.position[i]);
-            let k = patch.exponent * patch.stiffness * self.goal_scale(d, patch.exponent);
-            omega2 = omega2.max(2.0 * k * w);
-            gamma = gamma.max(patch.particle_damping_ratio * 2.0 * (patch.stiffness * w).sqrt());
-        }
+        let omega2 = self.pull_omega2(&patches.targets, patch.stiffness, patch.exponent);
+        let gamma = patch.particle_damping_ratio
+            * 2.0
+            * (patch.stiffness * self.max_free_inv_mass()).sqrt();
         (omega2, gamma)
+    }
+
+    /// ω² bound of a pull `α (d/L)^(p−1) d` toward `targets`: its stiffness along `d` is
+    /// `p α (d/L)^(p−1)`; the target moves with the particle (centre of mass, rotation,
+    /// interpolation), bounded by a factor 2. Over the free particles.
+    fn pull_omega2(&self, targets: &[Vec3], stiffness: f32, exponent: f32) -> f32 {
+        let p = &self.particles;
+        (0..p.len())
+            .filter(|&i| p.inv_mass[i] > 0.0)
+            .map(|i| {
+                let d = targets[i].distance(p.position[i]);
+                2.0 * exponent * stiffness * self.goal_scale(d, exponent) * p.inv_mass[i]
+            })
+            .fold(0.0, f32::max)
+    }
+
+    /// The largest inverse mass of a free particle.
+    fn max_free_inv_mass(&self) -> f32 {
+        self.particles.inv_mass.iter().copied().fold(0.0, f32::max)
     }
 
     /// Gershgorin bounds `(ω_max², γ_max)` of the spring lattice.
@@ -588,26 +599,18 @@ impl Cloth {
         (omega2, gamma)
     }
 
-    /// `(ω_max², γ_max)` of the goal forces at the current deformation: the force
-    /// `α (d/L)^(p−1) d` has stiffness `p α (d/L)^(p−1)` along `d`; the goal itself moves
-    /// with the particle through the centre of mass and rotation, bounded by a factor 2.
-    /// Müller's velocity update cannot overshoot: only drag and damping bound its step.
+    /// `(ω_max², γ_max)` of shape matching's goal force at the current deformation (see
+    /// `pull_omega2`). Müller's velocity update cannot overshoot: only drag and damping
+    /// bound its step.
     fn goal_frequency(&self, sm: &ShapeMatchingParams, state: &ShapeMatching) -> (f32, f32) {
-        let (mut omega2, mut gamma) = (0.0f32, 0.0f32);
-        let p = &self.particles;
-        for i in 0..p.len() {
-            let w = p.inv_mass[i];
-            if w == 0.0 {
-                continue;
-            }
-            if sm.update == GoalUpdate::Force {
-                let d = state.goals[i].distance(p.position[i]);
-                let k = sm.exponent * sm.stiffness * self.goal_scale(d, sm.exponent);
-                omega2 = omega2.max(2.0 * k * w);
-            }
-            gamma = gamma.max((sm.damping + self.params.drag) * w);
-        }
-        (omega2, gamma)
+        let omega2 = match sm.update {
+            GoalUpdate::Force => self.pull_omega2(&state.goals, sm.stiffness, sm.exponent),
+            GoalUpdate::Velocity => 0.0,
+        };
+        (
+            omega2,
+            (sm.damping + self.params.drag) * self.max_free_inv_mass(),
+        )
     }
 
     /// `(d/L)^(p−1)` for this cloth's length scale (see [`pull_scale`]).
