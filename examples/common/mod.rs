@@ -195,6 +195,8 @@ pub fn spawn_stage(
             radius: Some(radius),
             yaw: Some(0.35),
             pitch: Some(0.12),
+            // Right-drag cuts the cloth (see tools.rs), so panning takes the middle button.
+            button_pan: MouseButton::Middle,
             ..default()
         },
         Transform::from_translation(focus + Vec3::new(0.0, 0.0, radius)),

@@ -71,7 +71,6 @@ fn mouse_tools(
         .ctx_mut()
         .is_ok_and(|ctx| ctx.egui_wants_pointer_input() || ctx.is_pointer_over_egui());
     let (cam, cam_transform, orbit) = &mut *camera;
-    orbit.button_pan = MouseButton::Middle;
     let ray = window
         .cursor_position()
         .and_then(|cursor| cam.viewport_to_world(cam_transform, cursor).ok());
