@@ -5,6 +5,7 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
+use crate::garment::{GarmentLayout, asset_path};
 use crate::params::{ClothParams, Environment};
 use crate::shape::{ClothShape, Pins};
 use crate::solver;
@@ -76,10 +77,201 @@ impl Cloth {
         self.params.validate()
     }
 
-    /// Builds the solver for this cloth placed by `frame` (grid shapes only; mesh shapes
-    /// are built by the plugin from the entity's mesh).
+    /// A garment from a garment file under `assets/` (see [`crate::garment`]), at
+    /// resolution 1, pinned nowhere.
+    pub fn garment(file: impl Into<String>) -> Self {
+        Self {
+            shape: ClothShape::Garment {
+                file: file.into(),
+                resolution: 1,
+            },
+            pins: Pins::None,
+            ..default()
+        }
+    }
+
+    /// Builds the solver for this cloth placed by `frame`: grids directly, garments from
+    /// their files (logging pattern warnings). Mesh shapes are built by the plugin from
+    /// the entity's mesh.
     pub fn build(&self, frame: bevy::math::Affine3A) -> Result<solver::Cloth, ClothError> {
-        solver::Cloth::new(&self.shape, &self.pins, &self.params, frame)
+        match &self.shape {
+            ClothShape::Garment { file, resolution } => {
+                let layout = GarmentLayout::load(&asset_path(file), *resolution)?;
+                for warning in &layout.warnings {
+                    warn!("{warning}");
+                }
+                solver::Cloth::from_garment(&layout, &self.pins, &self.params, frame)
+            }
+            _ => solver::Cloth::new(&self.shape, &self.pins, &self.params, frame),
+        }
+    }
+}
+
+/// A solid the cloths are kept out of, placed by its entity's transform: spheres,
+/// capsules and planes with a thickness and friction. Every cloth collides with every
+/// collider, every substep.
+///
+/// ```
+/// use bevy::prelude::*;
+/// use bevy_cloth::prelude::*;
+/// # let mut world = World::new();
+/// world.spawn((ClothCollider::sphere(0.3), Transform::from_xyz(0.0, 1.0, 0.0)));
+/// world.spawn(ClothCollider::plane().with_friction(0.8)); // the ground, y = 0
+/// ```
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[reflect(Component, Default)]
+#[require(Transform)]
+#[serde(default, deny_unknown_fields)]
+pub struct ClothCollider {
+    /// The solid, in the entity's local frame.
+    pub shape: ColliderKind,
+    /// How far outside the surface particles stay, m.
+    pub thickness: f32,
+    /// Coulomb friction coefficient (0 = ice; a particle sticks on a slope while
+    /// tan θ ≤ friction).
+    pub friction: f32,
+}
+
+/// The solid of a [`ClothCollider`], in its entity's local frame (the same conventions as
+/// Bevy's `Sphere`, `Capsule3d` and `Plane3d` meshes).
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+pub enum ColliderKind {
+    /// A ball about the origin.
+    Sphere {
+        /// Radius, m.
+        radius: f32,
+    },
+    /// A capsule along local y: all points within `radius` of the segment from
+    /// `(0, −half_length, 0)` to `(0, half_length, 0)`.
+    Capsule {
+        /// Radius, m.
+        radius: f32,
+        /// Half the length of the axis segment (without the caps), m.
+        half_length: f32,
+    },
+    /// The half-space below the local xz plane (normal +y): a ground or a wall.
+    Plane,
+}
+
+impl Default for ClothCollider {
+    fn default() -> Self {
+        Self::plane()
+    }
+}
+
+impl ClothCollider {
+    fn new(shape: ColliderKind) -> Self {
+        Self {
+            shape,
+            thickness: 0.005,
+            friction: 0.3,
+        }
+    }
+
+    /// A sphere of `radius` m.
+    pub fn sphere(radius: f32) -> Self {
+        Self::new(ColliderKind::Sphere { radius })
+    }
+
+    /// A capsule along local y of `radius` m and axis length `2·half_length` m.
+    pub fn capsule(radius: f32, half_length: f32) -> Self {
+        Self::new(ColliderKind::Capsule {
+            radius,
+            half_length,
+        })
+    }
+
+    /// A plane through the origin with normal +y.
+    pub fn plane() -> Self {
+        Self::new(ColliderKind::Plane)
+    }
+
+    /// Replaces the thickness (m).
+    pub fn with_thickness(mut self, thickness: f32) -> Self {
+        self.thickness = thickness;
+        self
+    }
+
+    /// Replaces the friction coefficient.
+    pub fn with_friction(mut self, friction: f32) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// Checks sizes: radii and half-lengths > 0 (half-length ≥ 0), thickness and friction
+    /// ≥ 0, all finite.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        let check = |field, value: f32, ok: bool, expected| {
+            if ok && value.is_finite() {
+                Ok(())
+            } else {
+                Err(ClothError::InvalidParameter {
+                    field,
+                    value,
+                    expected,
+                })
+            }
+        };
+        match self.shape {
+            ColliderKind::Sphere { radius } => {
+                check("radius", radius, radius > 0.0, "a radius > 0 m")?
+            }
+            ColliderKind::Capsule {
+                radius,
+                half_length,
+            } => {
+                check("radius", radius, radius > 0.0, "a radius > 0 m")?;
+                check(
+                    "half_length",
+                    half_length,
+                    half_length >= 0.0,
+                    "a half-length ≥ 0 m",
+                )?;
+            }
+            ColliderKind::Plane => {}
+        }
+        check(
+            "thickness",
+            self.thickness,
+            self.thickness >= 0.0,
+            "a thickness ≥ 0 m",
+        )?;
+        check(
+            "friction",
+            self.friction,
+            self.friction >= 0.0,
+            "a friction coefficient ≥ 0",
+        )
+    }
+
+    /// The collider in world space under `transform` (radii scale with the largest scale
+    /// factor). Negative sizes count as 0.
+    pub fn to_world(&self, transform: &GlobalTransform) -> solver::Collider {
+        use solver::ColliderShape;
+        let scale = transform.scale().abs().max_element();
+        let shape = match self.shape {
+            ColliderKind::Sphere { radius } => ColliderShape::Sphere {
+                center: transform.translation(),
+                radius: radius.max(0.0) * scale,
+            },
+            ColliderKind::Capsule {
+                radius,
+                half_length,
+            } => ColliderShape::Capsule {
+                a: transform.transform_point(Vec3::new(0.0, -half_length.max(0.0), 0.0)),
+                b: transform.transform_point(Vec3::new(0.0, half_length.max(0.0), 0.0)),
+                radius: radius.max(0.0) * scale,
+            },
+            ColliderKind::Plane => ColliderShape::Plane {
+                point: transform.translation(),
+                normal: transform.rotation() * Vec3::Y,
+            },
+        };
+        solver::Collider {
+            shape,
+            thickness: self.thickness.max(0.0),
+            friction: self.friction.max(0.0),
+        }
     }
 }
 

@@ -47,4 +47,19 @@ pub enum ClothError {
         /// What is missing.
         reason: String,
     },
+    /// A pattern file is malformed (names the file, line and column).
+    #[error("{0}")]
+    Pattern(#[from] crate::pattern::PatternError),
+    /// A garment file is malformed, or its pieces and seams do not fit together.
+    #[error("{file}:{line}:{column}: {message}")]
+    Garment {
+        /// The garment file.
+        file: String,
+        /// 1-based line (of the piece or seam at fault, when known).
+        line: usize,
+        /// 1-based column.
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
 }

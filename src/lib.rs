@@ -35,8 +35,10 @@
 pub mod components;
 pub mod controls;
 pub mod error;
+pub mod garment;
 pub mod mesh;
 pub mod params;
+pub mod pattern;
 pub mod plugin;
 pub mod scene;
 pub mod shape;
@@ -45,8 +47,8 @@ pub mod solver;
 /// The types a user needs to add cloth to an app.
 pub mod prelude {
     pub use crate::components::{
-        Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats, ClothTorn,
-        StatSample,
+        Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation,
+        ClothStats, ClothTorn, ColliderKind, StatSample,
     };
     pub use crate::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::error::ClothError;
@@ -55,6 +57,6 @@ pub mod prelude {
         RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
     };
     pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSystems};
-    pub use crate::scene::{ClothScene, SceneCloth, SceneError};
+    pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError};
     pub use crate::shape::{ClothShape, Pins};
 }

@@ -83,6 +83,15 @@ pub struct SpringParams {
     pub bend_diagonal: SpringFamily,
     /// Damping along each spring in N·s/m: `F = c ((v_b − v_a)·d̂) d̂`.
     pub damping: f32,
+    /// Seam springs joining garment pieces (seed 002 §1.4).
+    pub seam: SpringFamily,
+    /// The length a seam spring is sewn to, m (0: the two edges meet).
+    pub seam_rest_length: f32,
+    /// Seconds over which seams are sewn: a seam spring's rest length shrinks linearly
+    /// from the gap it starts with to `seam_rest_length`, as a tailor pulls the edges
+    /// together (0 sews at once). Meanwhile the garment is held: gravity and wind act on
+    /// it from the end of sewing.
+    pub sew_time: f32,
 }
 
 impl Default for SpringParams {
@@ -104,6 +113,9 @@ impl SpringParams {
             bend: SpringFamily::new(stiffness * 0.5),
             bend_diagonal: SpringFamily::off(stiffness * 0.25),
             damping: 0.0,
+            seam: SpringFamily::new(stiffness),
+            seam_rest_length: 0.0,
+            sew_time: 1.0,
         }
     }
 }
@@ -442,6 +454,7 @@ impl ClothParams {
             ("springs.shear.stiffness", s.shear),
             ("springs.bend.stiffness", s.bend),
             ("springs.bend_diagonal.stiffness", s.bend_diagonal),
+            ("springs.seam.stiffness", s.seam),
         ] {
             check(
                 field,
@@ -455,6 +468,18 @@ impl ClothParams {
             s.damping,
             s.damping >= 0.0,
             "a damping ≥ 0 N·s/m",
+        )?;
+        check(
+            "springs.seam_rest_length",
+            s.seam_rest_length,
+            s.seam_rest_length >= 0.0,
+            "a length ≥ 0 m",
+        )?;
+        check(
+            "springs.sew_time",
+            s.sew_time,
+            s.sew_time >= 0.0,
+            "a time ≥ 0 s",
         )?;
         check("drag", self.drag, self.drag >= 0.0, "a drag ≥ 0 N·s/m")?;
         match self.substeps {

@@ -25,7 +25,8 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
 use crate::components::{
-    Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats, ClothTorn,
+    Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats,
+    ClothTorn,
 };
 use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::params::{
@@ -122,6 +123,8 @@ impl Plugin for ClothPlugin {
         app.register_type::<Cloth>()
             .register_type::<ClothShape>()
             .register_type::<Pins>()
+            .register_type::<ClothCollider>()
+            .register_type::<crate::components::ColliderKind>()
             .register_type::<ClothParams>()
             .register_type::<SpringParams>()
             .register_type::<SpringFamily>()
@@ -174,7 +177,7 @@ impl Plugin for ClothPlugin {
         .add_systems(
             self.schedule,
             (
-                (build_cloths, begin_steps)
+                (build_cloths, place_colliders, begin_steps)
                     .chain()
                     .in_set(ClothSystems::Prepare),
                 run_substeps.in_set(ClothSystems::Substeps),
@@ -190,8 +193,8 @@ impl Plugin for ClothPlugin {
     }
 }
 
-/// Builds a cloth's solver and mesh: a grid from its description, a mesh shape from the
-/// entity's (or the remembered source) mesh. `Ok(None)`: the source mesh is not loaded yet.
+/// Builds a cloth's solver and mesh: a grid or garment from its description, a mesh shape
+/// from the entity's (or the remembered source) mesh. `Ok(None)`: the source mesh is not loaded yet.
 fn build_one(
     cloth: &Cloth,
     frame: bevy::math::Affine3A,
@@ -199,7 +202,7 @@ fn build_one(
 ) -> Result<Option<(solver::Cloth, Mesh)>, crate::error::ClothError> {
     cloth.validate()?;
     match cloth.shape {
-        ClothShape::Grid { .. } => {
+        ClothShape::Grid { .. } | ClothShape::Garment { .. } => {
             let solver = cloth.build(frame)?;
             let mesh = cloth_mesh(&solver, None);
             Ok(Some((solver, mesh)))
@@ -273,7 +276,7 @@ fn build_cloths(
         }
         let source_handle = match cloth.shape {
             ClothShape::Mesh => source.map(|s| s.0.clone()).or(mesh3d.map(|m| m.0.clone())),
-            ClothShape::Grid { .. } => None,
+            ClothShape::Grid { .. } | ClothShape::Garment { .. } => None,
         };
         let source_mesh = source_handle.as_ref().and_then(|h| meshes.get(h));
         match build_one(&cloth, frame, source_mesh) {
@@ -297,6 +300,24 @@ fn build_cloths(
                     .remove::<ClothSimulation>();
             }
         }
+    }
+}
+
+/// Gives every cloth the colliders where their entities are now.
+fn place_colliders(
+    transforms: TransformHelper,
+    colliders: Query<(Entity, &ClothCollider)>,
+    mut cloths: Query<&mut ClothSimulation>,
+) {
+    if colliders.is_empty() && cloths.iter().all(|sim| sim.solver.colliders().is_empty()) {
+        return;
+    }
+    for mut sim in &mut cloths {
+        sim.solver
+            .set_colliders(colliders.iter().filter_map(|(entity, collider)| {
+                let transform = transforms.compute_global_transform(entity).ok()?;
+                Some(collider.to_world(&transform))
+            }));
     }
 }
 

@@ -18,7 +18,7 @@ use bevy::reflect::{GetPath, Reflect};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::components::Cloth;
+use crate::components::{Cloth, ClothCollider};
 use crate::params::Environment;
 
 /// A scene: the cloths, their world and the timestep.
@@ -33,6 +33,39 @@ pub struct ClothScene {
     pub environment: Environment,
     /// The cloths.
     pub cloths: Vec<SceneCloth>,
+    /// Solids the cloths are kept out of (a mannequin, a ground).
+    #[serde(default)]
+    pub colliders: Vec<SceneCollider>,
+}
+
+/// A collider in a scene, with where it is and whether it is drawn.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneCollider {
+    /// A name for the entity.
+    #[serde(default)]
+    pub name: String,
+    /// Where its origin is.
+    #[serde(default, with = "crate::params::vec3_serde")]
+    pub translation: Vec3,
+    /// Rotation as Euler angles X, Y, Z in degrees (applied in that order).
+    #[serde(default, with = "crate::params::vec3_serde")]
+    pub rotation_degrees: Vec3,
+    /// The solid, its thickness and friction.
+    pub collider: ClothCollider,
+    /// Colour to draw it in (linear RGB 0–1); not drawn when absent.
+    #[serde(default)]
+    pub color: Option<[f32; 3]>,
+}
+
+impl SceneCollider {
+    /// The entity's transform.
+    pub fn transform(&self) -> bevy::transform::components::Transform {
+        let r = self.rotation_degrees * (std::f32::consts::PI / 180.0);
+        bevy::transform::components::Transform::from_translation(self.translation).with_rotation(
+            bevy::math::Quat::from_euler(bevy::math::EulerRot::XYZ, r.x, r.y, r.z),
+        )
+    }
 }
 
 fn default_timestep() -> f32 {
@@ -57,6 +90,10 @@ pub struct SceneCloth {
     /// Base colour as linear RGB in 0–1.
     #[serde(default = "default_color")]
     pub color: [f32; 3],
+    /// Colours of a garment's pieces in order (front, back, …); pieces past the list take
+    /// `color`.
+    #[serde(default)]
+    pub piece_colors: Vec<[f32; 3]>,
 }
 
 fn default_color() -> [f32; 3] {
@@ -217,6 +254,24 @@ impl ClothScene {
                 .get(search_from..)
                 .and_then(|rest| rest.find("cloth:"))
                 .map_or(search_from, |o| search_from + o);
+            let garment = match &entry.cloth.shape {
+                crate::shape::ClothShape::Garment { file, resolution } => {
+                    crate::garment::GarmentLayout::load(
+                        &crate::garment::asset_path(file),
+                        *resolution,
+                    )
+                    .err()
+                }
+                _ => None,
+            };
+            if let Some(e) = garment {
+                return Err(invalid(
+                    format!("cloths[{i}].cloth.shape"),
+                    "Garment",
+                    e.to_string(),
+                    entry_start,
+                ));
+            }
             if let Err(e) = entry.cloth.validate() {
                 let field = error_field(&e);
                 let path = if field.starts_with("shape") || field == "pins" {
@@ -227,6 +282,17 @@ impl ClothScene {
                 return Err(invalid(path, leaf(field), e.to_string(), entry_start));
             }
             search_from = entry_start + 1;
+        }
+        for (i, entry) in self.colliders.iter().enumerate() {
+            if let Err(e) = entry.collider.validate() {
+                let field = error_field(&e);
+                return Err(invalid(
+                    format!("colliders[{i}].collider.{field}"),
+                    leaf(field),
+                    e.to_string(),
+                    text.find("colliders").unwrap_or(0),
+                ));
+            }
         }
         Ok(())
     }
@@ -320,7 +386,7 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         InvalidParameter { field, .. } => field,
         GridTooSmall { .. } | GridTooLarge { .. } => "shape",
         PinOutOfRange { .. } => "pins",
-        BadMesh { .. } => "shape",
+        BadMesh { .. } | Pattern(_) | Garment { .. } => "shape",
     }
 }
 

@@ -26,6 +26,14 @@ pub enum ClothShape {
     /// particle, each edge a structural spring, and the two far corners of each pair of
     /// triangles sharing an edge a bend spring.
     Mesh,
+    /// A garment: 0/1 pattern pieces stitched by seams (seed 002 §1.4), from a garment file
+    /// (see [`crate::garment`]); the local origin is the garment file's origin.
+    Garment {
+        /// The garment file, relative to the `assets` folder (or absolute).
+        file: String,
+        /// 1 = the patterns as drawn; n = the same outline on an n-times finer grid.
+        resolution: u32,
+    },
 }
 
 impl Default for ClothShape {
@@ -64,6 +72,15 @@ impl ClothShape {
                     expected: "a positive distance in m",
                 });
             }
+        }
+        if let ClothShape::Garment { resolution, .. } = *self
+            && !(1..=64).contains(&resolution)
+        {
+            return Err(ClothError::InvalidParameter {
+                field: "shape.resolution",
+                value: resolution as f32,
+                expected: "a resolution of 1 to 64",
+            });
         }
         Ok(())
     }

@@ -13,7 +13,8 @@ fn no_springs() -> SpringParams {
         shear: SpringFamily::off(50.0),
         bend: SpringFamily::off(50.0),
         bend_diagonal: SpringFamily::off(25.0),
-        damping: 0.0,
+        seam: SpringFamily::off(100.0),
+        ..SpringParams::default()
     }
 }
 

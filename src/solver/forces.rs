@@ -13,11 +13,19 @@ impl Cloth {
             self.pull_forces(env, &patch);
             return;
         }
-        let g = env.effective_gravity();
+        // While its seams are being sewn, a garment is held as a tailor holds it: gravity
+        // and wind act once the seams are closed (otherwise the pieces would fall past the
+        // body in the time it takes to sew them).
+        let held = self.sewing();
+        let g = if held {
+            bevy::math::Vec3::ZERO
+        } else {
+            env.effective_gravity()
+        };
         let drag = self.params.drag;
         let time = self.time;
         let wind = env.wind;
-        let has_wind = wind.strength > 0.0 && wind.direction != bevy::math::Vec3::ZERO;
+        let has_wind = !held && wind.strength > 0.0 && wind.direction != bevy::math::Vec3::ZERO;
         let p = &mut self.particles;
         for i in 0..p.position.len() {
             let mut f = p.mass[i] * g - drag * p.lump[i] * p.velocity[i];

@@ -87,8 +87,8 @@ impl Cloth {
         }
     }
 
-    /// Moves pinned particles along their path and applies Provot's strain limit; then
-    /// advances the clock by one substep.
+    /// Moves pinned particles along their path, applies Provot's strain limit and keeps
+    /// particles out of the colliders; then advances the clock by one substep.
     pub fn constrain(&mut self) {
         self.substep_index += 1;
         let t = self.substep_index as f32 / self.substeps.max(1) as f32;
@@ -112,6 +112,8 @@ impl Cloth {
         if let (Some(limit), Model::MassSpring) = (self.params.strain_limit, self.params.model) {
             self.limit_strain(limit, h);
         }
+        // Last, so no later correction pushes a particle back into a collider.
+        self.collide();
         self.time += h;
     }
 

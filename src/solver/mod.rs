@@ -11,6 +11,7 @@
 //!
 //! After the substeps, [`Cloth::end_step`] tears over-stretched springs.
 
+mod collide;
 mod forces;
 mod integrate;
 mod interact;
@@ -19,6 +20,7 @@ pub mod shape_matching;
 mod state;
 pub mod topology;
 
+pub use collide::{Collider, ColliderShape};
 pub use interact::Grab;
 pub use state::Particles;
 pub use topology::{SpringKind, Springs};
@@ -26,6 +28,7 @@ pub use topology::{SpringKind, Springs};
 use bevy::math::{Affine3A, Vec3};
 
 use crate::error::ClothError;
+use crate::garment::GarmentLayout;
 use crate::params::{
     ClothParams, Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams,
 };
@@ -99,6 +102,12 @@ pub struct Cloth {
     /// The cloth's characteristic length L (mean structural rest length), for the
     /// shape-matching force law.
     length_scale: f32,
+    /// Particle ranges of garment pieces (one range for other cloths).
+    pieces: Vec<std::ops::Range<u32>>,
+    /// The length each seam spring starts at, before sewing.
+    seam_start: Vec<f32>,
+    /// Colliders in world space the particles are kept out of (see `collide.rs`).
+    colliders: Vec<Collider>,
 }
 
 impl Cloth {
@@ -140,7 +149,36 @@ impl Cloth {
             ClothShape::Mesh => Err(ClothError::BadMesh {
                 reason: "a mesh-shaped cloth is built with `Cloth::from_mesh`".into(),
             }),
+            ClothShape::Garment { .. } => Err(ClothError::BadMesh {
+                reason: "a garment is built with `Cloth::from_garment`".into(),
+            }),
         }
+    }
+
+    /// Builds a garment: its pieces' particles, springs and triangles, and seam springs
+    /// that sew the pieces together over `springs.sew_time` (seed 002 §1.4).
+    pub fn from_garment(
+        layout: &GarmentLayout,
+        pins: &Pins,
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        if layout.positions.is_empty() || layout.triangles.is_empty() {
+            return Err(ClothError::BadMesh {
+                reason: "the garment has no faces".into(),
+            });
+        }
+        let mut cloth = Self::build(
+            layout.positions.clone(),
+            layout.springs.clone(),
+            layout.triangles.clone(),
+            None,
+            pins,
+            params,
+            frame,
+        )?;
+        cloth.pieces = layout.pieces.iter().map(|(_, r)| r.clone()).collect();
+        Ok(cloth)
     }
 
     /// Builds a cloth from a triangle mesh: vertices become particles, edges structural
@@ -278,7 +316,12 @@ impl Cloth {
             shape_matching: None,
             patches: None,
             length_scale: 1.0,
+            pieces: vec![0..n as u32],
+            seam_start: Vec::new(),
+            colliders: Vec::new(),
         };
+        let seams = cloth.springs.ranges[SpringKind::Seam as usize].clone();
+        cloth.seam_start = cloth.springs.rest_length[seams].to_vec();
         let structural = cloth.springs.ranges[SpringKind::Structural as usize].clone();
         if !structural.is_empty() {
             cloth.length_scale = cloth.springs.rest_length[structural.clone()]
@@ -395,6 +438,7 @@ impl Cloth {
         // goals or targets; otherwise the substeps compute their own.
         let auto = matches!(self.params.substeps, crate::params::Substeps::Auto { .. });
         self.prepare_model(auto && self.state_dependent_stiffness());
+        self.sew();
         if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
             // The lattice gets this step's parameters before its substeps are chosen.
             patches.set_params(&self.params, &patch, 1);
@@ -446,6 +490,31 @@ impl Cloth {
         n
     }
 
+    /// Seam springs shrink from their starting gap to `seam_rest_length` over `sew_time`
+    /// seconds of simulated time (a tailor sewing the pieces together).
+    fn sew(&mut self) {
+        let s = &self.params.springs;
+        let progress = if s.sew_time > 0.0 {
+            (self.time / s.sew_time).min(1.0)
+        } else {
+            1.0
+        };
+        let seams = self.springs.ranges[SpringKind::Seam as usize].clone();
+        for (rest, &start) in self.springs.rest_length[seams]
+            .iter_mut()
+            .zip(&self.seam_start)
+        {
+            *rest = start + (s.seam_rest_length - start) * progress;
+        }
+    }
+
+    /// True while the seams of a garment are still being sewn (see `sew_time`).
+    pub fn sewing(&self) -> bool {
+        !self.seam_start.is_empty()
+            && self.time < self.params.springs.sew_time
+            && self.params.springs.seam.effective() > 0.0
+    }
+
     /// Finishes a step: springs stretched past the tear ratio break and hide the faces
     /// they border (seed 000 §3.2). Returns the springs torn in this step.
     pub fn end_step(&mut self) -> &[u32] {
@@ -471,7 +540,8 @@ impl Cloth {
         if let (Some(ratio), Model::MassSpring) = (self.params.tear_ratio, self.params.model) {
             let x = &self.particles.position;
             let s = &mut self.springs;
-            for k in 0..s.len() {
+            // Seams are sewn to a rest length of 0 and do not tear.
+            for k in 0..s.ranges[SpringKind::Seam as usize].start {
                 if s.alive[k]
                     && x[s.a[k] as usize].distance_squared(x[s.b[k] as usize])
                         > (ratio * s.rest_length[k]).powi(2)
@@ -721,6 +791,7 @@ impl Cloth {
             SpringKind::Shear => s.shear.effective(),
             SpringKind::Bend => s.bend.effective(),
             SpringKind::BendDiagonal => s.bend_diagonal.effective(),
+            SpringKind::Seam => s.seam.effective(),
         }
     }
 
@@ -769,6 +840,24 @@ impl Cloth {
     /// The indices of the pinned particles.
     pub fn pins(&self) -> &[u32] {
         &self.pins
+    }
+
+    /// The particle range of each garment piece (one range holding every particle for
+    /// other cloths).
+    pub fn pieces(&self) -> &[std::ops::Range<u32>] {
+        &self.pieces
+    }
+
+    /// Replaces the colliders the particles are kept out of (world space); reuses its
+    /// storage, so calling it every step allocates nothing once it has grown.
+    pub fn set_colliders(&mut self, colliders: impl IntoIterator<Item = Collider>) {
+        self.colliders.clear();
+        self.colliders.extend(colliders);
+    }
+
+    /// The colliders in use.
+    pub fn colliders(&self) -> &[Collider] {
+        &self.colliders
     }
 
     /// `(width, height)` for a grid cloth.

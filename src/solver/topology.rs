@@ -16,15 +16,19 @@ pub enum SpringKind {
     Bend = 2,
     /// Every second particle along diagonals: optional extra bending resistance.
     BendDiagonal = 3,
+    /// Joins two garment pieces along a seam (seed 002 §1.4); rest length from the
+    /// parameters, reached by sewing.
+    Seam = 4,
 }
 
 impl SpringKind {
     /// All kinds, in storage order.
-    pub const ALL: [SpringKind; 4] = [
+    pub const ALL: [SpringKind; 5] = [
         SpringKind::Structural,
         SpringKind::Shear,
         SpringKind::Bend,
         SpringKind::BendDiagonal,
+        SpringKind::Seam,
     ];
 }
 
@@ -40,7 +44,7 @@ pub struct Springs {
     /// False once a spring has torn.
     pub alive: Vec<bool>,
     /// The index range of each kind, in `SpringKind` order.
-    pub ranges: [Range<usize>; 4],
+    pub ranges: [Range<usize>; 5],
 }
 
 impl Springs {

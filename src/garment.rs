@@ -1,0 +1,372 @@
+//! Garments: pattern pieces placed in space and stitched by seams (seed 002 §1.4: "the
+//! parts are joined by extra springs between the particles along the seams").
+//!
+//! A garment file (RON) lists the pieces and the seams; everything about a garment is
+//! data, so a user can stitch their own:
+//! ```ron
+//! (
+//!     spacing: 0.034,            // m between neighbouring nodes at resolution 1
+//!     pieces: [
+//!         (name: "front", pattern: "tshirt_front.txt", translation: (0.0, 0.0, 0.17)),
+//!         (name: "back", pattern: "tshirt_back.txt", translation: (0.0, 0.0, -0.17), yaw_degrees: 180.0),
+//!     ],
+//!     seams: [
+//!         // nodes (column, row) from `from` to `to` on each piece, joined in order
+//!         (name: "left side", a: (piece: "front", from: (6, 7), to: (6, 22)),
+//!                             b: (piece: "back", from: (23, 7), to: (23, 22))),
+//!     ],
+//! )
+//! ```
+//! Pattern paths are relative to the garment file. A piece's node `(c, r)` starts at
+//! `(c·s − (width−1)·s/2, −r·s, 0)` (centred, top row at y = 0), turned by `yaw_degrees`
+//! about +y and moved by `translation`. A seam edge runs along a row, a column or a 45°
+//! diagonal; both edges must hold the same number of present nodes.
+
+use std::ops::Range;
+use std::path::{Path, PathBuf};
+
+use bevy::math::{Quat, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::error::ClothError;
+use crate::pattern::{Pattern, PatternWarning};
+use crate::solver::SpringKind;
+use crate::solver::topology::{grid_spring_pairs, grid_triangles};
+
+/// A garment file as written.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GarmentFile {
+    /// Distance between neighbouring nodes at resolution 1, m.
+    pub spacing: f32,
+    /// The pattern pieces.
+    pub pieces: Vec<PieceDesc>,
+    /// The seams joining them.
+    #[serde(default)]
+    pub seams: Vec<SeamDesc>,
+}
+
+/// One pattern piece and where it starts.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PieceDesc {
+    /// The name seams refer to.
+    pub name: String,
+    /// The 0/1 pattern file, relative to the garment file.
+    pub pattern: String,
+    /// Where the middle of the piece's top row starts, m (garment frame).
+    #[serde(default, with = "crate::params::vec3_serde")]
+    pub translation: Vec3,
+    /// Turn about +y, degrees (180 puts a back piece behind, facing away).
+    #[serde(default)]
+    pub yaw_degrees: f32,
+}
+
+/// A seam: the nodes of edge `a` are joined one by one to those of edge `b`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeamDesc {
+    /// A name for messages.
+    #[serde(default)]
+    pub name: String,
+    /// One side.
+    pub a: SeamEdge,
+    /// The other side, in the same order.
+    pub b: SeamEdge,
+}
+
+/// A straight run of nodes on one piece, `from` and `to` included, as `(column, row)` at
+/// resolution 1.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SeamEdge {
+    /// The piece's name.
+    pub piece: String,
+    /// First node `(column, row)`.
+    pub from: (u32, u32),
+    /// Last node `(column, row)`.
+    pub to: (u32, u32),
+}
+
+/// A garment ready to build a cloth from: particles, springs, triangles, pieces and seams.
+#[derive(Clone, Debug, Default)]
+pub struct GarmentLayout {
+    /// Particle start positions in the garment's frame.
+    pub positions: Vec<Vec3>,
+    /// Springs within pieces and along seams.
+    pub springs: Vec<(SpringKind, u32, u32)>,
+    /// Triangles, counter-clockwise seen from each piece's outside.
+    pub triangles: Vec<[u32; 3]>,
+    /// `(name, particle range)` of each piece.
+    pub pieces: Vec<(String, Range<u32>)>,
+    /// `(name, particle pairs)` of each seam.
+    pub seams: Vec<(String, Vec<[u32; 2]>)>,
+    /// Legal but odd things in the patterns (disconnected islands).
+    pub warnings: Vec<PatternWarning>,
+}
+
+/// The path of an asset file as Bevy's asset server finds it: relative paths are under
+/// the `assets` folder beside the crate (or `BEVY_ASSET_ROOT`), absolute ones stay.
+pub fn asset_path(file: &str) -> PathBuf {
+    bevy::asset::io::file::FileAssetReader::get_base_path()
+        .join("assets")
+        .join(file)
+}
+
+impl GarmentLayout {
+    /// Reads a garment file and its patterns, rescaled to `resolution` (1 = as drawn; n
+    /// divides the spacing by n and keeps the outline, see [`Pattern::rescale`]).
+    pub fn load(path: &Path, resolution: u32) -> Result<GarmentLayout, ClothError> {
+        let name = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|e| ClothError::Garment {
+            file: name.clone(),
+            line: 1,
+            column: 1,
+            message: format!("cannot read the garment: {e}"),
+        })?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Self::parse(&text, &name, resolution, |pattern| {
+            Pattern::load(&dir.join(pattern))
+        })
+    }
+
+    /// Parses garment text; `read_pattern` loads a piece's pattern by its path as written.
+    pub fn parse(
+        text: &str,
+        file: &str,
+        resolution: u32,
+        mut read_pattern: impl FnMut(
+            &str,
+        ) -> Result<
+            (Pattern, Vec<PatternWarning>),
+            crate::pattern::PatternError,
+        >,
+    ) -> Result<GarmentLayout, ClothError> {
+        let error = |needle: &str, message: String| {
+            let (line, column) = locate(text, needle);
+            ClothError::Garment {
+                file: file.to_string(),
+                line,
+                column,
+                message,
+            }
+        };
+        let desc: GarmentFile = ron::from_str(text).map_err(|e| ClothError::Garment {
+            file: file.to_string(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
+        if !(desc.spacing > 0.0 && desc.spacing.is_finite()) {
+            return Err(error(
+                "spacing",
+                format!(
+                    "`spacing` must be a positive distance in m, got {}",
+                    desc.spacing
+                ),
+            ));
+        }
+        if !(1..=64).contains(&resolution) {
+            return Err(error(
+                "spacing",
+                format!("resolution {resolution} is outside 1–64"),
+            ));
+        }
+        if desc.pieces.is_empty() {
+            return Err(error("pieces", "a garment needs at least one piece".into()));
+        }
+        let spacing = desc.spacing / resolution as f32;
+        let mut layout = GarmentLayout::default();
+        // Per piece: its pattern and the particle index of each grid node.
+        let mut grids: Vec<(Pattern, Vec<u32>)> = Vec::new();
+        for piece in &desc.pieces {
+            if desc.pieces.iter().filter(|p| p.name == piece.name).count() > 1 {
+                return Err(error(
+                    &format!("\"{}\"", piece.name),
+                    format!("two pieces are named `{}`", piece.name),
+                ));
+            }
+            let (pattern, warnings) = read_pattern(&piece.pattern)?;
+            layout.warnings.extend(warnings);
+            let pattern = pattern.rescale(resolution);
+            let start = layout.positions.len() as u32;
+            let index = add_piece(&mut layout, &pattern, piece, spacing);
+            layout
+                .pieces
+                .push((piece.name.clone(), start..layout.positions.len() as u32));
+            grids.push((pattern, index));
+        }
+        for seam in &desc.seams {
+            let label = if seam.name.is_empty() {
+                "a seam".to_string()
+            } else {
+                format!("seam `{}`", seam.name)
+            };
+            let needle = if seam.name.is_empty() {
+                "seams".to_string()
+            } else {
+                format!("\"{}\"", seam.name)
+            };
+            let mut sides = Vec::new();
+            for edge in [&seam.a, &seam.b] {
+                let Some(p) = desc.pieces.iter().position(|p| p.name == edge.piece) else {
+                    return Err(error(
+                        &needle,
+                        format!("{label}: no piece is named `{}`", edge.piece),
+                    ));
+                };
+                let (pattern, index) = &grids[p];
+                let nodes = edge_nodes(edge, resolution)
+                    .map_err(|m| error(&needle, format!("{label}: {m}")))?;
+                let mut particles = Vec::with_capacity(nodes.len());
+                for (c, r) in nodes {
+                    if !pattern.has(c as i64, r as i64) {
+                        return Err(error(
+                            &needle,
+                            format!(
+                                "{label}: node ({}, {}) of `{}` is not in the pattern",
+                                c as f32 / resolution as f32,
+                                r as f32 / resolution as f32,
+                                edge.piece
+                            ),
+                        ));
+                    }
+                    particles.push(index[(r * pattern.width + c) as usize]);
+                }
+                sides.push(particles);
+            }
+            if sides[0].len() != sides[1].len() {
+                return Err(error(
+                    &needle,
+                    format!(
+                        "{label}: edge a has {} nodes but edge b has {}",
+                        sides[0].len(),
+                        sides[1].len()
+                    ),
+                ));
+            }
+            let pairs: Vec<[u32; 2]> = sides[0]
+                .iter()
+                .zip(&sides[1])
+                .map(|(&a, &b)| [a, b])
+                .collect();
+            if let Some(p) = pairs.iter().find(|p| p[0] == p[1]) {
+                return Err(error(
+                    &needle,
+                    format!("{label} joins particle {} to itself", p[0]),
+                ));
+            }
+            layout
+                .springs
+                .extend(pairs.iter().map(|p| (SpringKind::Seam, p[0], p[1])));
+            layout.seams.push((seam.name.clone(), pairs));
+        }
+        if layout.positions.len() > crate::shape::MAX_PARTICLES {
+            return Err(error(
+                "pieces",
+                format!(
+                    "{} particles is more than the limit",
+                    layout.positions.len()
+                ),
+            ));
+        }
+        Ok(layout)
+    }
+}
+
+/// Adds one piece's particles, springs and triangles; returns the particle index of each
+/// grid node (`u32::MAX` where the pattern has a 0).
+fn add_piece(
+    layout: &mut GarmentLayout,
+    pattern: &Pattern,
+    piece: &PieceDesc,
+    spacing: f32,
+) -> Vec<u32> {
+    let (w, h) = (pattern.width, pattern.height);
+    let turn = Quat::from_rotation_y(piece.yaw_degrees.to_radians());
+    let half = (w - 1) as f32 * spacing * 0.5;
+    let mut index = vec![u32::MAX; pattern.nodes.len()];
+    for r in 0..h {
+        for c in 0..w {
+            let g = (r * w + c) as usize;
+            if pattern.nodes[g] {
+                index[g] = layout.positions.len() as u32;
+                let local = Vec3::new(c as f32 * spacing - half, -(r as f32) * spacing, 0.0);
+                layout.positions.push(turn * local + piece.translation);
+            }
+        }
+    }
+    // The grid's springs between present nodes (seed 000 §3.2); a bend spring also needs
+    // the node it bends over, so none bridges a notch.
+    let present = |g: u32| index[g as usize] != u32::MAX;
+    for (kind, a, b) in grid_spring_pairs(w, h) {
+        let bends = matches!(kind, SpringKind::Bend | SpringKind::BendDiagonal);
+        let middle = || {
+            let (ca, ra, cb, rb) = (a % w, a / w, b % w, b / w);
+            ((ra + rb) / 2) * w + (ca + cb) / 2
+        };
+        if present(a) && present(b) && (!bends || present(middle())) {
+            layout
+                .springs
+                .push((kind, index[a as usize], index[b as usize]));
+        }
+    }
+    // Full cells keep the grid's two triangles; a cell with three nodes (a diagonal edge
+    // of the outline) gets the one triangle they make, wound the same way.
+    let full = grid_triangles(w, h);
+    for r in 0..h - 1 {
+        for c in 0..w - 1 {
+            let corners = [
+                r * w + c,
+                r * w + c + 1,
+                (r + 1) * w + c,
+                (r + 1) * w + c + 1,
+            ];
+            let [tl, tr, bl, br] = corners.map(present);
+            let cell = (r * (w - 1) + c) as usize * 2;
+            let map = |t: [u32; 3]| t.map(|g| index[g as usize]);
+            let [a, b, c2, d] = corners;
+            match (tl, tr, bl, br) {
+                (true, true, true, true) => {
+                    layout.triangles.push(map(full[cell]));
+                    layout.triangles.push(map(full[cell + 1]));
+                }
+                (false, true, true, true) => layout.triangles.push(map([b, c2, d])),
+                (true, false, true, true) => layout.triangles.push(map([a, c2, d])),
+                (true, true, false, true) => layout.triangles.push(map([a, d, b])),
+                (true, true, true, false) => layout.triangles.push(map([a, c2, b])),
+                _ => {}
+            }
+        }
+    }
+    index
+}
+
+/// The grid nodes of a seam edge at `resolution`, from `from` to `to` inclusive: a row, a
+/// column or a 45° diagonal.
+fn edge_nodes(edge: &SeamEdge, resolution: u32) -> Result<Vec<(u32, u32)>, String> {
+    let f = resolution as i64;
+    let (c0, r0) = (edge.from.0 as i64 * f, edge.from.1 as i64 * f);
+    let (c1, r1) = (edge.to.0 as i64 * f, edge.to.1 as i64 * f);
+    let (dc, dr) = (c1 - c0, r1 - r0);
+    if dc != 0 && dr != 0 && dc.abs() != dr.abs() {
+        return Err(format!(
+            "edge {:?}→{:?} on `{}` is not along a row, a column or a 45° diagonal",
+            edge.from, edge.to, edge.piece
+        ));
+    }
+    let n = dc.abs().max(dr.abs());
+    Ok((0..=n)
+        .map(|k| ((c0 + dc.signum() * k) as u32, (r0 + dr.signum() * k) as u32))
+        .collect())
+}
+
+/// 1-based line and column of the first occurrence of `needle` in `text` (1:1 if absent).
+fn locate(text: &str, needle: &str) -> (usize, usize) {
+    text.find(needle).map_or((1, 1), |at| {
+        let before = &text[..at];
+        let line = before.matches('\n').count() + 1;
+        let column = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+        (line, column)
+    })
+}

@@ -1,0 +1,117 @@
+//! Colliders: spheres, capsules and planes the particles are kept out of, every substep,
+//! with a thickness and Coulomb friction (position-based, as in Macklin et al. 2014,
+//! "Unified particle physics for real-time applications", §6.1).
+
+use bevy::math::Vec3;
+
+use super::Cloth;
+
+/// The solid a collider fills, in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ColliderShape {
+    /// A ball.
+    Sphere {
+        /// Centre, m.
+        center: Vec3,
+        /// Radius, m.
+        radius: f32,
+    },
+    /// All points within `radius` of the segment `a–b`.
+    Capsule {
+        /// One end of the axis, m.
+        a: Vec3,
+        /// The other end, m.
+        b: Vec3,
+        /// Radius, m.
+        radius: f32,
+    },
+    /// The half-space behind a plane (a ground).
+    Plane {
+        /// A point on the plane, m.
+        point: Vec3,
+        /// Unit normal pointing out of the solid.
+        normal: Vec3,
+    },
+}
+
+/// A collider in world space: particles stay at least `thickness` outside its surface and
+/// slide on it with friction coefficient `friction`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Collider {
+    /// The solid.
+    pub shape: ColliderShape,
+    /// How far outside the surface particles stay, m (the cloth's half-thickness plus a
+    /// margin).
+    pub thickness: f32,
+    /// Coulomb friction coefficient μ: a particle pressed into the surface by a normal
+    /// correction δ loses up to μ·δ of its tangential motion in that substep, so it sticks
+    /// on a slope while tan θ ≤ μ.
+    pub friction: f32,
+}
+
+impl Collider {
+    /// Signed distance from the surface (negative inside) and the outward normal at the
+    /// closest surface point.
+    pub fn distance(&self, x: Vec3) -> (f32, Vec3) {
+        match self.shape {
+            ColliderShape::Sphere { center, radius } => {
+                let d = x - center;
+                let len = d.length();
+                (len - radius, d.try_normalize().unwrap_or(Vec3::Y))
+            }
+            ColliderShape::Capsule { a, b, radius } => {
+                let axis = b - a;
+                let t = ((x - a).dot(axis) / axis.length_squared().max(f32::MIN_POSITIVE))
+                    .clamp(0.0, 1.0);
+                let d = x - (a + axis * t);
+                let normal = d
+                    .try_normalize()
+                    .unwrap_or_else(|| axis.any_orthonormal_vector());
+                (d.length() - radius, normal)
+            }
+            ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
+        }
+    }
+}
+
+impl Cloth {
+    /// Pushes every free particle out of every collider to `thickness` outside its surface,
+    /// then removes tangential motion of this substep up to `friction × push` (Coulomb).
+    /// Velocities follow the corrected positions: `v = (x − x_prev)/h`.
+    pub(super) fn collide(&mut self) {
+        if self.colliders.is_empty() {
+            return;
+        }
+        let h = self.h;
+        let p = &mut self.particles;
+        for i in 0..p.position.len() {
+            if p.inv_mass[i] == 0.0 {
+                continue;
+            }
+            let mut x = p.position[i];
+            let mut touched = false;
+            for c in &self.colliders {
+                let (d, n) = c.distance(x);
+                let depth = c.thickness - d;
+                if depth <= 0.0 {
+                    continue;
+                }
+                x += n * depth;
+                let moved = x - p.previous[i];
+                let tangential = moved - n * moved.dot(n);
+                let slide = tangential.length();
+                let grip = c.friction * depth;
+                x -= if slide <= grip {
+                    tangential
+                } else {
+                    tangential * (grip / slide)
+                };
+                touched = true;
+            }
+            if touched {
+                p.position[i] = x;
+                p.velocity[i] = (x - p.previous[i]) / h;
+            }
+        }
+    }
+}

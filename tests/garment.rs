@@ -1,0 +1,480 @@
+//! Pattern files, seams, colliders and the T-shirt on its mannequin (seed 002 §1.4).
+
+use std::path::Path;
+
+use bevy::math::{Affine3A, Vec3};
+use bevy::prelude::GlobalTransform;
+use bevy_cloth::garment::{GarmentLayout, asset_path};
+use bevy_cloth::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
+use bevy_cloth::prelude::*;
+use bevy_cloth::solver::{Cloth as Solver, Collider, ColliderShape, SpringKind};
+
+fn parse_err(text: &[u8]) -> (usize, usize, PatternErrorKind) {
+    let e = Pattern::parse(text, "bad.txt").expect_err("must be refused");
+    assert_eq!(e.file, "bad.txt");
+    assert!(
+        e.to_string()
+            .starts_with(&format!("bad.txt:{}:{}: ", e.line, e.column))
+    );
+    (e.line, e.column, e.kind)
+}
+
+#[test]
+fn malformed_patterns_name_file_line_and_column() {
+    // Empty: no rows at all, only comments, or no 1.
+    assert_eq!(parse_err(b"").2, PatternErrorKind::Empty);
+    assert_eq!(parse_err(b"# nothing\n\n").2, PatternErrorKind::Empty);
+    assert_eq!(
+        parse_err(b"# c\n000\n000\n"),
+        (2, 1, PatternErrorKind::Empty)
+    );
+    // Ragged: a short row, and a long row (reported at its first extra node).
+    assert_eq!(
+        parse_err(b"111\n11\n"),
+        (
+            2,
+            3,
+            PatternErrorKind::Ragged {
+                expected: 3,
+                found: 2
+            }
+        )
+    );
+    assert_eq!(
+        parse_err(b"111\n# ok\n1 1 1 1\n"),
+        (
+            3,
+            7,
+            PatternErrorKind::Ragged {
+                expected: 3,
+                found: 4
+            }
+        )
+    );
+    // A stray character, even in the middle of a row.
+    assert_eq!(
+        parse_err(b"111\n1x1\n"),
+        (2, 2, PatternErrorKind::BadCharacter('x'))
+    );
+    assert_eq!(
+        parse_err("11\n1й\n".as_bytes()),
+        (2, 2, PatternErrorKind::BadCharacter('й'))
+    );
+    // Not UTF-8: the position of the first bad byte.
+    assert_eq!(
+        parse_err(b"11\n1\xff1\n"),
+        (2, 2, PatternErrorKind::NotUtf8)
+    );
+    // Too large: one line longer than the limit, and many lines.
+    let long = vec![b'1'; MAX_PATTERN_NODES + 1];
+    assert!(matches!(
+        parse_err(&long).2,
+        PatternErrorKind::TooLarge { .. }
+    ));
+    let tall = "1111111111\n".repeat(MAX_PATTERN_NODES / 10 + 1);
+    let (line, _, kind) = parse_err(tall.as_bytes());
+    assert!(matches!(kind, PatternErrorKind::TooLarge { .. }));
+    assert_eq!(line, MAX_PATTERN_NODES / 10 + 1);
+    // A missing file.
+    let e = Pattern::load(Path::new("no/such/pattern.txt")).unwrap_err();
+    assert!(matches!(e.kind, PatternErrorKind::Io(_)), "{e}");
+}
+
+#[test]
+fn comments_blank_lines_and_spaces_are_allowed_and_islands_warn() {
+    let (p, warnings) =
+        Pattern::parse(b"# piece\n\n1 1 0 0 # two\r\n1100\n0000\n0001\n", "p.txt").unwrap();
+    assert_eq!((p.width, p.height, p.count()), (4, 4, 5));
+    assert!(p.has(0, 0) && p.has(1, 1) && !p.has(2, 0) && p.has(3, 3));
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert_eq!((warnings[0].line, warnings[0].column), (6, 4));
+    assert!(warnings[0].to_string().starts_with("p.txt:6:4: 1 node(s)"));
+    // Diagonal neighbours are joined by shear springs: one island.
+    let (_, warnings) = Pattern::parse(b"10\n01\n", "d.txt").unwrap();
+    assert!(warnings.is_empty());
+}
+
+#[test]
+fn rescaling_keeps_the_outline_on_a_finer_grid() {
+    let (p, _) = Pattern::parse(b"110\n111\n", "l.txt").unwrap();
+    let fine = p.rescale(2);
+    assert_eq!((fine.width, fine.height), (5, 3));
+    // Every coarse node stays; the cell with a missing corner stays empty inside, but the
+    // present edges of it stay.
+    for (c, r) in [(0, 0), (1, 0), (0, 1), (1, 1), (2, 1)] {
+        assert!(fine.has(2 * c, 2 * r), "({c}, {r})");
+    }
+    // The cell with three nodes keeps its triangle: the node on its diagonal stays.
+    assert!(!fine.has(4, 0) && !fine.has(3, 0) && fine.has(3, 1));
+    assert!(fine.has(1, 0) && fine.has(1, 1) && fine.has(3, 2) && fine.has(2, 1));
+    assert_eq!(fine.count(), 12);
+    // A diagonal outline: the triangle's inside at resolution 4.
+    let (tri, _) = Pattern::parse(b"10\n11\n", "t.txt").unwrap();
+    let fine = tri.rescale(4);
+    assert_eq!(
+        fine.count(),
+        15,
+        "1 + 2 + 3 + 4 + 5 nodes on and under the diagonal"
+    );
+    assert!(fine.has(2, 2) && !fine.has(3, 2) && fine.has(0, 4) && fine.has(4, 4));
+}
+
+fn tshirt(resolution: u32) -> GarmentLayout {
+    GarmentLayout::load(&asset_path("patterns/tshirt.ron"), resolution).expect("tshirt loads")
+}
+
+#[test]
+fn the_shipped_patterns_parse_to_their_node_counts() {
+    for side in ["front", "back"] {
+        let (p, warnings) =
+            Pattern::load(&asset_path(&format!("patterns/tshirt_{side}.txt"))).unwrap();
+        assert_eq!((p.width, p.height, p.count()), (30, 23, 510), "{side}");
+        assert!(warnings.is_empty());
+    }
+    let coarse = tshirt(1);
+    assert_eq!(coarse.positions.len(), 1020, "about the seed's 1,008");
+    let fine = tshirt(2);
+    assert!(fine.positions.len() > 3 * 1020, "{}", fine.positions.len());
+    // Same outline: the same extent in space.
+    let extent = |l: &GarmentLayout| {
+        l.positions
+            .iter()
+            .fold((Vec3::MAX, Vec3::MIN), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            })
+    };
+    let (a, b) = (extent(&coarse), extent(&fine));
+    assert!(
+        a.0.distance(b.0) < 1e-5 && a.1.distance(b.1) < 1e-5,
+        "{a:?} {b:?}"
+    );
+}
+
+/// Which piece a particle belongs to.
+fn piece_of(layout: &GarmentLayout, i: u32) -> &str {
+    &layout
+        .pieces
+        .iter()
+        .find(|(_, r)| r.contains(&i))
+        .unwrap()
+        .0
+}
+
+#[test]
+fn seams_join_front_to_matching_back_nodes_symmetrically_and_leave_openings() {
+    for resolution in [1, 2] {
+        let layout = tshirt(resolution);
+        let x = &layout.positions;
+        let spacing = 0.034 / resolution as f32;
+        let seam_springs: Vec<[u32; 2]> =
+            layout.seams.iter().flat_map(|(_, s)| s.clone()).collect();
+        assert_eq!(
+            layout
+                .springs
+                .iter()
+                .filter(|s| s.0 == SpringKind::Seam)
+                .count(),
+            seam_springs.len()
+        );
+        for &[a, b] in &seam_springs {
+            assert_eq!(
+                (piece_of(&layout, a), piece_of(&layout, b)),
+                ("front", "back")
+            );
+            // The matching node: the same place on the body, across the gap.
+            let (pa, pb) = (x[a as usize], x[b as usize]);
+            assert!(
+                (pa.x - pb.x).abs() < 1e-5 && (pa.y - pb.y).abs() < 1e-5,
+                "{pa} vs {pb}"
+            );
+            assert!((pa.z - pb.z - 0.34).abs() < 1e-6);
+        }
+        // Counts per seam at resolution 1: shoulders 12, under sleeves 6, sides 15.
+        let count = |name: &str| {
+            layout
+                .seams
+                .iter()
+                .find(|(n, _)| n == name)
+                .unwrap()
+                .1
+                .len()
+        };
+        let f = resolution as usize;
+        for (side, other) in [("right", "left")] {
+            for (seam, n) in [("shoulder", 12), ("under sleeve", 6), ("side", 15)] {
+                let (a, b) = (
+                    count(&format!("{side} {seam}")),
+                    count(&format!("{other} {seam}")),
+                );
+                assert_eq!((a, b), ((n - 1) * f + 1, (n - 1) * f + 1), "{seam}");
+            }
+        }
+        // Left/right symmetry: every seam node has a mirror image across x = 0.
+        for &[a, _] in &seam_springs {
+            let mirror = x[a as usize] * Vec3::new(-1.0, 1.0, 1.0);
+            assert!(
+                seam_springs
+                    .iter()
+                    .any(|&[m, _]| x[m as usize].distance(mirror) < 1e-5),
+                "no mirror of {}",
+                x[a as usize]
+            );
+        }
+        // Openings: the neck edge (rows 0–2 next to the hole), the hem between the side
+        // seams and the sleeve ends between the shoulder and the under-sleeve seam have no
+        // seam spring.
+        let seamed = |i: usize| seam_springs.iter().any(|s| s.contains(&(i as u32)));
+        let front = layout.pieces[0].1.clone();
+        let top = x[front.start as usize].y;
+        let row = |i: usize| ((top - x[i].y) / spacing).round() as i32;
+        let half_torso = 8.5 * 0.034;
+        let half_width = 14.5 * 0.034;
+        let mut checked = [0; 3];
+        for i in front.start as usize..front.end as usize {
+            let (px, r) = (x[i].x, row(i));
+            let neck = r > 0 && r <= 3 * resolution as i32 && px.abs() < 0.15;
+            let hem = r == 22 * resolution as i32 && px.abs() < half_torso - 1e-4;
+            let sleeve_end =
+                (px.abs() - half_width).abs() < 1e-4 && r > 0 && r < 8 * resolution as i32;
+            for (k, opening) in [neck, hem, sleeve_end].into_iter().enumerate() {
+                if opening {
+                    assert!(
+                        !seamed(i),
+                        "particle {i} at {} is in an opening but seamed",
+                        x[i]
+                    );
+                    checked[k] += 1;
+                }
+            }
+        }
+        assert!(checked.iter().all(|&c| c > 0), "{checked:?}");
+    }
+}
+
+#[test]
+fn broken_garments_name_the_file_and_what_is_wrong() {
+    let patterns = |name: &str| match name {
+        "a.txt" => Pattern::parse(b"111\n111\n", "a.txt"),
+        "bad.txt" => Pattern::parse(b"111\n1x1\n", "bad.txt"),
+        _ => Err(Pattern::parse(b"", name).unwrap_err()),
+    };
+    let garment = |seams: &str, pattern: &str| {
+        let text = format!(
+            "(spacing: 0.1, pieces: [(name: \"a\", pattern: \"a.txt\"), (name: \"b\", pattern: \"{pattern}\", translation: (0, 0, 1))],\n seams: [{seams}])"
+        );
+        GarmentLayout::parse(&text, "g.ron", 1, patterns).map(|l| l.seams.len())
+    };
+    let ok = "(name: \"s\", a: (piece: \"a\", from: (0, 0), to: (2, 0)), b: (piece: \"b\", from: (0, 0), to: (2, 0)))";
+    assert_eq!(garment(ok, "a.txt"), Ok(1));
+    let message = |r: Result<usize, ClothError>| r.unwrap_err().to_string();
+    // The pattern's own error comes through with its file, line and column.
+    assert_eq!(
+        message(garment(ok, "bad.txt")),
+        "bad.txt:2:2: unexpected character 'x': a pattern row holds only 0 and 1 (spaces and `#` comments allowed)"
+    );
+    let m = message(garment(&ok.replace("(2, 0)))", "(1, 0)))"), "a.txt"));
+    assert!(
+        m.starts_with("g.ron:2:") && m.contains("edge a has 3 nodes but edge b has 2"),
+        "{m}"
+    );
+    let m = message(garment(
+        &ok.replace("to: (2, 0)), b", "to: (2, 5)), b"),
+        "a.txt",
+    ));
+    assert!(
+        m.contains("not along a row, a column or a 45° diagonal"),
+        "{m}"
+    );
+    let m = message(garment(
+        &ok.replace("(0, 0), to: (2, 0)), b", "(0, 1), to: (2, 3)), b"),
+        "a.txt",
+    ));
+    assert!(m.contains("is not in the pattern"), "{m}");
+    let m = message(garment(
+        &ok.replace("piece: \"b\"", "piece: \"c\""),
+        "a.txt",
+    ));
+    assert!(m.contains("no piece is named `c`"), "{m}");
+    let m = message(
+        GarmentLayout::parse("(spacing: 0.1, pieces: [], extra: 1)", "g.ron", 1, patterns)
+            .map(|_| 0),
+    );
+    assert!(m.starts_with("g.ron:1:"), "{m}");
+}
+
+/// One free particle (no springs) at `start`, resting on `collider` after `seconds`.
+fn drop_particle(start: Vec3, collider: Collider, seconds: f32) -> Solver {
+    let params = ClothParams {
+        drag: 0.0,
+        ..ClothParams::default()
+    };
+    let mut cloth =
+        Solver::from_springs(&[start], &[], &Pins::None, &params, Affine3A::IDENTITY).unwrap();
+    cloth.set_colliders([collider]);
+    let env = Environment::default();
+    for _ in 0..(seconds / 0.016) as usize {
+        cloth.step(0.016, &env);
+    }
+    cloth
+}
+
+#[test]
+fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_and_a_plane() {
+    let thickness = 0.01;
+    let collider = |shape| Collider {
+        shape,
+        thickness,
+        friction: 0.5,
+    };
+    let cases = [
+        (
+            "sphere",
+            collider(ColliderShape::Sphere {
+                center: Vec3::new(0.2, 1.0, -0.1),
+                radius: 0.3,
+            }),
+            Vec3::new(0.2, 2.0, -0.1),
+            Vec3::new(0.2, 1.3 + thickness, -0.1),
+        ),
+        (
+            "capsule",
+            collider(ColliderShape::Capsule {
+                a: Vec3::new(-0.5, 0.5, 0.0),
+                b: Vec3::new(0.5, 0.5, 0.0),
+                radius: 0.1,
+            }),
+            Vec3::new(0.1, 1.5, 0.0),
+            Vec3::new(0.1, 0.6 + thickness, 0.0),
+        ),
+        (
+            "capsule end cap",
+            collider(ColliderShape::Capsule {
+                a: Vec3::new(0.0, 0.0, 0.0),
+                b: Vec3::new(0.0, 0.5, 0.0),
+                radius: 0.1,
+            }),
+            Vec3::new(0.0, 1.5, 0.0),
+            Vec3::new(0.0, 0.6 + thickness, 0.0),
+        ),
+        (
+            "plane",
+            collider(ColliderShape::Plane {
+                point: Vec3::new(0.0, 0.25, 0.0),
+                normal: Vec3::Y,
+            }),
+            Vec3::new(0.3, 1.0, 0.3),
+            Vec3::new(0.3, 0.25 + thickness, 0.3),
+        ),
+    ];
+    for (name, c, start, rest) in cases {
+        let cloth = drop_particle(start, c, 2.0);
+        let x = cloth.positions()[0];
+        assert!(
+            x.distance(rest) < 1e-4,
+            "{name}: rests at {x}, expected {rest}"
+        );
+        assert!(
+            cloth.particles().velocity[0].length() < 1e-3,
+            "{name} still moves"
+        );
+        // The analytic signed distance is the thickness.
+        assert!((c.distance(x).0 - thickness).abs() < 1e-4, "{name}");
+    }
+}
+
+#[test]
+fn friction_holds_on_a_slope_below_its_angle_and_lets_go_above() {
+    // Coulomb: a particle sticks while tan θ ≤ μ. Slope 20° (tan = 0.364).
+    let theta = 20f32.to_radians();
+    let normal = Vec3::new(-theta.sin(), theta.cos(), 0.0);
+    let plane = |friction| Collider {
+        shape: ColliderShape::Plane {
+            point: Vec3::ZERO,
+            normal,
+        },
+        thickness: 0.0,
+        friction,
+    };
+    // Start on the surface at rest.
+    let start = Vec3::ZERO;
+    let stuck = drop_particle(start, plane(0.4), 1.0);
+    assert!(
+        stuck.positions()[0].length() < 1e-4,
+        "μ = 0.4 slid to {}",
+        stuck.positions()[0]
+    );
+    let sliding = drop_particle(start, plane(0.3), 1.0);
+    // Kinetic friction: acceleration g (sin θ − μ cos θ) down the slope.
+    let a = 9.81 * (theta.sin() - 0.3 * theta.cos());
+    let expected = 0.5 * a * 1.0f32.powi(2);
+    let travelled = sliding.positions()[0].length();
+    assert!(
+        (travelled - expected).abs() < 0.05 * expected,
+        "slid {travelled} m, expected {expected} m"
+    );
+    let ice = drop_particle(start, plane(0.0), 1.0);
+    let expected = 0.5 * 9.81 * theta.sin();
+    assert!((ice.positions()[0].length() - expected).abs() < 0.05 * expected);
+}
+
+/// The T-shirt scene's cloth and colliders as a solver, headless.
+fn tshirt_scene() -> (Solver, Environment, Vec<Collider>) {
+    let scene = ClothScene::load("assets/scenes/tshirt.ron").expect("scene loads");
+    let entry = &scene.cloths[0];
+    let frame = Affine3A::from_translation(entry.translation);
+    let mut cloth = entry.cloth.build(frame).expect("builds");
+    let colliders: Vec<Collider> = scene
+        .colliders
+        .iter()
+        .map(|c| c.collider.to_world(&GlobalTransform::from(c.transform())))
+        .collect();
+    cloth.set_colliders(colliders.iter().copied());
+    (cloth, scene.environment, colliders)
+}
+
+#[test]
+fn the_tshirt_is_sewn_shut_on_the_mannequin_after_five_seconds() {
+    let (mut cloth, env, colliders) = tshirt_scene();
+    assert_eq!(cloth.particle_count(), 1020);
+    for _ in 0..(5.0 / 0.016) as usize {
+        cloth.step(0.016, &env);
+    }
+    assert!(cloth.is_finite());
+    let x = cloth.positions();
+    let springs = cloth.springs();
+    let spacing = 0.034;
+    let mut worst_gap = 0.0f32;
+    for s in springs.ranges[SpringKind::Seam as usize].clone() {
+        let gap = x[springs.a[s] as usize].distance(x[springs.b[s] as usize]);
+        if gap > 0.1 * spacing {
+            println!(
+                "open seam at {} – {}: {gap}",
+                x[springs.a[s] as usize], x[springs.b[s] as usize]
+            );
+        }
+        worst_gap = worst_gap.max(gap);
+    }
+    assert!(worst_gap < 0.1 * spacing, "a seam gap is {worst_gap} m");
+    // Every particle stays outside each collider's surface, give or take its thickness
+    // (where two colliders overlap, leaving one can enter the band of the other).
+    let mut deepest = f32::MIN;
+    for c in &colliders {
+        for p in x {
+            let inside = -c.distance(*p).0;
+            assert!(
+                inside <= c.thickness,
+                "a particle is {inside} m inside {c:?}"
+            );
+            deepest = deepest.max(inside);
+        }
+    }
+    let lowest = x.iter().map(|p| p.y).fold(f32::MAX, f32::min);
+    assert!(lowest > 0.3, "the shirt fell to {lowest} m");
+    println!(
+        "after 5 s: worst seam gap {:.2} mm, deepest {:.2} mm, lowest point {lowest:.3} m, max strain {:.1}%, {} substeps",
+        worst_gap * 1e3,
+        deepest * 1e3,
+        cloth.strain().max * 100.0,
+        cloth.substeps()
+    );
+}
