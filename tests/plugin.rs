@@ -487,3 +487,70 @@ fn stiffness_edits_change_the_next_step() {
     app.update();
     assert_ne!(pos(&app, a), pos(&app, b));
 }
+
+#[test]
+fn collider_entities_keep_cloth_out_and_follow_their_transform() {
+    let mut app = app();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 8, 0.05).with_pins(Pins::None),
+            Transform::from_xyz(0.0, 1.0, 0.0)
+                .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        ))
+        .id();
+    let ball = app
+        .world_mut()
+        .spawn((
+            ClothCollider::sphere(0.15).with_thickness(0.01),
+            Transform::from_xyz(0.0, 0.6, 0.175),
+        ))
+        .id();
+    app.world_mut().spawn(ClothCollider::plane());
+    // The cloth falls onto the ball and drapes over it: never inside it (by more than its
+    // thickness), never below the ground, and touching it.
+    let centre = Vec3::new(0.0, 0.6, 0.175);
+    let mut touched = false;
+    for _ in 0..150 {
+        app.update();
+        let Some(sim) = app.world().get::<ClothSimulation>(cloth) else {
+            continue;
+        };
+        let x = sim.solver.positions();
+        let closest = x
+            .iter()
+            .map(|p| p.distance(centre))
+            .fold(f32::MAX, f32::min);
+        assert!(
+            closest > 0.15 - 1e-4,
+            "a particle is {closest} m from the centre"
+        );
+        touched |= closest < 0.15 + 0.01 + 1e-3;
+        assert!(
+            x.iter().all(|p| p.y >= -1e-4),
+            "a particle went through the ground"
+        );
+    }
+    assert!(touched, "the cloth never reached the ball");
+    let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+    let colliders = sim.solver.colliders();
+    assert_eq!(colliders.len(), 2);
+    assert!(colliders.iter().any(|c| matches!(
+        c.shape,
+        bevy_cloth::solver::ColliderShape::Sphere { center, radius }
+            if center.distance(centre) < 1e-6 && radius == 0.15
+    )));
+    // Moving the entity moves the collider.
+    app.world_mut()
+        .get_mut::<Transform>(ball)
+        .unwrap()
+        .translation = Vec3::new(1.0, 0.5, 0.0);
+    app.update();
+    app.update();
+    let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+    assert!(sim.solver.colliders().iter().any(|c| matches!(
+        c.shape,
+        bevy_cloth::solver::ColliderShape::Sphere { center, .. }
+            if center.distance(Vec3::new(1.0, 0.5, 0.0)) < 1e-6
+    )));
+}

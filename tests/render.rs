@@ -74,10 +74,15 @@ fn cloth_mask(image: &RgbImage) -> Vec<bool> {
         .collect()
 }
 
-/// Runs `example` with `args` under a private Xvfb, screenshots at frames 30 and 90, and
-/// checks the cloth covers `coverage` of the window around the middle of the 3D view and
-/// that it moved in between.
-fn renders_and_moves(example: &str, args: &[&str], coverage: std::ops::Range<f32>) {
+/// Runs `example` with `args` under a private Xvfb, screenshots at `frames`, and checks the
+/// cloth covers `coverage` of the window around the middle of the 3D view and that it
+/// moved in between.
+fn renders_and_moves(
+    example: &str,
+    args: &[&str],
+    frames: (u32, u32),
+    coverage: std::ops::Range<f32>,
+) {
     let (_xvfb, display) = match start_xvfb() {
         Some(x) => x,
         None if std::env::var_os("CI").is_some() => {
@@ -100,8 +105,10 @@ fn renders_and_moves(example: &str, args: &[&str], coverage: std::ops::Range<f32
         .env("DISPLAY", &display)
         .env_remove("WAYLAND_DISPLAY")
         .args(args)
-        .args(["--screenshot", early.to_str().unwrap(), "--frames", "30"])
-        .args(["--screenshot", late.to_str().unwrap(), "--frames", "90"])
+        .args(["--screenshot", early.to_str().unwrap(), "--frames"])
+        .arg(frames.0.to_string())
+        .args(["--screenshot", late.to_str().unwrap(), "--frames"])
+        .arg(frames.1.to_string())
         .output()
         .expect("the example runs");
     let log = String::from_utf8_lossy(&output.stderr);
@@ -163,6 +170,7 @@ fn curtain_renders_and_moves() {
     renders_and_moves(
         "curtain",
         &["--set", "environment.wind.strength=0.003"],
+        (30, 90),
         0.05..0.6,
     );
 }
@@ -174,6 +182,14 @@ fn card_renders_and_moves() {
     renders_and_moves(
         "card",
         &["--set", "environment.wind.strength=0"],
+        (30, 90),
         0.005..0.4,
     );
+}
+
+#[test]
+fn tshirt_renders_and_moves() {
+    // Frame 10 is during sewing (the pieces still apart), frame 90 the sewn shirt on
+    // the mannequin.
+    renders_and_moves("tshirt", &[], (10, 90), 0.02..0.5);
 }

@@ -9,10 +9,13 @@ use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use bevy_inspector_egui::quick::WorldInspectorPlugin;
 
 /// Colour and seed 002's reflection coefficients of a cloth.
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
+#[derive(Component, Clone, Debug, PartialEq)]
 pub struct ClothLook {
     /// Base colour, linear RGB.
     pub color: [f32; 3],
+    /// Colours of a garment's pieces (seed 002 Fig. 4.2–4.3: front and back may differ),
+    /// drawn as vertex colours; empty for one colour.
+    pub piece_colors: Vec<[f32; 3]>,
     /// Diffuse coefficient k_d, 0–1.
     pub diffuse: f32,
     /// Specular coefficient k_s, 0–1.
@@ -24,9 +27,15 @@ impl ClothLook {
     pub fn from_color(color: [f32; 3]) -> Self {
         Self {
             color,
+            piece_colors: Vec::new(),
             diffuse: 0.9,
             specular: 0.2,
         }
+    }
+
+    /// The colour of piece `k`: its own, or the base colour.
+    pub fn piece_color(&self, k: usize) -> [f32; 3] {
+        self.piece_colors.get(k).copied().unwrap_or(self.color)
     }
 
     /// Seed 002's Phong coefficients on a PBR material: the diffuse coefficient scales the
@@ -34,7 +43,14 @@ impl ClothLook {
     /// roughness, so the highlight grows stronger and tighter. Double-sided: back faces
     /// are lit with their own normals (seed 000 §3.5), not as a mirror of the front.
     pub fn material(&self) -> StandardMaterial {
-        let [r, g, b] = self.color.map(|c| c * self.diffuse);
+        // With piece colours the mesh's vertex colours carry the hue (Bevy multiplies
+        // them with the base colour).
+        let color = if self.piece_colors.is_empty() {
+            self.color
+        } else {
+            [1.0; 3]
+        };
+        let [r, g, b] = color.map(|c| c * self.diffuse);
         StandardMaterial {
             base_color: Color::linear_rgb(r, g, b),
             reflectance: self.specular,
@@ -79,7 +95,35 @@ impl Plugin for InspectorPlugin {
             .init_resource::<LightControls>()
             .add_plugins(WorldInspectorPlugin::new().run_if(|show: Res<ShowWorldInspector>| show.0))
             .add_systems(EguiPrimaryContextPass, panel)
-            .add_systems(Update, (apply_looks, apply_light));
+            .add_systems(Update, (apply_looks, apply_piece_colors, apply_light));
+    }
+}
+
+#[allow(clippy::type_complexity)]
+/// Writes each piece's colour into the vertex colours of a multi-piece cloth's mesh (again
+/// when the colours change or the cloth is rebuilt with a new mesh).
+fn apply_piece_colors(
+    looks: Query<
+        (&ClothLook, &ClothSimulation, &Mesh3d),
+        Or<(Changed<ClothLook>, Changed<Mesh3d>)>,
+    >,
+    mut meshes: ResMut<Assets<Mesh>>,
+) {
+    for (look, sim, mesh3d) in &looks {
+        if look.piece_colors.is_empty() {
+            continue;
+        }
+        let Some(mut mesh) = meshes.get_mut(&mesh3d.0) else {
+            continue;
+        };
+        let mut colors = vec![[1.0f32; 4]; sim.solver.particle_count()];
+        for (k, (_, range)) in sim.solver.pieces().iter().enumerate() {
+            let [r, g, b] = look.piece_color(k);
+            for c in &mut colors[range.start as usize..range.end as usize] {
+                *c = [r, g, b, 1.0];
+            }
+        }
+        mesh.insert_attribute(Mesh::ATTRIBUTE_COLOR, colors);
     }
 }
 
@@ -127,6 +171,7 @@ fn panel(
         Option<&ClothStats>,
         Option<&mut ClothLook>,
         Option<&ClothInvalid>,
+        Option<&ClothSimulation>,
     )>,
     mut env: ResMut<ClothEnvironment>,
     mut pause: ResMut<ClothPause>,
@@ -171,7 +216,8 @@ fn panel(
                 {
                     time.set_timestep_seconds(step_ms as f64 / 1e3);
                 }
-                for (n, (entity, name, mut cloth, stats, look, invalid)) in
+                let step_ms = time.timestep().as_secs_f32() * 1e3;
+                for (n, (entity, name, mut cloth, stats, look, invalid, sim)) in
                     cloths.iter_mut().enumerate()
                 {
                     ui.separator();
@@ -193,14 +239,19 @@ fn panel(
                                 *cloth = edited;
                             }
                             if let Some(mut look) = look {
-                                let mut edited = *look;
-                                look_controls(ui, &mut edited);
+                                let mut edited = look.clone();
+                                let names: Vec<&str> = sim
+                                    .map(|s| {
+                                        s.solver.pieces().iter().map(|(n, _)| n.as_str()).collect()
+                                    })
+                                    .unwrap_or_default();
+                                look_controls(ui, &mut edited, &names);
                                 if edited != *look {
                                     *look = edited;
                                 }
                             }
                             if let Some(stats) = stats {
-                                statistics(ui, stats);
+                                statistics(ui, stats, step_ms);
                             }
                         });
                 }
@@ -263,6 +314,9 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                 .text("spacing, m"),
         );
     }
+    if let ClothShape::Garment { resolution, .. } = &mut cloth.shape {
+        ui.add(egui::Slider::new(resolution, 1..=4).text("resolution (rebuilds)"));
+    }
     egui::ComboBox::from_label("pins")
         .selected_text(format!("{:?}", cloth.pins))
         .show_ui(ui, |ui| {
@@ -297,9 +351,18 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                 }
             }
         });
+    let garment = matches!(cloth.shape, ClothShape::Garment { .. });
     match &mut p.model {
         Model::MassSpring => {
             spring_controls(ui, &mut p.springs);
+            if garment {
+                let s = &mut p.springs;
+                family(ui, "seam", &mut s.seam);
+                ui.add(
+                    egui::Slider::new(&mut s.seam_rest_length, 0.0..=0.05).text("seam length, m"),
+                );
+                ui.add(egui::Slider::new(&mut s.sew_time, 0.0..=5.0).text("sewing time, s"));
+            }
         }
         Model::ShapeMatching(sm) => shape_matching_controls(ui, sm),
         Model::Patches(patch) => {
@@ -451,12 +514,23 @@ fn optional(
     });
 }
 
-fn look_controls(ui: &mut egui::Ui, look: &mut ClothLook) {
+fn look_controls(ui: &mut egui::Ui, look: &mut ClothLook, pieces: &[&str]) {
     ui.collapsing("Look", |ui| {
-        ui.horizontal(|ui| {
-            ui.label("colour");
-            ui.color_edit_button_rgb(&mut look.color);
-        });
+        if look.piece_colors.is_empty() {
+            ui.horizontal(|ui| {
+                ui.label("colour");
+                ui.color_edit_button_rgb(&mut look.color);
+            });
+        }
+        for (k, color) in look.piece_colors.iter_mut().enumerate() {
+            ui.horizontal(|ui| {
+                ui.label(format!(
+                    "{} colour",
+                    pieces.get(k).copied().unwrap_or("piece")
+                ));
+                ui.color_edit_button_rgb(color);
+            });
+        }
         ui.add(egui::Slider::new(&mut look.diffuse, 0.0..=1.0).text("diffuse k_d"));
         ui.add(egui::Slider::new(&mut look.specular, 0.0..=1.0).text("specular k_s"));
     });
@@ -491,7 +565,7 @@ fn environment_controls(ui: &mut egui::Ui, env: &mut Environment) {
     }
 }
 
-fn statistics(ui: &mut egui::Ui, stats: &ClothStats) {
+fn statistics(ui: &mut egui::Ui, stats: &ClothStats, step_ms: f32) {
     ui.heading("Statistics");
     egui::Grid::new(ui.next_auto_id())
         .num_columns(2)
@@ -517,6 +591,28 @@ fn statistics(ui: &mut egui::Ui, stats: &ClothStats) {
             row("max strain", format!("{:.1} %", stats.max_strain * 100.0));
             row("total energy", format!("{:.4} J", stats.energy.total()));
         });
+    // Why a setting is slow or unsafe, rather than a cloth that explodes or a frozen window.
+    if stats.under_resolved {
+        ui.colored_label(
+            egui::Color32::LIGHT_RED,
+            format!(
+                "The springs are too stiff for the node mass: a stable explicit step needs \
+                 ω_max·h < 2, more than the {} substeps allowed. Raise the substep maximum, \
+                 lower the stiffness or raise the node mass.",
+                stats.substeps
+            ),
+        );
+    } else if stats.step_ms_median > step_ms {
+        ui.colored_label(
+            egui::Color32::YELLOW,
+            format!(
+                "Stable, but slower than real time ({:.0}%): stiff springs on light nodes \
+                 need {} substeps per {step_ms:.0} ms step (ω_max·h < 2, ω_max² ≈ 2Σk/m).",
+                100.0 * step_ms / stats.step_ms_median,
+                stats.substeps
+            ),
+        );
+    }
     plot(ui, stats);
 }
 

@@ -18,6 +18,7 @@ pub mod tools;
 pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
     let args = ExampleArgs::parse(default_scene);
     let scene = args.load_scene();
+    let yaw = args.yaw_degrees.to_radians();
     App::new()
         .add_plugins((
             DefaultPlugins.set(window_plugin(title)),
@@ -30,14 +31,26 @@ pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
             ScreenshotPlugin,
         ))
         .insert_resource(args)
+        // A setting too stiff for real time slows the simulation down instead of freezing
+        // the window: at most 100 ms of simulated time per frame.
+        .insert_resource(Time::<Virtual>::from_max_delta(
+            std::time::Duration::from_millis(100),
+        ))
         .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
         .add_systems(
             Startup,
             move |mut commands: Commands,
                   mut meshes: ResMut<Assets<Mesh>>,
                   mut materials: ResMut<Assets<StandardMaterial>>| {
-                spawn_scene(&scene, &mut commands, &mut materials);
-                spawn_stage(&mut commands, &mut meshes, &mut materials, focus, radius);
+                spawn_scene(&scene, &mut commands, &mut meshes, &mut materials);
+                spawn_stage(
+                    &mut commands,
+                    &mut meshes,
+                    &mut materials,
+                    focus,
+                    radius,
+                    yaw,
+                );
             },
         )
         .run();
@@ -54,6 +67,9 @@ pub struct ExampleArgs {
     pub overrides: Vec<String>,
     /// `(frame, path)`: save a PNG of the window at that frame; exit after the last.
     pub screenshots: Vec<(u32, PathBuf)>,
+    /// The camera's starting angle about the vertical, degrees (`--yaw`; 20 by default,
+    /// 180 looks at the back).
+    pub yaw_degrees: f32,
 }
 
 impl ExampleArgs {
@@ -69,6 +85,7 @@ impl ExampleArgs {
             screenshots: std::env::var_os("CLOTH_SCREENSHOT")
                 .map(|p| vec![(env_frames.unwrap_or(120), PathBuf::from(p))])
                 .unwrap_or_default(),
+            yaw_degrees: 20.0,
         };
         let mut pending_path: Option<PathBuf> = None;
         let mut pending_frames: Option<u32> = None;
@@ -82,6 +99,16 @@ impl ExampleArgs {
                 "--scene" => args.scene = PathBuf::from(value()),
                 "--set" => args.overrides.push(value()),
                 "--screenshot" => pending_path = Some(PathBuf::from(value())),
+                "--yaw" => {
+                    let v = value();
+                    args.yaw_degrees = v
+                        .parse()
+                        .ok()
+                        .filter(|y: &f32| y.is_finite())
+                        .unwrap_or_else(|| {
+                            fail(&format!("--yaw: `{v}` is not an angle in degrees"))
+                        });
+                }
                 "--frames" => {
                     let v = value();
                     let frames = v.parse().ok().filter(|f| *f > 0);
@@ -90,7 +117,7 @@ impl ExampleArgs {
                     }));
                 }
                 other => fail(&format!(
-                    "unknown option `{other}` (try --scene, --set, --screenshot, --frames)"
+                    "unknown option `{other}` (try --scene, --set, --screenshot, --frames, --yaw)"
                 )),
             }
             if pending_path.is_some() && pending_frames.is_some() {
@@ -136,36 +163,68 @@ pub fn window_plugin(title: &str) -> WindowPlugin {
     }
 }
 
-/// Spawns every cloth of the scene with a double-sided material of its colour, and sets
-/// gravity, wind and the timestep from it.
+/// Spawns every cloth of the scene with a double-sided material of its colour (one per
+/// garment piece), its colliders (drawn when they have a colour), and sets gravity, wind
+/// and the timestep from it.
 pub fn spawn_scene(
     scene: &ClothScene,
     commands: &mut Commands,
+    meshes: &mut Assets<Mesh>,
     materials: &mut Assets<StandardMaterial>,
 ) {
+    for entry in &scene.colliders {
+        let mut entity = commands.spawn((
+            entry.collider,
+            entry.transform(),
+            Name::new(entry.name.clone()),
+        ));
+        if let Some([r, g, b]) = entry.color {
+            let mesh = match entry.collider.shape {
+                ColliderKind::Sphere { radius } => Sphere::new(radius).mesh().build(),
+                ColliderKind::Capsule {
+                    radius,
+                    half_length,
+                } => Capsule3d::new(radius, 2.0 * half_length).mesh().build(),
+                ColliderKind::Plane => Plane3d::default().mesh().size(4.0, 4.0).build(),
+            };
+            entity.insert((
+                Mesh3d(meshes.add(mesh)),
+                MeshMaterial3d(materials.add(StandardMaterial {
+                    base_color: Color::linear_rgb(r, g, b),
+                    perceptual_roughness: 0.6,
+                    ..default()
+                })),
+            ));
+        }
+    }
     commands.insert_resource(ClothEnvironment(scene.environment));
     commands.insert_resource(Time::<Fixed>::from_seconds(scene.timestep as f64));
     for entry in &scene.cloths {
-        let look = inspector::ClothLook::from_color(entry.color);
+        let look = inspector::ClothLook {
+            piece_colors: entry.piece_colors.clone(),
+            ..inspector::ClothLook::from_color(entry.color)
+        };
         commands.spawn((
             entry.cloth.clone(),
             ClothStats::default(),
-            look,
             Name::new(entry.name.clone()),
             Transform::from_translation(entry.translation)
                 .with_rotation(Quat::from_rotation_y(entry.yaw_degrees.to_radians())),
             MeshMaterial3d(materials.add(look.material())),
+            look,
         ));
     }
 }
 
-/// Ground, light and an orbit camera looking at `focus` from `radius` m.
+/// Ground, light and an orbit camera looking at `focus` from `radius` m, turned `yaw`
+/// radians about the vertical.
 pub fn spawn_stage(
     commands: &mut Commands,
     meshes: &mut Assets<Mesh>,
     materials: &mut Assets<StandardMaterial>,
     focus: Vec3,
     radius: f32,
+    yaw: f32,
 ) {
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(12.0, 12.0))),
@@ -193,7 +252,7 @@ pub fn spawn_stage(
         PanOrbitCamera {
             focus,
             radius: Some(radius),
-            yaw: Some(0.35),
+            yaw: Some(yaw),
             pitch: Some(0.12),
             // Right-drag cuts the cloth (see tools.rs), so panning takes the middle button.
             button_pan: MouseButton::Middle,

@@ -102,8 +102,8 @@ pub struct Cloth {
     /// The cloth's characteristic length L (mean structural rest length), for the
     /// shape-matching force law.
     length_scale: f32,
-    /// Particle ranges of garment pieces (one range for other cloths).
-    pieces: Vec<std::ops::Range<u32>>,
+    /// Names and particle ranges of garment pieces (one range for other cloths).
+    pieces: Vec<(String, std::ops::Range<u32>)>,
     /// The length each seam spring starts at, before sewing.
     seam_start: Vec<f32>,
     /// Colliders in world space the particles are kept out of (see `collide.rs`).
@@ -177,7 +177,7 @@ impl Cloth {
             params,
             frame,
         )?;
-        cloth.pieces = layout.pieces.iter().map(|(_, r)| r.clone()).collect();
+        cloth.pieces.clone_from(&layout.pieces);
         Ok(cloth)
     }
 
@@ -316,7 +316,7 @@ impl Cloth {
             shape_matching: None,
             patches: None,
             length_scale: 1.0,
-            pieces: vec![0..n as u32],
+            pieces: vec![(String::from("cloth"), 0..n as u32)],
             seam_start: Vec::new(),
             colliders: Vec::new(),
         };
@@ -842,9 +842,9 @@ impl Cloth {
         &self.pins
     }
 
-    /// The particle range of each garment piece (one range holding every particle for
-    /// other cloths).
-    pub fn pieces(&self) -> &[std::ops::Range<u32>] {
+    /// The name and particle range of each garment piece (one range holding every
+    /// particle for other cloths).
+    pub fn pieces(&self) -> &[(String, std::ops::Range<u32>)] {
         &self.pieces
     }
 
