@@ -198,20 +198,9 @@ impl ClothCollider {
         self
     }
 
-    /// Checks sizes: radii and half-lengths > 0 (half-length ≥ 0), thickness and friction
-    /// ≥ 0, all finite.
+    /// Checks sizes: radius > 0, half-length, thickness and friction ≥ 0, all finite.
     pub fn validate(&self) -> Result<(), ClothError> {
-        let check = |field, value: f32, ok: bool, expected| {
-            if ok && value.is_finite() {
-                Ok(())
-            } else {
-                Err(ClothError::InvalidParameter {
-                    field,
-                    value,
-                    expected,
-                })
-            }
-        };
+        use crate::params::check;
         match self.shape {
             ColliderKind::Sphere { radius } => {
                 check("radius", radius, radius > 0.0, "a radius > 0 m")?

@@ -422,7 +422,8 @@ impl Default for ClothParams {
     }
 }
 
-fn check(
+/// `Ok` when `ok` holds and `value` is finite; otherwise the error naming `field`.
+pub(crate) fn check(
     field: &'static str,
     value: f32,
     ok: bool,

@@ -132,3 +132,27 @@ fn overrides_on_a_scene_of_several_cloths() {
         .unwrap_err();
     assert!(e.to_string().contains("cloths[1]"), "{e}");
 }
+
+#[test]
+fn scenes_name_a_missing_garment_and_a_bad_collider() {
+    let garment =
+        r#"(cloths: [(cloth: (shape: Garment(file: "patterns/nope.ron", resolution: 1)))])"#;
+    let e = ClothScene::parse(garment, Path::new("g.ron"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("g.ron:1: `cloths[0].cloth.shape`") && e.contains("nope.ron"),
+        "{e}"
+    );
+    let collider = "(cloths: [],\n colliders: [(collider: (shape: Sphere(radius: -1.0)))])";
+    let e = ClothScene::parse(collider, Path::new("c.ron"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.starts_with("c.ron:2: `colliders[0].collider.radius`"),
+        "{e}"
+    );
+    // The shipped T-shirt scene loads, with its mannequin.
+    let scene = ClothScene::load("assets/scenes/tshirt.ron").unwrap();
+    assert_eq!(scene.colliders.len(), 12);
+}
