@@ -36,6 +36,7 @@ pub mod components;
 pub mod controls;
 pub mod error;
 pub mod garment;
+pub mod measure;
 pub mod mesh;
 pub mod params;
 pub mod pattern;

@@ -1,0 +1,269 @@
+//! Measurement: headless scene runs with JSON summaries, and seed 000's timing table
+//! (Slika 23). Used by the `cloth` command line; everything steps the same
+//! [`solver::Cloth`] a game runs.
+
+use std::time::Instant;
+
+use bevy::math::{Affine3A, Quat};
+use bevy::prelude::GlobalTransform;
+use serde::Serialize;
+
+use crate::error::ClothError;
+use crate::params::{ClothParams, Environment, Model, PatchParams, ShapeMatchingParams};
+use crate::scene::ClothScene;
+use crate::shape::{ClothShape, Pins};
+use crate::solver::{self, Collider};
+
+/// What a headless run of a scene did, per cloth.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ClothSummary {
+    /// The cloth's name in the scene.
+    pub name: String,
+    /// Particles.
+    pub particles: usize,
+    /// Acting springs (or part springs for the patch model).
+    pub springs: usize,
+    /// Substeps of the last step.
+    pub substeps: u32,
+    /// Largest structural strain at the end.
+    pub max_strain: f32,
+    /// Mean |strain| at the end.
+    pub mean_strain: f32,
+    /// Kinetic energy at the end, J.
+    pub kinetic_energy: f32,
+    /// Total energy at the start, J.
+    pub energy_start: f32,
+    /// Total energy at the end, J.
+    pub energy_end: f32,
+    /// Springs torn.
+    pub torn_springs: usize,
+    /// Finite everywhere and no spring past 100% strain.
+    pub stable: bool,
+}
+
+/// A headless run: the scene's cloths stepped together.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// Steps taken.
+    pub steps: usize,
+    /// Simulated seconds.
+    pub simulated_seconds: f32,
+    /// Median wall-clock time of one step of all cloths, ms (the only field that varies
+    /// between identical runs).
+    pub median_ms_per_step: f64,
+    /// Per cloth.
+    pub cloths: Vec<ClothSummary>,
+}
+
+/// A scene's cloths built as solvers, with their colliders, ready to step.
+pub struct SceneRun {
+    /// `(name, solver)` per cloth.
+    pub cloths: Vec<(String, solver::Cloth)>,
+    /// Gravity and wind.
+    pub environment: Environment,
+    /// The step, s.
+    pub timestep: f32,
+}
+
+impl SceneRun {
+    /// Builds every cloth of `scene` where its frame puts it, with the scene's colliders.
+    pub fn new(scene: &ClothScene) -> Result<Self, ClothError> {
+        let colliders: Vec<Collider> = scene
+            .colliders
+            .iter()
+            .map(|c| c.collider.to_world(&GlobalTransform::from(c.transform())))
+            .collect();
+        let mut cloths = Vec::with_capacity(scene.cloths.len());
+        for entry in &scene.cloths {
+            let frame = Affine3A::from_rotation_translation(
+                Quat::from_rotation_y(entry.yaw_degrees.to_radians()),
+                entry.translation,
+            );
+            let mut cloth = entry.cloth.build(frame)?;
+            cloth.set_colliders(colliders.iter().copied());
+            cloths.push((entry.name.clone(), cloth));
+        }
+        Ok(Self {
+            cloths,
+            environment: scene.environment,
+            timestep: scene.timestep,
+        })
+    }
+
+    /// Runs `steps` steps, calling `each` after every step with the step number (1-based),
+    /// and returns the summary.
+    pub fn run(
+        &mut self,
+        steps: usize,
+        mut each: impl FnMut(usize, &[(String, solver::Cloth)]),
+    ) -> RunSummary {
+        let env = self.environment;
+        let energy_start: Vec<f32> = self
+            .cloths
+            .iter()
+            .map(|(_, c)| c.energy(&env).total())
+            .collect();
+        let mut times = Vec::with_capacity(steps);
+        for step in 1..=steps {
+            let start = Instant::now();
+            for (_, cloth) in &mut self.cloths {
+                cloth.step(self.timestep, &env);
+            }
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+            each(step, &self.cloths);
+        }
+        RunSummary {
+            steps,
+            simulated_seconds: steps as f32 * self.timestep,
+            median_ms_per_step: median(&mut times),
+            cloths: self
+                .cloths
+                .iter()
+                .zip(energy_start)
+                .map(|((name, c), energy_start)| {
+                    let strain = c.strain();
+                    let energy = c.energy(&env);
+                    ClothSummary {
+                        name: name.clone(),
+                        particles: c.particle_count(),
+                        springs: c.spring_count(),
+                        substeps: c.substeps(),
+                        max_strain: strain.max,
+                        mean_strain: strain.mean,
+                        kinetic_energy: energy.kinetic,
+                        energy_start,
+                        energy_end: energy.total(),
+                        torn_springs: c.torn_count(),
+                        stable: c.is_stable(),
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The median of `values` (0 for none); reorders them.
+pub fn median(values: &mut [f64]) -> f64 {
+    if values.is_empty() {
+        return 0.0;
+    }
+    let mid = values.len() / 2;
+    *values.select_nth_unstable_by(mid, f64::total_cmp).1
+}
+
+/// The models of seed 000's timing table (Slika 23): 1 mass-spring, 2 shape matching,
+/// 3a–3c patches of 2×2, 4×4 and 8×8 particles.
+pub const SEED_MODELS: [&str; 5] = ["1", "2", "3a", "3b", "3c"];
+
+/// Particle counts of Slika 23.
+pub const SEED_COUNTS: [usize; 11] = [
+    64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536,
+];
+
+/// Slika 23's ms per 16 ms step, by model (rows as in [`SEED_MODELS`]) and count.
+pub const SEED_MS: [[f64; 11]; 5] = [
+    [
+        0.0, 1.0, 2.0, 4.0, 9.0, 18.0, 26.0, 60.0, 79.0, 257.0, 592.0,
+    ],
+    [
+        0.0, 0.0, 1.0, 2.0, 6.0, 11.0, 23.0, 43.0, 77.0, 179.0, 335.0,
+    ],
+    [0.0, 0.0, 1.0, 1.0, 3.0, 7.0, 14.0, 29.0, 63.0, 120.0, 237.0],
+    [0.0, 0.0, 0.0, 1.0, 2.0, 4.0, 8.0, 12.0, 37.0, 73.0, 145.0],
+    [0.0, 0.0, 0.0, 0.0, 1.0, 3.0, 5.0, 13.0, 31.0, 62.0, 127.0],
+];
+
+/// The parameters of a Slika 23 model on the default cloth.
+pub fn seed_model_params(model: &str) -> Option<ClothParams> {
+    let patches = |size| {
+        Model::Patches(PatchParams {
+            part_width: size,
+            part_height: size,
+            ..PatchParams::default()
+        })
+    };
+    let model = match model {
+        "1" => Model::MassSpring,
+        "2" => Model::ShapeMatching(ShapeMatchingParams::default()),
+        "3a" => patches(2),
+        "3b" => patches(4),
+        "3c" => patches(8),
+        _ => return None,
+    };
+    Some(ClothParams {
+        model,
+        ..ClothParams::default()
+    })
+}
+
+/// A grid of `count` particles (a power of two): square, or twice as wide as tall.
+pub fn grid_for(count: usize) -> (u32, u32) {
+    let mut height = (count as f64).sqrt() as u32;
+    while !count.is_multiple_of(height as usize) {
+        height -= 1;
+    }
+    ((count / height as usize) as u32, height)
+}
+
+/// One cell of the timing table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct BenchCell {
+    /// Slika 23's model name.
+    pub model: String,
+    /// Particles.
+    pub particles: usize,
+    /// Median ms per 16 ms step (all its substeps).
+    pub ms_per_step: f64,
+    /// Substeps per step (automatic: what stability needs).
+    pub substeps: u32,
+    /// Median ms per substep.
+    pub ms_per_substep: f64,
+    /// The seed's ms per step, when it has this cell.
+    pub seed_ms: Option<f64>,
+}
+
+/// Times one 16 ms step of a curtain (a grid of `count` particles, 5 cm apart, pinned at
+/// its top corners, gravity and the default wind) with `model`: `warmup` steps first, then
+/// the median of `repeats` steps.
+pub fn bench_cell(
+    model: &str,
+    count: usize,
+    warmup: usize,
+    repeats: usize,
+) -> Result<BenchCell, ClothError> {
+    let params = seed_model_params(model).ok_or_else(|| ClothError::BadMesh {
+        reason: format!("no model `{model}` (1, 2, 3a, 3b, 3c)"),
+    })?;
+    let (width, height) = grid_for(count);
+    let shape = ClothShape::Grid {
+        width,
+        height,
+        spacing: 0.05,
+    };
+    let mut cloth = solver::Cloth::new(&shape, &Pins::TopCorners, &params, Affine3A::IDENTITY)?;
+    let env = Environment::default();
+    for _ in 0..warmup {
+        cloth.step(0.016, &env);
+    }
+    let mut times = Vec::with_capacity(repeats);
+    for _ in 0..repeats {
+        let start = Instant::now();
+        cloth.step(0.016, &env);
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    let ms = median(&mut times);
+    let substeps = cloth.substeps().max(1);
+    let seed_ms = SEED_MODELS
+        .iter()
+        .position(|m| *m == model)
+        .zip(SEED_COUNTS.iter().position(|c| *c == count))
+        .map(|(m, c)| SEED_MS[m][c]);
+    Ok(BenchCell {
+        model: model.to_string(),
+        particles: count,
+        ms_per_step: ms,
+        substeps,
+        ms_per_substep: ms / substeps as f64,
+        seed_ms,
+    })
+}

@@ -1,0 +1,167 @@
+//! The `cloth` command line: JSON summaries, dumps, determinism, exit codes.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn cloth() -> Command {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_cloth"));
+    cmd.current_dir(env!("CARGO_MANIFEST_DIR"));
+    cmd
+}
+
+fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("bevy_cloth_cli_{}_{name}", std::process::id()))
+}
+
+/// The summary without its wall-clock field, which is the only one that may differ.
+fn physics_of(stdout: &[u8]) -> serde_json::Value {
+    let mut v: serde_json::Value = serde_json::from_slice(stdout).expect("stdout is JSON");
+    v.as_object_mut().unwrap().remove("median_ms_per_step");
+    v
+}
+
+#[test]
+fn run_prints_a_summary_and_is_deterministic() {
+    let mut outputs = Vec::new();
+    for k in 0..2 {
+        let dump = temp(&format!("run{k}.csv"));
+        let out = cloth()
+            .args([
+                "run",
+                "assets/scenes/tshirt.ron",
+                "--steps",
+                "40",
+                "--every",
+                "20",
+            ])
+            .args(["--set", "environment.wind.strength=0.001", "--dump"])
+            .arg(&dump)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let dumped = std::fs::read(&dump).unwrap();
+        let _ = std::fs::remove_file(&dump);
+        outputs.push((physics_of(&out.stdout), dumped));
+    }
+    // Same scene, same input: the same physics, and the dumps byte for byte.
+    assert_eq!(outputs[0].0, outputs[1].0);
+    assert!(outputs[0].1 == outputs[1].1, "the dumps differ");
+    let summary = &outputs[0].0;
+    assert_eq!(summary["steps"], 40);
+    let shirt = &summary["cloths"][0];
+    assert_eq!(shirt["name"], "T-shirt");
+    assert_eq!(shirt["particles"], 1020);
+    assert_eq!(shirt["stable"], true);
+    // Header + frames 0, 20 and 40 of 1,020 particles each.
+    let rows = String::from_utf8_lossy(&outputs[0].1).lines().count();
+    assert_eq!(rows, 1 + 3 * 1020);
+}
+
+#[test]
+fn dumps_in_json_and_obj() {
+    let json = temp("d.json");
+    let obj = temp("d.obj");
+    for path in [&json, &obj] {
+        let out = cloth()
+            .args([
+                "run",
+                "assets/scenes/curtain.ron",
+                "--steps",
+                "4",
+                "--every",
+                "2",
+                "--dump",
+            ])
+            .arg(path)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let frames = doc["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 3);
+    assert_eq!(frames[2]["step"], 4);
+    assert_eq!(frames[0]["cloths"][0].as_array().unwrap().len(), 40 * 32);
+    let frame = PathBuf::from(format!("{}_000004.obj", obj.with_extension("").display()));
+    let text = std::fs::read_to_string(&frame).unwrap();
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("v ")).count(),
+        40 * 32
+    );
+    assert_eq!(
+        text.lines().filter(|l| l.starts_with("f ")).count(),
+        2 * 39 * 31
+    );
+    for k in [0, 2, 4] {
+        let _ = std::fs::remove_file(format!("{}_{k:06}.obj", obj.with_extension("").display()));
+    }
+    let _ = std::fs::remove_file(&json);
+}
+
+#[test]
+fn bad_input_exits_2_with_one_line_naming_the_problem() {
+    let bad_scene = temp("bad.ron");
+    std::fs::write(
+        &bad_scene,
+        "(cloths: [(cloth: (params: (node_mass: -1.0)))])",
+    )
+    .unwrap();
+    let cases: Vec<(Vec<String>, &str)> = vec![
+        (vec!["run".into(), "no/such.ron".into()], "no/such.ron"),
+        (
+            vec!["run".into(), bad_scene.display().to_string()],
+            "cloths[0].cloth.params.node_mass",
+        ),
+        (
+            vec![
+                "run".into(),
+                "assets/scenes/curtain.ron".into(),
+                "--set".into(),
+                "cloth.nope=1".into(),
+            ],
+            "no field `nope`",
+        ),
+        (
+            vec![
+                "run".into(),
+                "assets/scenes/curtain.ron".into(),
+                "--steps".into(),
+                "many".into(),
+            ],
+            "--steps",
+        ),
+        (
+            vec![
+                "run".into(),
+                "assets/scenes/curtain.ron".into(),
+                "--dump".into(),
+                "x.txt".into(),
+            ],
+            ".json, .csv or .obj",
+        ),
+        (
+            vec!["bench".into(), "--models".into(), "9".into()],
+            "no model `9`",
+        ),
+    ];
+    for (args, needle) in cases {
+        let out = cloth().args(&args).output().unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(needle),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    let _ = std::fs::remove_file(&bad_scene);
+}
