@@ -105,12 +105,20 @@ pub struct GarmentLayout {
     pub warnings: Vec<PatternWarning>,
 }
 
-/// The path of an asset file as Bevy's asset server finds it: relative paths are under
-/// the `assets` folder beside the crate (or `BEVY_ASSET_ROOT`), absolute ones stay.
+/// The path of an asset file: under the `assets` folder where Bevy's asset server looks
+/// (`BEVY_ASSET_ROOT`, the crate under cargo, else beside the executable), or else under
+/// `assets` in the working directory (a binary run by hand from the project); absolute
+/// paths stay as they are.
 pub fn asset_path(file: &str) -> PathBuf {
-    bevy::asset::io::file::FileAssetReader::get_base_path()
+    let bevy_path = bevy::asset::io::file::FileAssetReader::get_base_path()
         .join("assets")
-        .join(file)
+        .join(file);
+    let local = Path::new("assets").join(file);
+    if bevy_path.exists() || !local.exists() {
+        bevy_path
+    } else {
+        local
+    }
 }
 
 impl GarmentLayout {

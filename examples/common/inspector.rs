@@ -361,7 +361,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                 ui.add(
                     egui::Slider::new(&mut s.seam_rest_length, 0.0..=0.05).text("seam length, m"),
                 );
-                ui.add(egui::Slider::new(&mut s.sew_time, 0.0..=5.0).text("sewing time, s"));
+                ui.add(egui::Slider::new(&mut s.sew_time, 0.0..=10.0).text("sewing time, s"));
             }
         }
         Model::ShapeMatching(sm) => shape_matching_controls(ui, sm),
