@@ -100,7 +100,7 @@ impl Cloth {
                 for warning in &layout.warnings {
                     warn!("{warning}");
                 }
-                solver::Cloth::from_garment(&layout, &self.pins, &self.params, frame)
+                solver::Cloth::from_garment(layout, &self.pins, &self.params, frame)
             }
             _ => solver::Cloth::new(&self.shape, &self.pins, &self.params, frame),
         }
@@ -407,12 +407,7 @@ impl ClothStats {
                 .take_while(|s| s.time >= time - 1.0)
                 .map(|s| s.step_ms),
         );
-        let mid = self.scratch.len() / 2;
-        self.step_ms_median = if self.scratch.is_empty() {
-            0.0
-        } else {
-            *self.scratch.select_nth_unstable_by(mid, f32::total_cmp).1
-        };
+        self.step_ms_median = crate::measure::median(&mut self.scratch);
     }
 }
 

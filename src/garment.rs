@@ -33,6 +33,9 @@ use crate::pattern::{Pattern, PatternWarning};
 use crate::solver::SpringKind;
 use crate::solver::topology::{grid_spring_pairs, grid_triangles};
 
+/// The finest resolution a garment may be rescaled to.
+pub const MAX_RESOLUTION: u32 = 64;
+
 /// A garment file as written.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -174,10 +177,10 @@ impl GarmentLayout {
                 ),
             ));
         }
-        if !(1..=64).contains(&resolution) {
+        if !(1..=MAX_RESOLUTION).contains(&resolution) {
             return Err(error(
                 "spacing",
-                format!("resolution {resolution} is outside 1–64"),
+                format!("resolution {resolution} is outside 1–{MAX_RESOLUTION}"),
             ));
         }
         if desc.pieces.is_empty() {

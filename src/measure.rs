@@ -4,7 +4,7 @@
 
 use std::time::Instant;
 
-use bevy::math::{Affine3A, Quat};
+use bevy::math::Affine3A;
 use bevy::prelude::GlobalTransform;
 use serde::Serialize;
 
@@ -75,11 +75,7 @@ impl SceneRun {
             .collect();
         let mut cloths = Vec::with_capacity(scene.cloths.len());
         for entry in &scene.cloths {
-            let frame = Affine3A::from_rotation_translation(
-                Quat::from_rotation_y(entry.yaw_degrees.to_radians()),
-                entry.translation,
-            );
-            let mut cloth = entry.cloth.build(frame)?;
+            let mut cloth = entry.cloth.build(entry.transform().compute_affine())?;
             cloth.set_colliders(colliders.iter().copied());
             cloths.push((entry.name.clone(), cloth));
         }
@@ -142,13 +138,17 @@ impl SceneRun {
     }
 }
 
-/// The median of `values` (0 for none); reorders them.
-pub fn median(values: &mut [f64]) -> f64 {
+/// The median of `values` (the upper one of an even count; 0 for none); reorders them.
+pub fn median<T: Copy + Default + PartialOrd>(values: &mut [T]) -> T {
     if values.is_empty() {
-        return 0.0;
+        return T::default();
     }
     let mid = values.len() / 2;
-    *values.select_nth_unstable_by(mid, f64::total_cmp).1
+    *values
+        .select_nth_unstable_by(mid, |a, b| {
+            a.partial_cmp(b).unwrap_or(std::cmp::Ordering::Equal)
+        })
+        .1
 }
 
 /// The models of seed 000's timing table (Slika 23): 1 mass-spring, 2 shape matching,

@@ -303,21 +303,23 @@ fn build_cloths(
     }
 }
 
-/// Gives every cloth the colliders where their entities are now.
+/// Gives every cloth the colliders where their entities are now: each collider's world
+/// placement is computed once per step, then copied to every cloth.
 fn place_colliders(
     transforms: TransformHelper,
     colliders: Query<(Entity, &ClothCollider)>,
     mut cloths: Query<&mut ClothSimulation>,
+    mut world_colliders: Local<Vec<solver::Collider>>,
 ) {
-    if colliders.is_empty() && cloths.iter().all(|sim| sim.solver.colliders().is_empty()) {
-        return;
-    }
+    world_colliders.clear();
+    world_colliders.extend(colliders.iter().filter_map(|(entity, collider)| {
+        let transform = transforms.compute_global_transform(entity).ok()?;
+        Some(collider.to_world(&transform))
+    }));
     for mut sim in &mut cloths {
-        sim.solver
-            .set_colliders(colliders.iter().filter_map(|(entity, collider)| {
-                let transform = transforms.compute_global_transform(entity).ok()?;
-                Some(collider.to_world(&transform))
-            }));
+        if !(world_colliders.is_empty() && sim.solver.colliders().is_empty()) {
+            sim.solver.set_colliders(world_colliders.iter().copied());
+        }
     }
 }
 

@@ -96,6 +96,15 @@ pub struct SceneCloth {
     pub piece_colors: Vec<[f32; 3]>,
 }
 
+impl SceneCloth {
+    /// The cloth's frame: its translation, turned by `yaw_degrees` about +y.
+    pub fn transform(&self) -> bevy::transform::components::Transform {
+        bevy::transform::components::Transform::from_translation(self.translation).with_rotation(
+            bevy::math::Quat::from_rotation_y(self.yaw_degrees.to_radians()),
+        )
+    }
+}
+
 fn default_color() -> [f32; 3] {
     [0.6, 0.1, 0.12]
 }

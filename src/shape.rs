@@ -74,7 +74,7 @@ impl ClothShape {
             }
         }
         if let ClothShape::Garment { resolution, .. } = *self
-            && !(1..=64).contains(&resolution)
+            && !(1..=crate::garment::MAX_RESOLUTION).contains(&resolution)
         {
             return Err(ClothError::InvalidParameter {
                 field: "shape.resolution",

@@ -13,6 +13,21 @@ fn temp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("bevy_cloth_cli_{}_{name}", std::process::id()))
 }
 
+/// Runs `cloth` with `args` and expects success.
+fn run_ok<I, S>(args: I) -> std::process::Output
+where
+    I: IntoIterator<Item = S>,
+    S: AsRef<std::ffi::OsStr>,
+{
+    let out = cloth().args(args).output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 /// The summary without its wall-clock field, which is the only one that may differ.
 fn physics_of(stdout: &[u8]) -> serde_json::Value {
     let mut v: serde_json::Value = serde_json::from_slice(stdout).expect("stdout is JSON");
@@ -25,24 +40,19 @@ fn run_prints_a_summary_and_is_deterministic() {
     let mut outputs = Vec::new();
     for k in 0..2 {
         let dump = temp(&format!("run{k}.csv"));
-        let out = cloth()
-            .args([
-                "run",
-                "assets/scenes/tshirt.ron",
-                "--steps",
-                "40",
-                "--every",
-                "20",
-            ])
-            .args(["--set", "environment.wind.strength=0.001", "--dump"])
-            .arg(&dump)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let dump = dump.display().to_string();
+        let out = run_ok([
+            "run",
+            "assets/scenes/tshirt.ron",
+            "--steps",
+            "40",
+            "--every",
+            "20",
+            "--set",
+            "environment.wind.strength=0.001",
+            "--dump",
+            &dump,
+        ]);
         let dumped = std::fs::read(&dump).unwrap();
         let _ = std::fs::remove_file(&dump);
         outputs.push((physics_of(&out.stdout), dumped));
@@ -66,24 +76,16 @@ fn dumps_in_json_and_obj() {
     let json = temp("d.json");
     let obj = temp("d.obj");
     for path in [&json, &obj] {
-        let out = cloth()
-            .args([
-                "run",
-                "assets/scenes/curtain.ron",
-                "--steps",
-                "4",
-                "--every",
-                "2",
-                "--dump",
-            ])
-            .arg(path)
-            .output()
-            .unwrap();
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let path = path.display().to_string();
+        let args = [
+            "run",
+            "assets/scenes/curtain.ron",
+            "--steps",
+            "4",
+            "--every",
+            "2",
+        ];
+        run_ok(args.into_iter().chain(["--dump", &path]));
     }
     let doc: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
     let frames = doc["frames"].as_array().unwrap();

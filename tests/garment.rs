@@ -3,8 +3,8 @@
 use std::path::Path;
 
 use bevy::math::{Affine3A, Vec3};
-use bevy::prelude::GlobalTransform;
 use bevy_cloth::garment::{GarmentLayout, asset_path};
+use bevy_cloth::measure::SceneRun;
 use bevy_cloth::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{Cloth as Solver, Collider, ColliderShape, SpringKind};
@@ -417,19 +417,14 @@ fn friction_holds_on_a_slope_below_its_angle_and_lets_go_above() {
     assert!((ice.positions()[0].length() - expected).abs() < 0.05 * expected);
 }
 
-/// The T-shirt scene's cloth and colliders as a solver, headless.
+/// The T-shirt scene's cloth and colliders as a solver, headless (as the `cloth` command
+/// line builds it).
 fn tshirt_scene() -> (Solver, Environment, Vec<Collider>) {
     let scene = ClothScene::load("assets/scenes/tshirt.ron").expect("scene loads");
-    let entry = &scene.cloths[0];
-    let frame = Affine3A::from_translation(entry.translation);
-    let mut cloth = entry.cloth.build(frame).expect("builds");
-    let colliders: Vec<Collider> = scene
-        .colliders
-        .iter()
-        .map(|c| c.collider.to_world(&GlobalTransform::from(c.transform())))
-        .collect();
-    cloth.set_colliders(colliders.iter().copied());
-    (cloth, scene.environment, colliders)
+    let run = SceneRun::new(&scene).expect("builds");
+    let (_, cloth) = run.cloths.into_iter().next().expect("one cloth");
+    let colliders = cloth.colliders().to_vec();
+    (cloth, run.environment, colliders)
 }
 
 #[test]

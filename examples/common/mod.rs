@@ -208,8 +208,7 @@ pub fn spawn_scene(
             entry.cloth.clone(),
             ClothStats::default(),
             Name::new(entry.name.clone()),
-            Transform::from_translation(entry.translation)
-                .with_rotation(Quat::from_rotation_y(entry.yaw_degrees.to_radians())),
+            entry.transform(),
             MeshMaterial3d(materials.add(look.material())),
             look,
         ));

@@ -158,7 +158,7 @@ impl Cloth {
     /// Builds a garment: its pieces' particles, springs and triangles, and seam springs
     /// that sew the pieces together over `springs.sew_time` (seed 002 §1.4).
     pub fn from_garment(
-        layout: &GarmentLayout,
+        layout: GarmentLayout,
         pins: &Pins,
         params: &ClothParams,
         frame: Affine3A,
@@ -169,15 +169,15 @@ impl Cloth {
             });
         }
         let mut cloth = Self::build(
-            layout.positions.clone(),
-            layout.springs.clone(),
-            layout.triangles.clone(),
+            layout.positions,
+            layout.springs,
+            layout.triangles,
             None,
             pins,
             params,
             frame,
         )?;
-        cloth.pieces.clone_from(&layout.pieces);
+        cloth.pieces = layout.pieces;
         Ok(cloth)
     }
 
@@ -278,11 +278,7 @@ impl Cloth {
         frame: Affine3A,
     ) -> Result<Self, ClothError> {
         params.validate()?;
-        if matches!(params.model, Model::Patches(_)) && grid.is_none() {
-            return Err(ClothError::BadMesh {
-                reason: "the patch model needs a grid cloth".into(),
-            });
-        }
+        check_model_fits(params, grid)?;
         let pin_indices = pins.resolve(&local, grid.map(|g| g.0))?;
         let springs = Springs::from_pairs(pairs, &local);
         let (triangle_springs, spring_triangles) =
@@ -379,11 +375,7 @@ impl Cloth {
     /// refused with an error and the old parameters stay.
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
-        if matches!(params.model, Model::Patches(_)) && self.grid.is_none() {
-            return Err(ClothError::BadMesh {
-                reason: "the patch model needs a grid cloth".into(),
-            });
-        }
+        check_model_fits(params, self.grid)?;
         if params.node_mass != self.params.node_mass {
             for i in 0..self.particles.len() {
                 self.particles.mass[i] = params.node_mass * self.particles.lump[i];
@@ -1008,6 +1000,16 @@ impl Cloth {
             *n = n.normalize_or(Vec3::Z);
         }
     }
+}
+
+/// The patch model needs a grid cloth (its parts are blocks of rows and columns).
+fn check_model_fits(params: &ClothParams, grid: Option<(u32, u32)>) -> Result<(), ClothError> {
+    if matches!(params.model, Model::Patches(_)) && grid.is_none() {
+        return Err(ClothError::BadMesh {
+            reason: "the patch model needs a grid cloth".into(),
+        });
+    }
+    Ok(())
 }
 
 /// Substeps that keep `h = dt/N` inside the explicit bound `h²ω² + 2hγ < 4` with a safety
