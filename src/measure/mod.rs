@@ -1,6 +1,11 @@
-//! Measurement: headless scene runs with JSON summaries, and seed 000's timing table
-//! (Slika 23). Used by the `cloth` command line; everything steps the same
-//! [`solver::Cloth`] a game runs.
+//! Measurement: headless scene runs with JSON summaries, seed 000's timing table
+//! (Slika 23), seed 002's frame rates with the full app ([`fps`]), speed against
+//! accuracy ([`accuracy`]) and where each method fails ([`stability`]). Used by the
+//! `cloth` command line; everything steps the same [`solver::Cloth`] a game runs.
+
+pub mod accuracy;
+pub mod fps;
+pub mod stability;
 
 use std::time::Instant;
 
@@ -222,15 +227,9 @@ pub struct BenchCell {
     pub seed_ms: Option<f64>,
 }
 
-/// Times one 16 ms step of a curtain (a grid of `count` particles, 5 cm apart, pinned at
-/// its top corners, gravity and the default wind) with `model`: `warmup` steps first, then
-/// the median of `repeats` steps.
-pub fn bench_cell(
-    model: &str,
-    count: usize,
-    warmup: usize,
-    repeats: usize,
-) -> Result<BenchCell, ClothError> {
+/// The curtain of the timing table: a grid of `count` particles (a power of two), 5 cm
+/// apart, pinned at its top corners, with Slika 23's `model`.
+pub fn bench_cloth(model: &str, count: usize) -> Result<solver::Cloth, ClothError> {
     let params = seed_model_params(model).ok_or_else(|| ClothError::BadMesh {
         reason: format!("no model `{model}` (1, 2, 3a, 3b, 3c)"),
     })?;
@@ -240,7 +239,19 @@ pub fn bench_cell(
         height,
         spacing: 0.05,
     };
-    let mut cloth = solver::Cloth::new(&shape, &Pins::TopCorners, &params, Affine3A::IDENTITY)?;
+    solver::Cloth::new(&shape, &Pins::TopCorners, &params, Affine3A::IDENTITY)
+}
+
+/// Times one 16 ms step of a curtain (a grid of `count` particles, 5 cm apart, pinned at
+/// its top corners, gravity and the default wind) with `model`: `warmup` steps first, then
+/// the median of `repeats` steps.
+pub fn bench_cell(
+    model: &str,
+    count: usize,
+    warmup: usize,
+    repeats: usize,
+) -> Result<BenchCell, ClothError> {
+    let mut cloth = bench_cloth(model, count)?;
     let env = Environment::default();
     for _ in 0..warmup {
         cloth.step(0.016, &env);

@@ -1,0 +1,399 @@
+//! The `cloth` command line's charts, drawn with `plotters` to PNG and SVG side by side
+//! (`docs/bench.png` and `docs/bench.svg`). Text uses egui's bundled Ubuntu Light, so no
+//! system font is needed.
+
+use std::ops::Range;
+use std::path::Path;
+
+use bevy_cloth::measure::accuracy::Row;
+use bevy_cloth::measure::fps::{AppFrame, SEED_002_FPS};
+use bevy_cloth::measure::stability::{Cell, MODELS};
+use bevy_cloth::measure::{BenchCell, SEED_COUNTS, SEED_MODELS, SEED_MS};
+use bevy_cloth::prelude::Integrator;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+const FONT: &str = "sans-serif";
+const PALETTE: [RGBColor; 5] = [
+    RGBColor(200, 40, 40),
+    RGBColor(30, 100, 200),
+    RGBColor(30, 150, 60),
+    RGBColor(210, 130, 0),
+    RGBColor(130, 50, 170),
+];
+
+type Result<T> = std::result::Result<T, String>;
+
+fn register_font() -> Result<()> {
+    plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
+        .map_err(|_| "the bundled chart font could not be read".to_string())
+}
+
+/// Draws `draw` to `png` and to the same name with `.svg`.
+fn both(
+    png: &Path,
+    size: (u32, u32),
+    draw: impl Fn(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
+    draw_svg: impl Fn(&DrawingArea<SVGBackend, Shift>) -> Result<()>,
+) -> Result<()> {
+    register_font()?;
+    if png.extension().and_then(|e| e.to_str()) != Some("png") {
+        return Err(format!(
+            "--chart {}: the file must end in .png (an .svg is written beside it)",
+            png.display()
+        ));
+    }
+    if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).map_err(|e| format!("--chart {}: {e}", png.display()))?;
+    }
+    {
+        let root = BitMapBackend::new(png, size).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| e.to_string())?;
+        draw(&root)?;
+        root.present()
+            .map_err(|e| format!("--chart {}: {e}", png.display()))?;
+    }
+    let svg = png.with_extension("svg");
+    let root = SVGBackend::new(&svg, size).into_drawing_area();
+    root.fill(&WHITE).map_err(|e| e.to_string())?;
+    draw_svg(&root)?;
+    root.present()
+        .map_err(|e| format!("--chart {}: {e}", svg.display()))?;
+    Ok(())
+}
+
+/// A log range around `values` with some margin.
+fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+    if !lo.is_finite() {
+        return 0.1..10.0;
+    }
+    lo / 1.6..hi * 1.6
+}
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+// ----- bench --------------------------------------------------------------------------
+
+/// `docs/bench.png`: ms per step against particles, log-log, one line per model, seed
+/// 000's Slika 23 as hollow markers of the same colour; the full app's ms per frame and
+/// seed 002's (from its frames per second) in black.
+pub fn bench(png: &Path, cells: &[BenchCell], app: &[AppFrame]) -> Result<()> {
+    both(
+        png,
+        (1100, 750),
+        |a| draw_bench(a, cells, app),
+        |a| draw_bench(a, cells, app),
+    )
+}
+
+fn draw_bench<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    cells: &[BenchCell],
+    app: &[AppFrame],
+) -> Result<()> {
+    let ys = cells
+        .iter()
+        .map(|c| c.ms_per_step)
+        .chain(SEED_MS.iter().flatten().copied())
+        .chain(app.iter().map(|a| a.ms_per_frame))
+        .chain(SEED_002_FPS.iter().map(|(_, f)| 1e3 / f));
+    let xs = (SEED_COUNTS[0] as f64 / 1.5)..(SEED_COUNTS[SEED_COUNTS.len() - 1] as f64 * 1.5);
+    let mut chart = ChartBuilder::on(area)
+        .caption(
+            "One 16 ms step: ours (lines) against the seeds (hollow)",
+            (FONT, 24),
+        )
+        .margin(14)
+        .x_label_area_size(45)
+        .y_label_area_size(70)
+        .build_cartesian_2d(xs.log_scale(), log_range(ys).log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("particles")
+        .y_desc("ms per step (app: ms per frame)")
+        .label_style((FONT, 15))
+        .axis_desc_style((FONT, 17))
+        .draw()
+        .map_err(err)?;
+    let names = [
+        "1 mass-spring",
+        "2 shape matching",
+        "3a patches 2×2",
+        "3b patches 4×4",
+        "3c patches 8×8",
+    ];
+    for (m, model) in SEED_MODELS.iter().enumerate() {
+        let color = PALETTE[m];
+        let ours: Vec<(f64, f64)> = cells
+            .iter()
+            .filter(|c| c.model == *model)
+            .map(|c| (c.particles as f64, c.ms_per_step))
+            .collect();
+        if !ours.is_empty() {
+            chart
+                .draw_series(LineSeries::new(ours.clone(), color.stroke_width(2)))
+                .map_err(err)?
+                .label(names[m])
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                });
+            chart
+                .draw_series(ours.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .map_err(err)?;
+        }
+        // The seed's zeros (under its 1 ms resolution) have no place on a log axis.
+        let seed = SEED_COUNTS
+            .iter()
+            .zip(SEED_MS[m])
+            .filter(|(_, ms)| *ms > 0.0)
+            .map(|(&c, ms)| TriangleMarker::new((c as f64, ms), 6, color.stroke_width(2)));
+        chart.draw_series(seed).map_err(err)?;
+    }
+    if !app.is_empty() {
+        let line: Vec<(f64, f64)> = app
+            .iter()
+            .map(|a| (a.particles as f64, a.ms_per_frame))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(line.clone(), BLACK.stroke_width(2)))
+            .map_err(err)?
+            .label(format!("full app, model {}: ms per frame", app[0].model))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+        chart
+            .draw_series(line.iter().map(|&p| Circle::new(p, 4, BLACK.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .draw_series(
+            SEED_002_FPS
+                .iter()
+                .map(|&(c, f)| Rectangle::new(square((c as f64, 1e3 / f)), BLACK.stroke_width(2))),
+        )
+        .map_err(err)?
+        .label("seed 002 table 4.1: 1000 / fps (hollow squares)")
+        .legend(|(x, y)| Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], BLACK.stroke_width(2)));
+    chart
+        .draw_series(std::iter::once(TriangleMarker::new(
+            (f64::NAN, f64::NAN),
+            6,
+            BLACK.stroke_width(2),
+        )))
+        .map_err(err)?
+        .label("seed 000 Slika 23 (hollow triangles, model colour)")
+        .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .label_font((FONT, 15))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// A small square around a point of a log-log chart, in data units.
+fn square((x, y): (f64, f64)) -> [(f64, f64); 2] {
+    let f = 1.08;
+    [(x / f, y / f), (x * f, y * f)]
+}
+
+// ----- accuracy -----------------------------------------------------------------------
+
+const ACCURACY_MODELS: [&str; 3] = ["mass-spring", "shape-matching", "patches"];
+
+/// `docs/accuracy.png`: one panel per scene, cost (ms per simulated second) against
+/// error, log-log; circles mass-spring, triangles shape matching, squares patches; the
+/// Pareto frontier as a black staircase. Failed runs are not drawn (they are in the table).
+pub fn accuracy(png: &Path, rows: &[Row]) -> Result<()> {
+    let mut scenes: Vec<&str> = Vec::new();
+    for r in rows {
+        if !scenes.contains(&r.scene.as_str()) {
+            scenes.push(&r.scene);
+        }
+    }
+    let width = 520 * scenes.len().max(1) as u32;
+    both(
+        png,
+        (width, 560),
+        |a| draw_accuracy(a, rows, &scenes),
+        |a| draw_accuracy(a, rows, &scenes),
+    )
+}
+
+fn draw_accuracy<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    rows: &[Row],
+    scenes: &[&str],
+) -> Result<()> {
+    let panels = area.split_evenly((1, scenes.len().max(1)));
+    for (panel, scene) in panels.iter().zip(scenes) {
+        let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == *scene).collect();
+        let ok: Vec<&&Row> = rows.iter().filter(|r| r.error.is_some()).collect();
+        let mut chart = ChartBuilder::on(panel)
+            .caption(*scene, (FONT, 22))
+            .margin(12)
+            .x_label_area_size(45)
+            .y_label_area_size(65)
+            .build_cartesian_2d(
+                log_range(ok.iter().map(|r| r.ms_per_second)).log_scale(),
+                log_range(ok.iter().filter_map(|r| r.error)).log_scale(),
+            )
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("ms per simulated second")
+            .y_desc("RMS error / diagonal")
+            .label_style((FONT, 14))
+            .axis_desc_style((FONT, 16))
+            .draw()
+            .map_err(err)?;
+        let mut frontier: Vec<(f64, f64)> = ok
+            .iter()
+            .filter(|r| r.pareto)
+            .map(|r| (r.ms_per_second, r.error.expect("ok")))
+            .collect();
+        frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let mut stairs = Vec::new();
+        for (i, p) in frontier.iter().enumerate() {
+            if i > 0 {
+                stairs.push((p.0, frontier[i - 1].1));
+            }
+            stairs.push(*p);
+        }
+        chart
+            .draw_series(LineSeries::new(stairs, BLACK.stroke_width(1)))
+            .map_err(err)?
+            .label("Pareto frontier")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
+        for (m, model) in ACCURACY_MODELS.iter().enumerate() {
+            let color = PALETTE[m];
+            let points: Vec<(f64, f64)> = ok
+                .iter()
+                .filter(|r| r.model == *model)
+                .map(|r| (r.ms_per_second, r.error.expect("ok")))
+                .collect();
+            let style = color.filled();
+            let anno = match m {
+                0 => chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, style))),
+                1 => chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, 7, style))),
+                _ => chart.draw_series(points.iter().map(|&p| Rectangle::new(square(p), style))),
+            }
+            .map_err(err)?;
+            anno.label(*model).legend(move |(x, y)| match m {
+                0 => Circle::new((x + 10, y), 5, style).into_dyn(),
+                1 => TriangleMarker::new((x + 10, y), 7, style).into_dyn(),
+                _ => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
+            });
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FONT, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+// ----- stability ----------------------------------------------------------------------
+
+/// `docs/stability.png`: a panel per model (rows) and integrator with automatic
+/// substeps off and on (columns); a cell is drawn at (timestep, `√(k/m)`), green when it
+/// ran stable, a red cross when it failed. The line is the explicit bound `ω_max·h = 2`
+/// with `ω_max = factor·√(k/m)`, `factors` per model as in [`MODELS`].
+pub fn stability(png: &Path, cells: &[Cell], factors: &[f32; 3]) -> Result<()> {
+    both(
+        png,
+        (1500, 1050),
+        |a| draw_stability(a, cells, factors),
+        |a| draw_stability(a, cells, factors),
+    )
+}
+
+fn draw_stability<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    cells: &[Cell],
+    factors: &[f32; 3],
+) -> Result<()> {
+    let columns = [
+        (Integrator::Verlet, false, "Verlet, 1 substep"),
+        (Integrator::SemiImplicitEuler, false, "Euler, 1 substep"),
+        (Integrator::Verlet, true, "Verlet, auto substeps"),
+        (Integrator::SemiImplicitEuler, true, "Euler, auto substeps"),
+    ];
+    let (title, body) = area.split_vertically(40);
+    title
+        .titled(
+            "Stable (green) and failed (red ×) cells; line: ω_max·h = 2",
+            (FONT, 24),
+        )
+        .map_err(err)?;
+    let panels = body.split_evenly((MODELS.len(), columns.len()));
+    let xs = 0.0007f64..0.05;
+    let ys = log_range(cells.iter().map(|c| c.omega0 as f64));
+    for (i, panel) in panels.iter().enumerate() {
+        let (m, col) = (i / columns.len(), i % columns.len());
+        let (integrator, auto, name) = columns[col];
+        let model = MODELS[m];
+        let mut chart = ChartBuilder::on(panel)
+            .caption(format!("{model}: {name}"), (FONT, 17))
+            .margin(8)
+            .x_label_area_size(35)
+            .y_label_area_size(55)
+            .build_cartesian_2d(xs.clone().log_scale(), ys.clone().log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("h, s")
+            .y_desc("√(k/m), rad/s")
+            .label_style((FONT, 12))
+            .axis_desc_style((FONT, 13))
+            .x_labels(4)
+            .y_labels(5)
+            .draw()
+            .map_err(err)?;
+        let factor = factors[m] as f64;
+        let bound: Vec<(f64, f64)> = (0..=60)
+            .map(|j| {
+                let h = xs.start * (xs.end / xs.start).powf(j as f64 / 60.0);
+                (h, 2.0 / (factor * h))
+            })
+            .filter(|(_, w)| ys.contains(w))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(bound, BLACK.stroke_width(2)))
+            .map_err(err)?;
+        let here = cells
+            .iter()
+            .filter(|c| c.model == model && c.integrator == integrator && c.auto == auto);
+        let (failed, stable): (Vec<&Cell>, Vec<&Cell>) = here.partition(|c| c.failure.is_some());
+        chart
+            .draw_series(
+                stable.iter().map(|c| {
+                    Circle::new((c.timestep as f64, c.omega0 as f64), 4, PALETTE[2].filled())
+                }),
+            )
+            .map_err(err)?;
+        chart
+            .draw_series(failed.iter().map(|c| {
+                Cross::new(
+                    (c.timestep as f64, c.omega0 as f64),
+                    5,
+                    PALETTE[0].stroke_width(2),
+                )
+            }))
+            .map_err(err)?;
+    }
+    Ok(())
+}

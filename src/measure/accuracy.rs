@@ -1,0 +1,436 @@
+//! Speed against accuracy: every model and its main knobs against a converged
+//! mass-spring reference of the same scene (issue 7).
+//!
+//! The reference is the scene's cloth as a mass-spring cloth at the same resolution, with
+//! the substep divided by 64: 64 times the substeps the explicit bound asks for (the
+//! scene's 16 ms step divided by 64 would be unstable for a stiff card). It is checked
+//! by halving the substep once more. It integrates with symplectic Euler (see
+//! [`Case::reference`]).
+
+use std::time::Instant;
+
+use bevy::math::Vec3;
+use serde::Serialize;
+
+use crate::error::ClothError;
+use crate::params::{ClothParams, Integrator, Model, PatchParams, ShapeMatchingParams, Substeps};
+use crate::scene::ClothScene;
+
+use super::SceneRun;
+
+/// Seconds between error samples.
+pub const SAMPLE_INTERVAL: f64 = 0.1;
+
+/// A configuration: a model with its knobs set.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Config {
+    /// `mass-spring`, `shape-matching` or `patches`.
+    pub model: &'static str,
+    /// The knobs, e.g. `Verlet, 4 substeps`.
+    pub label: String,
+    /// The parameters.
+    #[serde(skip)]
+    pub params: ClothParams,
+}
+
+/// The configurations measured on a cloth whose mass-spring parameters are `base`:
+/// mass-spring with either integrator at 1, 2, 4, 8 and automatic substeps; shape
+/// matching with 1 and 4×4 clusters at stiffness k, 4k, 16k and 64k (k the structural
+/// spring stiffness: the pins hold a shape-matched cloth only through the fit, so a
+/// hanging cloth needs a stiff pull); patches of 1, 2, 4 and 8 particles square pulled
+/// at 3k.
+pub fn configs(base: &ClothParams) -> Vec<Config> {
+    let mut out = Vec::new();
+    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        for substeps in [
+            Substeps::Fixed(1),
+            Substeps::Fixed(2),
+            Substeps::Fixed(4),
+            Substeps::Fixed(8),
+            Substeps::default(),
+        ] {
+            let name = match integrator {
+                Integrator::Verlet => "Verlet",
+                Integrator::SemiImplicitEuler => "Euler",
+            };
+            let steps = match substeps {
+                Substeps::Fixed(n) => format!("{n} substeps"),
+                Substeps::Auto { .. } => "auto substeps".into(),
+            };
+            out.push(Config {
+                model: "mass-spring",
+                label: format!("{name}, {steps}"),
+                params: ClothParams {
+                    model: Model::MassSpring,
+                    integrator,
+                    substeps,
+                    ..*base
+                },
+            });
+        }
+    }
+    let k = base.springs.structural.stiffness;
+    for clusters in [1, 4] {
+        for factor in [1.0, 4.0, 16.0, 64.0] {
+            let stiffness = k * factor;
+            out.push(Config {
+                model: "shape-matching",
+                label: format!("{clusters}×{clusters} clusters, α = {stiffness} N/m"),
+                params: ClothParams {
+                    model: Model::ShapeMatching(ShapeMatchingParams {
+                        stiffness,
+                        clusters,
+                        // The reference's spring damping, as particle damping.
+                        damping: base.springs.damping,
+                        ..ShapeMatchingParams::default()
+                    }),
+                    substeps: Substeps::default(),
+                    ..*base
+                },
+            });
+        }
+    }
+    for size in [1, 2, 4, 8] {
+        out.push(Config {
+            model: "patches",
+            label: format!("{size}×{size} parts"),
+            params: ClothParams {
+                model: Model::Patches(PatchParams {
+                    part_width: size,
+                    part_height: size,
+                    stiffness: 3.0 * k,
+                    ..PatchParams::default()
+                }),
+                substeps: Substeps::default(),
+                ..*base
+            },
+        });
+    }
+    out
+}
+
+/// One scene of the accuracy study: `scene` reduced to the cloth measured.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// A name for tables and charts.
+    pub name: String,
+    /// The scene with one cloth; its parameters are the reference's (mass-spring).
+    pub scene: ClothScene,
+    /// Simulated seconds.
+    pub seconds: f32,
+}
+
+impl Case {
+    /// Cloth `index` of `scene` alone (colliders kept).
+    pub fn new(
+        name: &str,
+        scene: &ClothScene,
+        index: usize,
+        seconds: f32,
+    ) -> Result<Self, ClothError> {
+        let cloth = scene.cloths.get(index).ok_or_else(|| ClothError::BadMesh {
+            reason: format!("the scene has no cloth {index}"),
+        })?;
+        if cloth.cloth.params.model != Model::MassSpring {
+            return Err(ClothError::BadMesh {
+                reason: format!("cloth {index} is the reference: it must be mass-spring"),
+            });
+        }
+        let mut scene = scene.clone();
+        scene.cloths = vec![cloth.clone()];
+        Ok(Self {
+            name: name.to_string(),
+            scene,
+            seconds,
+        })
+    }
+
+    /// Steps of the scene's timestep that cover `seconds`.
+    pub fn steps(&self) -> usize {
+        (self.seconds as f64 / self.scene.timestep as f64 - 1e-6).ceil() as usize
+    }
+
+    /// The reference's parameters.
+    pub fn base(&self) -> ClothParams {
+        self.scene.cloths[0].cloth.params
+    }
+
+    /// Steps after which a sample is taken: the first step at or past each multiple of
+    /// [`SAMPLE_INTERVAL`], the same steps for every configuration.
+    pub fn sample_steps(&self) -> Vec<usize> {
+        let dt = self.scene.timestep as f64;
+        (1..=self.steps())
+            .filter(|&s| {
+                let k = |s: usize| ((s as f64 * dt + 1e-9) / SAMPLE_INTERVAL).floor();
+                k(s) > k(s - 1)
+            })
+            .collect()
+    }
+
+    /// Runs the cloth with `params`.
+    pub fn simulate(&self, params: &ClothParams) -> Result<Trajectory, ClothError> {
+        let mut scene = self.scene.clone();
+        scene.cloths[0].cloth.params = *params;
+        let mut run = SceneRun::new(&scene)?;
+        let env = run.environment;
+        let dt = run.timestep;
+        let samples_at = self.sample_steps();
+        let (_, cloth) = &mut run.cloths[0];
+        let start = cloth.energy(&env).total();
+        let mut t = Trajectory {
+            samples: Vec::with_capacity(samples_at.len()),
+            milliseconds: 0.0,
+            max_strain: 0.0,
+            energy_start: start,
+            energy_end: start,
+            failed_at: None,
+            mean_substeps: 0.0,
+            mass: cloth.particles().mass.iter().sum(),
+            diagonal: diagonal(cloth.positions()),
+        };
+        let (mut substeps, mut steps_run) = (0u64, 0usize);
+        for step in 1..=self.steps() {
+            steps_run = step;
+            let clock = Instant::now();
+            cloth.step(dt, &env);
+            t.milliseconds += clock.elapsed().as_secs_f64() * 1e3;
+            substeps += cloth.substeps() as u64;
+            let strain = cloth.strain().max;
+            t.max_strain = t.max_strain.max(strain);
+            if !cloth.is_stable() {
+                t.failed_at = Some(step as f32 * dt);
+                break;
+            }
+            if samples_at.binary_search(&step).is_ok() {
+                t.samples.push(cloth.positions().to_vec());
+            }
+        }
+        t.energy_end = cloth.energy(&env).total();
+        t.mean_substeps = substeps as f64 / steps_run.max(1) as f64;
+        Ok(t)
+    }
+
+    /// The reference: the base parameters with `factor` times the automatic substeps,
+    /// integrated by symplectic Euler.
+    pub fn reference(&self, factor: u32) -> Result<(u32, Trajectory), ClothError> {
+        let scene = &self.scene;
+        let solver = SceneRun::new(scene)?;
+        let auto = solver.cloths[0].1.stable_substeps(scene.timestep);
+        let substeps = auto * factor;
+        // Symplectic Euler, not Verlet: in `f32`, Verlet's `a h²` vanishes below the
+        // rounding of a position (at 512 substeps of 16 ms, g h² = 1e-8 m against
+        // 2.4e-7 m spacing of floats near 2 m), while Euler carries the velocity itself.
+        let params = ClothParams {
+            substeps: Substeps::Fixed(substeps),
+            integrator: Integrator::SemiImplicitEuler,
+            ..self.base()
+        };
+        Ok((substeps, self.simulate(&params)?))
+    }
+}
+
+/// The bounding-box diagonal of `positions`.
+fn diagonal(positions: &[Vec3]) -> f32 {
+    let (lo, hi) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    (hi - lo).length()
+}
+
+/// A run sampled every [`SAMPLE_INTERVAL`].
+#[derive(Clone, Debug)]
+pub struct Trajectory {
+    /// Positions at each sample step (fewer when the run failed).
+    pub samples: Vec<Vec<Vec3>>,
+    /// Wall-clock time of all steps, ms.
+    pub milliseconds: f64,
+    /// Largest structural strain over the run.
+    pub max_strain: f32,
+    /// Total energy at the start and the end, J.
+    pub energy_start: f32,
+    /// Total energy at the end, J.
+    pub energy_end: f32,
+    /// When the run went non-finite or past 100% strain, s.
+    pub failed_at: Option<f32>,
+    /// Substeps per step, on average.
+    pub mean_substeps: f64,
+    /// Mass of the cloth, kg.
+    pub mass: f32,
+    /// Diagonal of the cloth at the start, m.
+    pub diagonal: f32,
+}
+
+impl Trajectory {
+    /// RMS distance between corresponding particles over all samples, and at the last
+    /// sample, both divided by the cloth's diagonal; `None` when either run has fewer
+    /// samples (it failed).
+    pub fn error_against(&self, reference: &Trajectory) -> Option<(f64, f64)> {
+        if self.samples.len() != reference.samples.len() || self.samples.is_empty() {
+            return None;
+        }
+        let rms = |pairs: &mut dyn Iterator<Item = (&Vec<Vec3>, &Vec<Vec3>)>| {
+            let (mut sum, mut count) = (0.0f64, 0usize);
+            for (a, b) in pairs {
+                for (p, q) in a.iter().zip(b) {
+                    sum += p.distance_squared(*q) as f64;
+                    count += 1;
+                }
+            }
+            (sum / count.max(1) as f64).sqrt() / reference.diagonal as f64
+        };
+        let all = rms(&mut self.samples.iter().zip(&reference.samples));
+        let last = rms(&mut std::iter::once((
+            self.samples.last()?,
+            reference.samples.last()?,
+        )));
+        Some((all, last))
+    }
+}
+
+/// One row of the accuracy table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Row {
+    /// The case.
+    pub scene: String,
+    /// The model.
+    pub model: &'static str,
+    /// Its knobs.
+    pub label: String,
+    /// Wall-clock ms per simulated second.
+    pub ms_per_second: f64,
+    /// Substeps per 16 ms step, on average.
+    pub substeps: f64,
+    /// RMS particle distance to the reference over the run / diagonal (`None`: failed).
+    pub error: Option<f64>,
+    /// The same at the last sample only: the final drape.
+    pub final_error: Option<f64>,
+    /// Largest structural strain over the run.
+    pub max_strain: f32,
+    /// Final total energy minus the reference's, over `M g D` (mass, gravity, diagonal).
+    pub energy_drift: Option<f64>,
+    /// When the run failed, s.
+    pub failed_at: Option<f32>,
+    /// On the cost–error Pareto frontier of its scene.
+    pub pareto: bool,
+}
+
+/// The reference of a case and its convergence check.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Reference {
+    /// The case.
+    pub scene: String,
+    /// Substeps per step of the reference.
+    pub substeps: u32,
+    /// Error of the reference against one with half its substep (its own error).
+    pub halving_change: f64,
+    /// The smallest error reported for a configuration of the case.
+    pub smallest_error: f64,
+    /// `halving_change < 0.05 · smallest_error`.
+    pub converged: bool,
+    /// Wall-clock time of the reference run, ms.
+    pub milliseconds: f64,
+}
+
+/// Measures every configuration of `case` against its reference; `progress` hears of
+/// each row as it is done.
+pub fn measure(
+    case: &Case,
+    configs: &[Config],
+    mut progress: impl FnMut(&Row),
+) -> Result<(Reference, Vec<Row>), ClothError> {
+    let (substeps, reference) = case.reference(64)?;
+    let (_, finer) = case.reference(128)?;
+    let halving_change = reference
+        .error_against(&finer)
+        .map_or(f64::INFINITY, |e| e.0);
+    let g = case
+        .scene
+        .environment
+        .effective_gravity()
+        .length()
+        .max(1e-6) as f64;
+    let scale = reference.mass as f64 * g * reference.diagonal as f64;
+    let mut rows = Vec::new();
+    for config in configs {
+        let run = case.simulate(&config.params)?;
+        let errors = run.error_against(&reference);
+        let row = Row {
+            scene: case.name.clone(),
+            model: config.model,
+            label: config.label.clone(),
+            ms_per_second: run.milliseconds / case.seconds as f64,
+            substeps: run.mean_substeps,
+            error: errors.map(|e| e.0),
+            final_error: errors.map(|e| e.1),
+            max_strain: run.max_strain,
+            energy_drift: errors
+                .map(|_| (run.energy_end as f64 - reference.energy_end as f64) / scale),
+            failed_at: run.failed_at,
+            pareto: false,
+        };
+        progress(&row);
+        rows.push(row);
+    }
+    let points: Vec<Option<(f64, f64)>> = rows
+        .iter()
+        .map(|r| r.error.map(|e| (r.ms_per_second, e)))
+        .collect();
+    for i in pareto(&points) {
+        rows[i].pareto = true;
+    }
+    let smallest_error = rows
+        .iter()
+        .filter_map(|r| r.error)
+        .filter(|e| *e > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    Ok((
+        Reference {
+            scene: case.name.clone(),
+            substeps,
+            halving_change,
+            smallest_error,
+            converged: halving_change < 0.05 * smallest_error,
+            milliseconds: reference.milliseconds,
+        },
+        rows,
+    ))
+}
+
+/// Indices of the points (cost, error) no other point beats in both, cheapest first;
+/// `None` points are left out.
+pub fn pareto(points: &[Option<(f64, f64)>]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..points.len()).filter(|&i| points[i].is_some()).collect();
+    order.sort_by(|&a, &b| {
+        let (pa, pb) = (points[a].expect("some"), points[b].expect("some"));
+        pa.0.total_cmp(&pb.0).then(pa.1.total_cmp(&pb.1))
+    });
+    let mut best = f64::INFINITY;
+    let mut out = Vec::new();
+    for i in order {
+        let error = points[i].expect("some").1;
+        if error < best {
+            best = error;
+            out.push(i);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn pareto_keeps_points_nothing_beats_in_cost_and_error() {
+        let points = [
+            Some((1.0, 0.5)),
+            Some((2.0, 0.6)), // beaten by the first
+            Some((3.0, 0.1)),
+            None,
+            Some((0.5, 0.9)),
+            Some((3.0, 0.2)), // same cost as the third, worse error
+        ];
+        assert_eq!(pareto(&points), vec![4, 0, 2]);
+    }
+}

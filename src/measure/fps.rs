@@ -1,0 +1,108 @@
+//! Seed 002's experiment (table 4.1): frames per second against the number of masses,
+//! here with the whole Bevy app and no window: `MinimalPlugins`, assets, `ClothPlugin`
+//! stepping on `FixedUpdate` and writing the mesh back every frame. Time is advanced by
+//! exactly one 16 ms fixed step per frame, so a frame's wall-clock time is what one
+//! step of the game costs; frames per second are `1000 / ms`.
+
+use std::time::{Duration, Instant};
+
+use bevy::asset::AssetPlugin;
+use bevy::mesh::{Mesh, Mesh3d};
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+
+use crate::error::ClothError;
+use crate::measure::{grid_for, median, seed_model_params};
+use crate::prelude::{Cloth, ClothPlugin, Pins};
+
+/// Seed 002's table 4.1: masses and the frames per second it reported.
+pub const SEED_002_FPS: [(usize, f64); 10] = [
+    (100, 60.0),
+    (300, 50.0),
+    (500, 31.0),
+    (700, 22.0),
+    (900, 16.0),
+    (1100, 13.0),
+    (1300, 10.0),
+    (1600, 8.0),
+    (3600, 5.0),
+    (6400, 3.0),
+];
+
+/// Table 4.1's counts continued to 65,536 masses.
+pub const APP_COUNTS: [usize; 12] = [
+    100, 300, 500, 700, 900, 1100, 1300, 1600, 3600, 6400, 16_384, 65_536,
+];
+
+/// One row of the experiment.
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct AppFrame {
+    /// Slika 23's model name (see [`seed_model_params`]).
+    pub model: String,
+    /// Masses (particles).
+    pub particles: usize,
+    /// Median wall-clock ms of one frame (one fixed step, mesh write-back).
+    pub ms_per_frame: f64,
+    /// `1000 / ms_per_frame`.
+    pub fps: f64,
+    /// Seed 002's frames per second at this count, when it has one.
+    pub seed_fps: Option<f64>,
+}
+
+/// Runs the app with one curtain of `count` particles (5 cm grid, top corners pinned,
+/// default gravity and wind) of `model`: `warmup` frames, then the median of `frames`.
+pub fn app_frame(
+    model: &str,
+    count: usize,
+    warmup: usize,
+    frames: usize,
+) -> Result<AppFrame, ClothError> {
+    let params = seed_model_params(model).ok_or_else(|| ClothError::BadMesh {
+        reason: format!("no model `{model}` (1, 2, 3a, 3b, 3c)"),
+    })?;
+    let (width, height) = grid_for(count);
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        ClothPlugin::default(),
+    ))
+    .init_asset::<Mesh>()
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+        16,
+    )));
+    let entity = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(width, height, 0.05)
+                .with_pins(Pins::TopCorners)
+                .with_params(params),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+        ))
+        .id();
+    for _ in 0..warmup.max(2) {
+        app.update();
+    }
+    if app.world().get::<Mesh3d>(entity).is_none() {
+        return Err(ClothError::BadMesh {
+            reason: "the plugin made no mesh for the cloth".into(),
+        });
+    }
+    let mut times = Vec::with_capacity(frames);
+    for _ in 0..frames.max(1) {
+        let start = Instant::now();
+        app.update();
+        times.push(start.elapsed().as_secs_f64() * 1e3);
+    }
+    let ms = median(&mut times);
+    Ok(AppFrame {
+        model: model.to_string(),
+        particles: count,
+        ms_per_frame: ms,
+        fps: 1e3 / ms,
+        seed_fps: SEED_002_FPS
+            .iter()
+            .find(|(c, _)| *c == count)
+            .map(|(_, f)| *f),
+    })
+}

@@ -1,0 +1,426 @@
+//! Where each method fails: a grid over stiffness, node mass and timestep (issue 7), and
+//! the measured stability threshold of a single spring and of the full lattice against
+//! the explicit bound `ω_max·h = 2`.
+//!
+//! Every probe is a free cloth (nothing pinned but the single spring's anchor) with no
+//! gravity, wind or damping, started from rest with every particle displaced by a small
+//! deterministic pseudo-random offset, so every mode, the fastest too, is excited. It
+//! fails on a non-finite position, a structural strain over 100%, or kinetic energy
+//! growing tenfold with no input: over ten times the larger of the energy it started with
+//! (all potential) and the largest kinetic energy of the first quarter of the run (the
+//! patch model's energy counts only its part lattice). Springs and goal pulls
+//! are undamped (damping only moves the bound, to `h²ω² + 2hγ < 4`); the strain limiter
+//! is off, since it would hide the failure it is there to mask.
+
+use bevy::math::{Affine3A, Vec3};
+use serde::Serialize;
+
+use crate::error::ClothError;
+use crate::params::{
+    ClothParams, Environment, Integrator, Model, PatchParams, ShapeMatchingParams, SpringFamily,
+    SpringParams, Substeps, Wind,
+};
+use crate::shape::{ClothShape, Pins};
+use crate::solver::{self, SpringKind};
+
+/// Spring (and pull) stiffnesses of the grid, N/m (seed 002 §1.4's range).
+pub const STIFFNESS: [f32; 6] = [100.0, 300.0, 1_000.0, 3_000.0, 10_000.0, 25_000.0];
+/// Node masses of the grid, kg (seed 002: 0.001–1 g).
+pub const MASS: [f32; 4] = [1e-6, 1e-5, 1e-4, 1e-3];
+/// Timesteps of the grid, s.
+pub const TIMESTEP: [f32; 6] = [0.001, 0.002, 0.004, 0.008, 0.016, 0.033];
+
+/// The models of the grid.
+pub const MODELS: [&str; 3] = ["mass-spring", "shape-matching", "patches"];
+
+/// Particles across the probe cloth (a square grid, 2 cm spacing).
+pub const PROBE_SIZE: u32 = 12;
+const SPACING: f32 = 0.02;
+
+/// The undamped, unlimited parameters of `model` at stiffness `k` and node mass `m`:
+/// springs with the seed's 2:1:1 ratio from `k`; shape matching's and the patches' pull
+/// at `k` (one cluster; parts of 4×4).
+pub fn params(
+    model: &str,
+    k: f32,
+    m: f32,
+    integrator: Integrator,
+    substeps: Substeps,
+) -> Option<ClothParams> {
+    let model = match model {
+        "mass-spring" => Model::MassSpring,
+        "shape-matching" => Model::ShapeMatching(ShapeMatchingParams {
+            stiffness: k,
+            damping: 0.0,
+            ..ShapeMatchingParams::default()
+        }),
+        "patches" => Model::Patches(PatchParams {
+            stiffness: k,
+            particle_damping_ratio: 0.0,
+            part_damping: 0.0,
+            ..PatchParams::default()
+        }),
+        _ => return None,
+    };
+    Some(ClothParams {
+        model,
+        node_mass: m,
+        springs: SpringParams::from_structural(k),
+        drag: 0.0,
+        integrator,
+        substeps,
+        strain_limit: None,
+        strain_limit_iterations: 0,
+        tear_ratio: None,
+    })
+}
+
+/// No gravity, no wind: nothing puts energy in.
+pub fn quiet() -> Environment {
+    Environment {
+        gravity_enabled: false,
+        wind: Wind {
+            strength: 0.0,
+            ..Wind::default()
+        },
+        ..Environment::default()
+    }
+}
+
+/// Displaces every free particle by up to `fraction` of `spacing` in each axis
+/// (a fixed hash, the same every run), at rest.
+pub fn perturb(cloth: &mut solver::Cloth, spacing: f32, fraction: f32) {
+    let p = cloth.particles_mut();
+    for i in 0..p.len() {
+        if p.is_pinned(i) {
+            continue;
+        }
+        let offset = Vec3::new(hash(i, 0), hash(i, 1), hash(i, 2)) * (spacing * fraction);
+        p.position[i] += offset;
+        p.previous[i] = p.position[i];
+        p.velocity[i] = Vec3::ZERO;
+    }
+}
+
+/// A number in [−1, 1] from `(i, axis)`.
+fn hash(i: usize, axis: u32) -> f32 {
+    let mut x = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ ((axis as u64 + 1) << 32);
+    x ^= x >> 31;
+    x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x ^= x >> 29;
+    (x % 2_000_001) as f32 / 1_000_000.0 - 1.0
+}
+
+/// Kinetic energy of the free particles, J.
+pub fn kinetic(cloth: &solver::Cloth) -> f64 {
+    let p = cloth.particles();
+    (0..p.len())
+        .filter(|&i| !p.is_pinned(i))
+        .map(|i| 0.5 * p.mass[i] as f64 * p.velocity[i].length_squared() as f64)
+        .sum()
+}
+
+/// Why a probe failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum Failure {
+    /// A position or velocity went non-finite.
+    NonFinite,
+    /// A structural spring passed 100% strain.
+    Strain,
+    /// Kinetic energy grew tenfold.
+    EnergyGrowth,
+}
+
+/// Steps `cloth` `steps` times by `dt` with no input and says whether and how it failed.
+pub fn probe(cloth: &mut solver::Cloth, dt: f32, steps: usize) -> Option<Failure> {
+    let env = quiet();
+    let quarter = (steps / 4).max(1);
+    let mut early = cloth.energy(&env).total() as f64;
+    let mut late = 0.0f64;
+    for step in 1..=steps {
+        cloth.step(dt, &env);
+        if !cloth.is_finite() {
+            return Some(Failure::NonFinite);
+        }
+        if cloth.strain().max > 1.0 {
+            return Some(Failure::Strain);
+        }
+        let ke = kinetic(cloth);
+        if step <= quarter {
+            early = early.max(ke);
+        } else {
+            late = late.max(ke);
+            if late > 10.0 * early {
+                return Some(Failure::EnergyGrowth);
+            }
+        }
+    }
+    None
+}
+
+/// The probe cloth of the grid: [`PROBE_SIZE`]² particles, nothing pinned, perturbed by
+/// 1% of the spacing.
+pub fn probe_cloth(params: &ClothParams) -> Result<solver::Cloth, ClothError> {
+    let shape = ClothShape::Grid {
+        width: PROBE_SIZE,
+        height: PROBE_SIZE,
+        spacing: SPACING,
+    };
+    let mut cloth = solver::Cloth::new(&shape, &Pins::None, params, Affine3A::IDENTITY)?;
+    perturb(&mut cloth, SPACING, 0.01);
+    Ok(cloth)
+}
+
+/// One cell of the grid.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Cell {
+    /// The model.
+    pub model: String,
+    /// `Verlet` or `SemiImplicitEuler`.
+    pub integrator: Integrator,
+    /// Automatic substeps (else one substep per step).
+    pub auto: bool,
+    /// Stiffness, N/m.
+    pub stiffness: f32,
+    /// Node mass, kg.
+    pub mass: f32,
+    /// Timestep, s.
+    pub timestep: f32,
+    /// `√(k/m)`, rad/s.
+    pub omega0: f32,
+    /// Substeps of the last step.
+    pub substeps: u32,
+    /// The automatic substeps hit their limit (8192).
+    pub under_resolved: bool,
+    /// What failed, if anything.
+    pub failure: Option<Failure>,
+}
+
+/// Runs one cell for one simulated second (at least 30 steps).
+pub fn cell(
+    model: &str,
+    integrator: Integrator,
+    auto: bool,
+    k: f32,
+    m: f32,
+    dt: f32,
+) -> Result<Cell, ClothError> {
+    let substeps = if auto {
+        Substeps::default()
+    } else {
+        Substeps::Fixed(1)
+    };
+    let params = params(model, k, m, integrator, substeps).ok_or_else(|| ClothError::BadMesh {
+        reason: format!("no model `{model}`"),
+    })?;
+    let mut cloth = probe_cloth(&params)?;
+    let steps = ((1.0 / dt).ceil() as usize).max(30);
+    let failure = probe(&mut cloth, dt, steps);
+    Ok(Cell {
+        model: model.to_string(),
+        integrator,
+        auto,
+        stiffness: k,
+        mass: m,
+        timestep: dt,
+        omega0: (k / m).sqrt(),
+        substeps: cloth.substeps(),
+        under_resolved: cloth.under_resolved(),
+        failure,
+    })
+}
+
+/// ω_max of the mass-spring lattice linearised at its current (rest) state: the square
+/// root of the largest eigenvalue of `M⁻¹K`, by power iteration. `K u` sums, over the
+/// acting springs, `k d̂ d̂ᵀ (u_b − u_a)`: at rest length a spring has no geometric
+/// stiffness across itself.
+pub fn lattice_omega_max(cloth: &solver::Cloth) -> f32 {
+    let p = cloth.particles();
+    let s = cloth.springs();
+    let n = p.len();
+    let mut u: Vec<Vec3> = (0..n)
+        .map(|i| Vec3::new(hash(i, 3), hash(i, 4), hash(i, 5)))
+        .collect();
+    let mut y = vec![Vec3::ZERO; n];
+    let mut lambda = 0.0f32;
+    for _ in 0..2_000 {
+        y.fill(Vec3::ZERO);
+        for kind in SpringKind::ALL {
+            let k = cloth.stiffness(kind);
+            if k == 0.0 {
+                continue;
+            }
+            for i in s.ranges[kind as usize].clone() {
+                if !s.alive[i] {
+                    continue;
+                }
+                let (a, b) = (s.a[i] as usize, s.b[i] as usize);
+                let d = (p.position[b] - p.position[a]).normalize_or_zero();
+                let f = d * (k * d.dot(u[b] - u[a]));
+                y[a] -= f;
+                y[b] += f;
+            }
+        }
+        let mut norm = 0.0f32;
+        for i in 0..n {
+            // −M⁻¹K u: the restoring acceleration, positive definite as −.
+            y[i] *= -p.inv_mass[i];
+            norm += y[i].length_squared();
+        }
+        let norm = norm.sqrt();
+        let u_norm = u.iter().map(|v| v.length_squared()).sum::<f32>().sqrt();
+        if norm == 0.0 || u_norm == 0.0 {
+            return 0.0;
+        }
+        lambda = norm / u_norm;
+        for i in 0..n {
+            u[i] = y[i] / norm;
+        }
+    }
+    lambda.sqrt()
+}
+
+/// The largest step the solver's own automatic substeps take as one substep (its
+/// Gershgorin bound with the 0.8 safety factor), by bisection on
+/// [`solver::Cloth::stable_substeps`].
+pub fn auto_bound(cloth: &solver::Cloth) -> f32 {
+    let (mut lo, mut hi) = (1e-7f32, 1.0f32);
+    for _ in 0..60 {
+        let mid = (lo * hi).sqrt();
+        if cloth.stable_substeps(mid) <= 1 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
+}
+
+/// The largest stable step found by bisection: `make` builds the perturbed cloth
+/// afresh for each try, and a try runs `steps` single-substep steps.
+pub fn measured_threshold(
+    mut make: impl FnMut() -> Result<solver::Cloth, ClothError>,
+    guess: f32,
+    steps: usize,
+) -> Result<f32, ClothError> {
+    let fails = |dt: f32, cloth: &mut solver::Cloth| probe(cloth, dt, steps).is_some();
+    let (mut lo, mut hi) = (guess * 0.25, guess * 4.0);
+    if fails(lo, &mut make()?) || !fails(hi, &mut make()?) {
+        return Err(ClothError::BadMesh {
+            reason: format!("no threshold between {lo} and {hi} s"),
+        });
+    }
+    for _ in 0..30 {
+        let mid = (lo * hi).sqrt();
+        if fails(mid, &mut make()?) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(lo)
+}
+
+/// A row of the threshold table.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Threshold {
+    /// What was measured.
+    pub case: String,
+    /// Stiffness, N/m.
+    pub stiffness: f32,
+    /// Node mass, kg.
+    pub mass: f32,
+    /// ω_max used for the prediction, rad/s.
+    pub omega_max: f32,
+    /// `2 / ω_max`, s.
+    pub predicted: f32,
+    /// The largest step the automatic substeps allow as one substep, s.
+    pub auto_bound: f32,
+    /// The largest stable step found, s.
+    pub measured: f32,
+}
+
+/// A single spring from a pinned particle to a free one of mass `m`: `ω = √(k/m)`.
+pub fn single_spring(k: f32, m: f32, integrator: Integrator) -> Result<Threshold, ClothError> {
+    let springs = SpringParams {
+        structural: SpringFamily::new(k),
+        shear: SpringFamily::off(k),
+        bend: SpringFamily::off(k),
+        bend_diagonal: SpringFamily::off(k),
+        ..SpringParams::from_structural(k)
+    };
+    let params = ClothParams {
+        springs,
+        ..params("mass-spring", k, m, integrator, Substeps::Fixed(1)).expect("model")
+    };
+    let make = || {
+        let mut cloth = solver::Cloth::from_springs(
+            &[Vec3::ZERO, Vec3::X * SPACING],
+            &[[0, 1]],
+            &Pins::Indices(vec![0]),
+            &params,
+            Affine3A::IDENTITY,
+        )?;
+        // Stretched along the spring by 1%.
+        let p = cloth.particles_mut();
+        p.position[1].x += SPACING * 0.01;
+        p.previous[1] = p.position[1];
+        Ok(cloth)
+    };
+    let omega = (k / m).sqrt();
+    let auto = auto_bound(&make()?);
+    let measured = measured_threshold(make, 2.0 / omega, 400)?;
+    Ok(Threshold {
+        case: format!("single spring, {integrator:?}"),
+        stiffness: k,
+        mass: m,
+        omega_max: omega,
+        predicted: 2.0 / omega,
+        auto_bound: auto,
+        measured,
+    })
+}
+
+/// The full [`PROBE_SIZE`]² lattice (structural, shear, bend at 2:1:1): `ω_max` from
+/// [`lattice_omega_max`].
+pub fn lattice(k: f32, m: f32, integrator: Integrator) -> Result<Threshold, ClothError> {
+    let params = params("mass-spring", k, m, integrator, Substeps::Fixed(1)).expect("model");
+    let make = || probe_cloth(&params);
+    let rest = solver::Cloth::new(
+        &ClothShape::Grid {
+            width: PROBE_SIZE,
+            height: PROBE_SIZE,
+            spacing: SPACING,
+        },
+        &Pins::None,
+        &params,
+        Affine3A::IDENTITY,
+    )?;
+    let omega = lattice_omega_max(&rest);
+    let auto = auto_bound(&rest);
+    let measured = measured_threshold(make, 2.0 / omega, 400)?;
+    Ok(Threshold {
+        case: format!("{PROBE_SIZE}×{PROBE_SIZE} lattice, {integrator:?}"),
+        stiffness: k,
+        mass: m,
+        omega_max: omega,
+        predicted: 2.0 / omega,
+        auto_bound: auto,
+        measured,
+    })
+}
+
+/// `ω_max / √(k/m)` of the mass-spring lattice: the same for every `k` and `m`, since
+/// all families scale with `k`.
+pub fn lattice_factor() -> f32 {
+    let (k, m) = (1000.0, 1e-4);
+    let params =
+        params("mass-spring", k, m, Integrator::Verlet, Substeps::Fixed(1)).expect("model");
+    let shape = ClothShape::Grid {
+        width: PROBE_SIZE,
+        height: PROBE_SIZE,
+        spacing: SPACING,
+    };
+    solver::Cloth::new(&shape, &Pins::None, &params, Affine3A::IDENTITY)
+        .map_or(f32::NAN, |c| lattice_omega_max(&c) / (k / m).sqrt())
+}

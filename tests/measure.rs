@@ -1,0 +1,150 @@
+//! The measuring instruments checked against answers known without them: the explicit
+//! stability bound of a single spring, the largest frequency of a lattice, the error
+//! metric of a known displacement, and the full app's frame loop.
+
+use bevy::math::Vec3;
+use bevy_cloth::measure::accuracy::{Case, SAMPLE_INTERVAL, Trajectory};
+use bevy_cloth::measure::{fps, stability};
+use bevy_cloth::prelude::*;
+
+#[test]
+fn a_single_spring_goes_unstable_at_omega_h_2() {
+    // x'' = −ω² x by Verlet or symplectic Euler: |eigenvalues| = 1 while h ω ≤ 2.
+    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        for (k, m) in [(100.0, 1e-3), (25_000.0, 1e-6)] {
+            let t = stability::single_spring(k, m, integrator).unwrap();
+            let ratio = t.measured / t.predicted;
+            assert!(
+                (0.98..=1.005).contains(&ratio),
+                "{integrator:?}, k {k}, m {m}: measured {} s against 2/ω = {} s",
+                t.measured,
+                t.predicted
+            );
+            // The automatic substeps stay inside the bound.
+            assert!(t.auto_bound < t.measured, "{t:?}");
+        }
+    }
+}
+
+#[test]
+fn the_lattice_fails_where_its_largest_frequency_says() {
+    let t = stability::lattice(1_000.0, 1e-4, Integrator::Verlet).unwrap();
+    // Gershgorin's bound (what the automatic substeps use) is below the true ω_max, and
+    // the power iteration's ω_max predicts the measured threshold.
+    let ratio = t.measured / t.predicted;
+    assert!((0.95..=1.05).contains(&ratio), "{t:?}");
+    assert!(t.auto_bound < t.measured, "{t:?}");
+    // ω_max scales with √(k/m): the factor is the same at another stiffness and mass.
+    let other = stability::lattice(10_000.0, 1e-5, Integrator::Verlet).unwrap();
+    let factor = |t: &stability::Threshold| t.omega_max / (t.stiffness / t.mass).sqrt();
+    assert!((factor(&t) - factor(&other)).abs() < 0.01 * factor(&t));
+    assert!((factor(&t) - stability::lattice_factor()).abs() < 0.01 * factor(&t));
+}
+
+#[test]
+fn grid_cells_fail_past_the_bound_and_not_with_auto_substeps() {
+    // k = 1000 N/m, 0.1 g: ω₀ = 3162 rad/s, ω_max ≈ 3.9·ω₀ by the lattice factor.
+    let fixed = |dt| stability::cell("mass-spring", Integrator::Verlet, false, 1_000.0, 1e-4, dt);
+    assert_eq!(fixed(0.0001).unwrap().failure, None);
+    assert!(fixed(0.004).unwrap().failure.is_some());
+    let auto = stability::cell(
+        "mass-spring",
+        Integrator::Verlet,
+        true,
+        1_000.0,
+        1e-4,
+        0.004,
+    )
+    .unwrap();
+    assert_eq!(auto.failure, None);
+    assert!(auto.substeps > 1);
+}
+
+fn trajectory(samples: Vec<Vec<Vec3>>, diagonal: f32) -> Trajectory {
+    Trajectory {
+        samples,
+        milliseconds: 0.0,
+        max_strain: 0.0,
+        energy_start: 0.0,
+        energy_end: 0.0,
+        failed_at: None,
+        mean_substeps: 1.0,
+        mass: 1.0,
+        diagonal,
+    }
+}
+
+#[test]
+fn the_error_is_the_rms_distance_over_the_diagonal() {
+    let reference = trajectory(vec![vec![Vec3::ZERO; 4]; 3], 2.0);
+    assert_eq!(reference.error_against(&reference), Some((0.0, 0.0)));
+    // Every particle 0.1 m off in the last sample only: RMS over 3 samples is
+    // 0.1·√(1/3); the final drape's error is 0.1; both over the 2 m diagonal.
+    let mut moved = reference.samples.clone();
+    moved[2] = vec![Vec3::new(0.0, 0.1, 0.0); 4];
+    let (all, last) = trajectory(moved, 2.0).error_against(&reference).unwrap();
+    assert!((all - 0.1 / 3f64.sqrt() / 2.0).abs() < 1e-7, "{all}");
+    assert!((last - 0.05).abs() < 1e-7, "{last}");
+    // A run that failed early has fewer samples: no error.
+    assert_eq!(
+        trajectory(vec![vec![Vec3::ZERO; 4]; 2], 2.0).error_against(&reference),
+        None
+    );
+}
+
+#[test]
+fn samples_are_every_tenth_of_a_second_on_every_configuration_alike() {
+    let scene = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    let case = Case::new("curtain", &scene, 0, 3.0).unwrap();
+    let steps = case.sample_steps();
+    assert_eq!(steps.len(), 30);
+    let dt = scene.timestep as f64;
+    for (k, s) in steps.iter().enumerate() {
+        let t = *s as f64 * dt;
+        // The first step at or past each 0.1 s.
+        assert!(
+            t + 1e-9 >= (k + 1) as f64 * SAMPLE_INTERVAL
+                && t < (k + 1) as f64 * SAMPLE_INTERVAL + dt
+        );
+    }
+    // The reference must be mass-spring.
+    let card = ClothScene::load("assets/scenes/card.ron").unwrap();
+    assert!(Case::new("card", &card, 0, 3.0).is_err());
+}
+
+#[test]
+fn a_coarse_configuration_is_further_from_the_reference_than_a_fine_one() {
+    let mut scene = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    scene.apply_override("cloth.shape.width=12").unwrap();
+    scene.apply_override("cloth.shape.height=10").unwrap();
+    let case = Case::new("small curtain", &scene, 0, 1.0).unwrap();
+    let (_, reference) = case.reference(16).unwrap();
+    let error = |substeps| {
+        let params = ClothParams {
+            substeps,
+            ..case.base()
+        };
+        let run = case.simulate(&params).unwrap();
+        run.error_against(&reference).expect("stable").0
+    };
+    let auto = error(Substeps::default());
+    let finer = error(Substeps::Fixed(
+        4 * bevy_cloth::measure::SceneRun::new(&case.scene)
+            .unwrap()
+            .cloths[0]
+            .1
+            .stable_substeps(scene.timestep),
+    ));
+    assert!(
+        finer < auto,
+        "4× the automatic substeps: {finer}, automatic: {auto}"
+    );
+}
+
+#[test]
+fn the_full_app_steps_and_writes_the_mesh_each_frame() {
+    let row = fps::app_frame("1", 100, 3, 5).unwrap();
+    assert_eq!(row.particles, 100);
+    assert!(row.ms_per_frame > 0.0 && row.fps.is_finite());
+    assert_eq!(row.seed_fps, Some(60.0));
+}
