@@ -119,6 +119,7 @@ fn draw_bench<DB: DrawingBackend>(
         .configure_mesh()
         .x_desc("particles")
         .y_desc("ms per step (app: ms per frame)")
+        .x_label_formatter(&|x| format!("{x:.0}"))
         .label_style((FONT, 15))
         .axis_desc_style((FONT, 17))
         .draw()
@@ -155,40 +156,39 @@ fn draw_bench<DB: DrawingBackend>(
             .zip(SEED_MS[m])
             .filter(|(_, ms)| *ms > 0.0)
             .map(|(&c, ms)| TriangleMarker::new((c as f64, ms), 6, color.stroke_width(2)));
-        chart.draw_series(seed).map_err(err)?;
+        let series = chart.draw_series(seed).map_err(err)?;
+        if m == 0 {
+            series
+                .label("seed 000 Slika 23 (hollow triangles, model colour)")
+                .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
+        }
     }
-    if !app.is_empty() {
+    let mut app_models: Vec<&str> = app.iter().map(|a| a.model.as_str()).collect();
+    app_models.dedup();
+    for (i, model) in app_models.iter().enumerate() {
+        let color = if i == 0 { BLACK } else { RGBColor(120, 120, 120) };
         let line: Vec<(f64, f64)> = app
             .iter()
+            .filter(|a| a.model == *model)
             .map(|a| (a.particles as f64, a.ms_per_frame))
             .collect();
         chart
-            .draw_series(LineSeries::new(line.clone(), BLACK.stroke_width(2)))
+            .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
             .map_err(err)?
-            .label(format!("full app, model {}: ms per frame", app[0].model))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+            .label(format!("full app, model {model}: ms per frame"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
         chart
-            .draw_series(line.iter().map(|&p| Circle::new(p, 4, BLACK.filled())))
+            .draw_series(line.iter().map(|&p| Circle::new(p, 4, color.filled())))
             .map_err(err)?;
     }
     chart
-        .draw_series(
-            SEED_002_FPS
-                .iter()
-                .map(|&(c, f)| Rectangle::new(square((c as f64, 1e3 / f)), BLACK.stroke_width(2))),
-        )
+        .draw_series(SEED_002_FPS.iter().map(|&(c, f)| {
+            EmptyElement::at((c as f64, 1e3 / f))
+                + Rectangle::new([(-5, -5), (5, 5)], BLACK.stroke_width(2))
+        }))
         .map_err(err)?
         .label("seed 002 table 4.1: 1000 / fps (hollow squares)")
         .legend(|(x, y)| Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], BLACK.stroke_width(2)));
-    chart
-        .draw_series(std::iter::once(TriangleMarker::new(
-            (f64::NAN, f64::NAN),
-            6,
-            BLACK.stroke_width(2),
-        )))
-        .map_err(err)?
-        .label("seed 000 Slika 23 (hollow triangles, model colour)")
-        .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::UpperLeft)
@@ -198,12 +198,6 @@ fn draw_bench<DB: DrawingBackend>(
         .draw()
         .map_err(err)?;
     Ok(())
-}
-
-/// A small square around a point of a log-log chart, in data units.
-fn square((x, y): (f64, f64)) -> [(f64, f64); 2] {
-    let f = 1.08;
-    [(x / f, y / f), (x * f, y * f)]
 }
 
 // ----- accuracy -----------------------------------------------------------------------
@@ -252,6 +246,10 @@ fn draw_accuracy<DB: DrawingBackend>(
             .configure_mesh()
             .x_desc("ms per simulated second")
             .y_desc("RMS error / diagonal")
+            .x_labels(6)
+            .y_labels(6)
+            .x_label_formatter(&|x| format!("{x:.3}"))
+            .y_label_formatter(&|y| format!("{y:.3}"))
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
             .draw()
@@ -285,7 +283,9 @@ fn draw_accuracy<DB: DrawingBackend>(
             let anno = match m {
                 0 => chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, style))),
                 1 => chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, 7, style))),
-                _ => chart.draw_series(points.iter().map(|&p| Rectangle::new(square(p), style))),
+                _ => chart.draw_series(points.iter().map(|&p| {
+                    EmptyElement::at(p) + Rectangle::new([(-5, -5), (5, 5)], style)
+                })),
             }
             .map_err(err)?;
             anno.label(*model).legend(move |(x, y)| match m {
@@ -357,6 +357,7 @@ fn draw_stability<DB: DrawingBackend>(
             .configure_mesh()
             .x_desc("h, s")
             .y_desc("√(k/m), rad/s")
+            .y_label_formatter(&|y| format!("{y:.0}"))
             .label_style((FONT, 12))
             .axis_desc_style((FONT, 13))
             .x_labels(4)
