@@ -261,20 +261,18 @@ pub fn lattice_omega_max(cloth: &solver::Cloth) -> f32 {
                 y[b] += f;
             }
         }
-        let mut norm = 0.0f32;
-        for i in 0..n {
-            // −M⁻¹K u: the restoring acceleration, positive definite as −.
-            y[i] *= -p.inv_mass[i];
-            norm += y[i].length_squared();
+        // y = M⁻¹K u (pinned particles have no inverse mass and do not move).
+        for (y, w) in y.iter_mut().zip(&p.inv_mass) {
+            *y *= *w;
         }
-        let norm = norm.sqrt();
+        let norm = y.iter().map(|v| v.length_squared()).sum::<f32>().sqrt();
         let u_norm = u.iter().map(|v| v.length_squared()).sum::<f32>().sqrt();
         if norm == 0.0 || u_norm == 0.0 {
             return 0.0;
         }
         lambda = norm / u_norm;
-        for i in 0..n {
-            u[i] = y[i] / norm;
+        for (u, y) in u.iter_mut().zip(&y) {
+            *u = *y / norm;
         }
     }
     lambda.sqrt()

@@ -166,7 +166,11 @@ fn draw_bench<DB: DrawingBackend>(
     let mut app_models: Vec<&str> = app.iter().map(|a| a.model.as_str()).collect();
     app_models.dedup();
     for (i, model) in app_models.iter().enumerate() {
-        let color = if i == 0 { BLACK } else { RGBColor(120, 120, 120) };
+        let color = if i == 0 {
+            BLACK
+        } else {
+            RGBColor(120, 120, 120)
+        };
         let line: Vec<(f64, f64)> = app
             .iter()
             .filter(|a| a.model == *model)
@@ -176,7 +180,9 @@ fn draw_bench<DB: DrawingBackend>(
             .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
             .map_err(err)?
             .label(format!("full app, model {model}: ms per frame"))
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
         chart
             .draw_series(line.iter().map(|&p| Circle::new(p, 4, color.filled())))
             .map_err(err)?;
@@ -283,9 +289,11 @@ fn draw_accuracy<DB: DrawingBackend>(
             let anno = match m {
                 0 => chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, style))),
                 1 => chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, 7, style))),
-                _ => chart.draw_series(points.iter().map(|&p| {
-                    EmptyElement::at(p) + Rectangle::new([(-5, -5), (5, 5)], style)
-                })),
+                _ => chart.draw_series(
+                    points
+                        .iter()
+                        .map(|&p| EmptyElement::at(p) + Rectangle::new([(-5, -5), (5, 5)], style)),
+                ),
             }
             .map_err(err)?;
             anno.label(*model).legend(move |(x, y)| match m {

@@ -621,10 +621,10 @@ fn stability(args: &[String]) -> Result<(), String> {
     println!("|---|---:|---:|---:|---:|---:|---:|---:|");
     for t in &thresholds {
         println!(
-            "| {} | {} | {} | {:.0} | {:.4} | {:.4} | {:.4} | {:.3} |",
+            "| {} | {} | {:.3} | {:.0} | {:.4} | {:.4} | {:.4} | {:.3} |",
             t.case,
             t.stiffness,
-            format!("{:.3}", t.mass * 1e3),
+            t.mass * 1e3,
             t.omega_max,
             t.predicted * 1e3,
             t.auto_bound * 1e3,
