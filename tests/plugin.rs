@@ -1,26 +1,12 @@
 //! Headless App tests of `ClothPlugin`: MinimalPlugins, manual time, no window.
 
-use std::time::Duration;
-
-use bevy::asset::AssetPlugin;
 use bevy::ecs::message::Messages;
 use bevy::mesh::{Mesh, Mesh3d, VertexAttributeValues};
 use bevy::prelude::*;
-use bevy::time::TimeUpdateStrategy;
 use bevy_cloth::prelude::*;
 
 fn app() -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        ClothPlugin::default(),
-    ))
-    .init_asset::<Mesh>()
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
-        16,
-    )));
-    app
+    bevy_cloth::measure::fps::headless_app()
 }
 
 /// Default parameters: automatic substeps keep them stable.

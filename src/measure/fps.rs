@@ -49,6 +49,22 @@ pub struct AppFrame {
     pub seed_fps: Option<f64>,
 }
 
+/// The app without a window: `MinimalPlugins`, assets, meshes and `ClothPlugin`, with
+/// time advanced by exactly one 16 ms fixed step per `update`.
+pub fn headless_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        ClothPlugin::default(),
+    ))
+    .init_asset::<Mesh>()
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+        16,
+    )));
+    app
+}
+
 /// Runs the app with one curtain of `count` particles (5 cm grid, top corners pinned,
 /// default gravity and wind) of `model`: `warmup` frames, then the median of `frames`.
 pub fn app_frame(
@@ -61,16 +77,7 @@ pub fn app_frame(
         reason: format!("no model `{model}` (1, 2, 3a, 3b, 3c)"),
     })?;
     let (width, height) = grid_for(count);
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        ClothPlugin::default(),
-    ))
-    .init_asset::<Mesh>()
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
-        16,
-    )));
+    let mut app = headless_app();
     let entity = app
         .world_mut()
         .spawn((

@@ -161,14 +161,39 @@ pub fn probe(cloth: &mut solver::Cloth, dt: f32, steps: usize) -> Option<Failure
 /// The probe cloth of the grid: [`PROBE_SIZE`]² particles, nothing pinned, perturbed by
 /// 1% of the spacing.
 pub fn probe_cloth(params: &ClothParams) -> Result<solver::Cloth, ClothError> {
+    let mut cloth = rest_lattice(params)?;
+    perturb(&mut cloth, SPACING, 0.01);
+    Ok(cloth)
+}
+
+/// The probe cloth at rest, unperturbed.
+fn rest_lattice(params: &ClothParams) -> Result<solver::Cloth, ClothError> {
     let shape = ClothShape::Grid {
         width: PROBE_SIZE,
         height: PROBE_SIZE,
         spacing: SPACING,
     };
-    let mut cloth = solver::Cloth::new(&shape, &Pins::None, params, Affine3A::IDENTITY)?;
-    perturb(&mut cloth, SPACING, 0.01);
-    Ok(cloth)
+    solver::Cloth::new(&shape, &Pins::None, params, Affine3A::IDENTITY)
+}
+
+/// Measures the threshold of cloths from `make` and fills in the table row.
+fn threshold(
+    case: String,
+    k: f32,
+    m: f32,
+    omega: f32,
+    make: impl FnMut() -> Result<solver::Cloth, ClothError>,
+    auto_bound: f32,
+) -> Result<Threshold, ClothError> {
+    Ok(Threshold {
+        case,
+        stiffness: k,
+        mass: m,
+        omega_max: omega,
+        predicted: 2.0 / omega,
+        auto_bound,
+        measured: measured_threshold(make, 2.0 / omega, 400)?,
+    })
 }
 
 /// One cell of the grid.
@@ -365,47 +390,26 @@ pub fn single_spring(k: f32, m: f32, integrator: Integrator) -> Result<Threshold
         p.previous[1] = p.position[1];
         Ok(cloth)
     };
-    let omega = (k / m).sqrt();
     let auto = auto_bound(&make()?);
-    let measured = measured_threshold(make, 2.0 / omega, 400)?;
-    Ok(Threshold {
-        case: format!("single spring, {integrator:?}"),
-        stiffness: k,
-        mass: m,
-        omega_max: omega,
-        predicted: 2.0 / omega,
-        auto_bound: auto,
-        measured,
-    })
+    let case = format!("single spring, {integrator:?}");
+    threshold(case, k, m, (k / m).sqrt(), make, auto)
 }
 
 /// The full [`PROBE_SIZE`]² lattice (structural, shear, bend at 2:1:1): `ω_max` from
 /// [`lattice_omega_max`].
 pub fn lattice(k: f32, m: f32, integrator: Integrator) -> Result<Threshold, ClothError> {
     let params = params("mass-spring", k, m, integrator, Substeps::Fixed(1)).expect("model");
+    let rest = rest_lattice(&params)?;
+    let case = format!("{PROBE_SIZE}×{PROBE_SIZE} lattice, {integrator:?}");
     let make = || probe_cloth(&params);
-    let rest = solver::Cloth::new(
-        &ClothShape::Grid {
-            width: PROBE_SIZE,
-            height: PROBE_SIZE,
-            spacing: SPACING,
-        },
-        &Pins::None,
-        &params,
-        Affine3A::IDENTITY,
-    )?;
-    let omega = lattice_omega_max(&rest);
-    let auto = auto_bound(&rest);
-    let measured = measured_threshold(make, 2.0 / omega, 400)?;
-    Ok(Threshold {
-        case: format!("{PROBE_SIZE}×{PROBE_SIZE} lattice, {integrator:?}"),
-        stiffness: k,
-        mass: m,
-        omega_max: omega,
-        predicted: 2.0 / omega,
-        auto_bound: auto,
-        measured,
-    })
+    threshold(
+        case,
+        k,
+        m,
+        lattice_omega_max(&rest),
+        make,
+        auto_bound(&rest),
+    )
 }
 
 /// `ω_max / √(k/m)` of the mass-spring lattice: the same for every `k` and `m`, since
@@ -414,11 +418,5 @@ pub fn lattice_factor() -> f32 {
     let (k, m) = (1000.0, 1e-4);
     let params =
         params("mass-spring", k, m, Integrator::Verlet, Substeps::Fixed(1)).expect("model");
-    let shape = ClothShape::Grid {
-        width: PROBE_SIZE,
-        height: PROBE_SIZE,
-        spacing: SPACING,
-    };
-    solver::Cloth::new(&shape, &Pins::None, &params, Affine3A::IDENTITY)
-        .map_or(f32::NAN, |c| lattice_omega_max(&c) / (k / m).sqrt())
+    rest_lattice(&params).map_or(f32::NAN, |c| lattice_omega_max(&c) / (k / m).sqrt())
 }
