@@ -459,3 +459,41 @@ fn shape_matching_works_with_pins_gravity_and_wind_and_never_tears() {
     assert!(centre.y < pin.y - 0.03, "centre {centre} vs pin {pin}");
     assert!(shape_error(&mut c) < 0.01);
 }
+
+#[test]
+fn goal_forces_conserve_momentum_on_a_free_cloth() {
+    // Until the goal offsets were formed from relative positions with each cluster's
+    // mean removed, the f32 rounding of the centre of mass acted as a net force: the
+    // first of these cloths drifted at ~1 m/s² and its energy grew 40× in one second.
+    use bevy_cloth::measure::stability;
+    for (k, m) in [(1_000.0, 1e-4), (25_000.0, 1e-6), (100.0, 1e-5)] {
+        for clusters in [1, 3] {
+            let mut params = stability::params(
+                "shape-matching",
+                k,
+                m,
+                Integrator::Verlet,
+                Substeps::default(),
+            )
+            .unwrap();
+            if let Model::ShapeMatching(sm) = &mut params.model {
+                sm.clusters = clusters;
+            }
+            let mut cloth = stability::probe_cloth(&params).unwrap();
+            let env = stability::quiet();
+            let e0 = cloth.energy(&env).total() as f64;
+            assert_eq!(stability::probe(&mut cloth, 0.001, 1000), None);
+            let p = cloth.particles();
+            let total: f32 = p.mass.iter().sum();
+            let momentum: Vec3 = (0..p.len()).map(|i| p.velocity[i] * p.mass[i]).sum();
+            // Against the momentum of the whole cloth moving at the perturbation's speed.
+            let v_scale = (2.0 * e0 / total as f64).sqrt() as f32;
+            assert!(
+                momentum.length() < 1e-3 * total * v_scale,
+                "k {k}, m {m}, {clusters}×{clusters}: momentum {momentum} against {}",
+                total * v_scale
+            );
+            assert!(stability::kinetic(&cloth) <= 2.0 * e0, "k {k}, m {m}");
+        }
+    }
+}

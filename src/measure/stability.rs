@@ -88,7 +88,7 @@ pub fn quiet() -> Environment {
 }
 
 /// Displaces every free particle by up to `fraction` of `spacing` in each axis
-/// (a fixed hash, the same every run), at rest.
+/// (a fixed hash, the same every run), at rest, and updates the model's goals.
 pub fn perturb(cloth: &mut solver::Cloth, spacing: f32, fraction: f32) {
     let p = cloth.particles_mut();
     for i in 0..p.len() {
@@ -100,6 +100,8 @@ pub fn perturb(cloth: &mut solver::Cloth, spacing: f32, fraction: f32) {
         p.previous[i] = p.position[i];
         p.velocity[i] = Vec3::ZERO;
     }
+    // Goals and targets of the displaced cloth, so its energy counts the displacement.
+    cloth.update_goals();
 }
 
 /// A number in [−1, 1] from `(i, axis)`.

@@ -93,7 +93,7 @@ impl Cloth {
         };
         let (l, exponent) = (self.length_scale, sm.exponent);
         for i in 0..p.position.len() {
-            let d = state.goals[i] - p.position[i];
+            let d = state.offsets[i];
             p.force[i] += d * (sm.stiffness * pull_scale(d.length(), l, exponent));
         }
     }

@@ -81,7 +81,7 @@ impl Cloth {
             if p.inv_mass[i] == 0.0 {
                 continue;
             }
-            let delta = (state.goals[i] - p.position[i]) * sm.stiffness;
+            let delta = state.offsets[i] * sm.stiffness;
             p.position[i] += delta;
             p.velocity[i] += delta / h;
         }

@@ -933,7 +933,7 @@ impl Cloth {
                 let l = self.length_scale;
                 for i in 0..p.len() {
                     if p.inv_mass[i] > 0.0 {
-                        let d = state.goals[i].distance(p.position[i]) / l;
+                        let d = state.offsets[i].length() / l;
                         e.spring +=
                             sm.stiffness * l * l * d.powf(sm.exponent + 1.0) / (sm.exponent + 1.0);
                     }

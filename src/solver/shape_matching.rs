@@ -4,7 +4,7 @@
 
 use bevy::math::{Mat3, Quat, Vec3, Vec4};
 
-use crate::params::{RotationMethod, ShapeMatchingParams};
+use crate::params::{GoalUpdate, RotationMethod, ShapeMatchingParams};
 
 /// One cluster: a set of particles matched together.
 #[derive(Clone, Debug)]
@@ -26,6 +26,9 @@ pub struct ShapeMatching {
     clusters: Vec<Cluster>,
     /// Goal position of every particle (the mean over the clusters that hold it).
     pub goals: Vec<Vec3>,
+    /// `goal − position` of every particle, computed without forming the goal: what the
+    /// forces use (see [`ShapeMatching::compute_goals`]).
+    pub offsets: Vec<Vec3>,
     /// `1 / (number of clusters holding the particle)`.
     inv_cluster_count: Vec<f32>,
     /// The `k` of k×k clusters these were built for.
@@ -67,12 +70,7 @@ impl ShapeMatching {
         let clusters = members
             .into_iter()
             .map(|particles| {
-                let total: f32 = particles.iter().map(|&i| mass[i as usize]).sum();
-                let com = particles
-                    .iter()
-                    .map(|&i| rest[i as usize] * mass[i as usize])
-                    .sum::<Vec3>()
-                    / total;
+                let com = centre_of_mass(&particles, rest, mass);
                 let rest_offsets: Vec<Vec3> =
                     particles.iter().map(|&i| rest[i as usize] - com).collect();
                 let mut a_qq = Mat3::ZERO;
@@ -92,6 +90,7 @@ impl ShapeMatching {
         ShapeMatching {
             clusters,
             goals: rest.to_vec(),
+            offsets: vec![Vec3::ZERO; n],
             inv_cluster_count: count.iter().map(|&c| 1.0 / c.max(1.0)).collect(),
             built_for: k,
         }
@@ -112,16 +111,19 @@ impl ShapeMatching {
 
     /// Goals `g_i = G (x_i0 − x_cm0) + x_cm` (seed 000 eq. 12) from the current positions,
     /// with `G = R` or Müller's `β A + (1 − β) R`. Allocates nothing.
+    ///
+    /// The offsets `g_i − x_i = G q_i − (x_i − x_cm)` are formed from the small relative
+    /// positions, and each cluster's mean offset is removed (weighted as the update moves
+    /// the particles), so a cluster's pushes sum to zero and conserve momentum, as Müller
+    /// et al. 2005's do for one cluster in exact arithmetic. In `f32` the mean would
+    /// otherwise be the rounding of the centre of mass (1e-8–1e-6 m on a 144-particle
+    /// cloth), a net force `α N δ` that accelerates the whole cloth at `δ α/m` and, at stiff
+    /// pulls on light particles, pumped energy into it; overlapping clusters averaged per
+    /// particle would not conserve momentum even in exact arithmetic.
     pub fn compute_goals(&mut self, x: &[Vec3], mass: &[f32], params: &ShapeMatchingParams) {
-        self.goals.fill(Vec3::ZERO);
+        self.offsets.fill(Vec3::ZERO);
         for c in &mut self.clusters {
-            let mut total = 0.0;
-            let mut com = Vec3::ZERO;
-            for &i in &c.particles {
-                total += mass[i as usize];
-                com += x[i as usize] * mass[i as usize];
-            }
-            com /= total; // seed 000 eq. 4
+            let com = centre_of_mass(&c.particles, x, mass); // seed 000 eq. 4
             let mut a_pq = Mat3::ZERO;
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
                 a_pq += outer((x[i as usize] - com) * mass[i as usize], *q);
@@ -147,14 +149,50 @@ impl ShapeMatching {
             } else {
                 r
             };
+            let offset = |i: u32, q: &Vec3| g * *q - (x[i as usize] - com);
+            // The force update moves particle i by α d_i / n_i (n_i: its clusters), the
+            // velocity update by α d_i m_i / n_i: removing the mean with those weights makes
+            // every cluster's pushes sum to zero.
+            let weight = |i: u32| {
+                let w = self.inv_cluster_count[i as usize] as f64;
+                match params.update {
+                    GoalUpdate::Force => w,
+                    GoalUpdate::Velocity => w * mass[i as usize] as f64,
+                }
+            };
+            let (mut mean, mut weights) = (bevy::math::DVec3::ZERO, 0.0f64);
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
-                self.goals[i as usize] += g * *q + com;
+                mean += offset(i, q).as_dvec3() * weight(i);
+                weights += weight(i);
+            }
+            let mean = (mean / weights).as_vec3();
+            for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
+                self.offsets[i as usize] += offset(i, q) - mean;
             }
         }
-        for (g, w) in self.goals.iter_mut().zip(&self.inv_cluster_count) {
-            *g *= *w;
+        for (((d, w), g), x) in self
+            .offsets
+            .iter_mut()
+            .zip(&self.inv_cluster_count)
+            .zip(&mut self.goals)
+            .zip(x)
+        {
+            *d *= *w;
+            *g = *x + *d;
         }
     }
+}
+
+/// Centre of mass of `particles`, summed in `f64` (in `f32` the sum's rounding grows
+/// with the particle count).
+fn centre_of_mass(particles: &[u32], x: &[Vec3], mass: &[f32]) -> Vec3 {
+    let mut total = 0.0f64;
+    let mut com = bevy::math::DVec3::ZERO;
+    for &i in particles {
+        total += mass[i as usize] as f64;
+        com += x[i as usize].as_dvec3() * mass[i as usize] as f64;
+    }
+    (com / total).as_vec3()
 }
 
 fn outer(a: Vec3, b: Vec3) -> Mat3 {
@@ -210,7 +248,7 @@ fn extract_rotation(a: &Mat3, start: Quat) -> Quat {
     }
     let a = *a * (1.0 / norm);
     let mut q = start.normalize();
-    for _ in 0..30 {
+    for _ in 0..100 {
         let r = Mat3::from_quat(q);
         let torque = r.x_axis.cross(a.x_axis) + r.y_axis.cross(a.y_axis) + r.z_axis.cross(a.z_axis);
         let align = r.x_axis.dot(a.x_axis) + r.y_axis.dot(a.y_axis) + r.z_axis.dot(a.z_axis);
