@@ -4,7 +4,7 @@
 
 use bevy::math::{Mat3, Quat, Vec3, Vec4};
 
-use crate::params::{GoalUpdate, RotationMethod, ShapeMatchingParams};
+use crate::params::{RotationMethod, ShapeMatchingParams};
 
 /// One cluster: a set of particles matched together.
 #[derive(Clone, Debug)]
@@ -67,16 +67,20 @@ impl ShapeMatching {
             _ => vec![(0..n as u32).collect()],
         };
         let mut count = vec![0.0f32; n];
+        for &i in members.iter().flatten() {
+            count[i as usize] += 1.0;
+        }
+        let inv_cluster_count: Vec<f32> = count.iter().map(|&c| 1.0 / c.max(1.0)).collect();
+        let weight = |i: u32| mass[i as usize] * inv_cluster_count[i as usize];
         let clusters = members
             .into_iter()
             .map(|particles| {
-                let com = centre_of_mass(&particles, rest, mass);
+                let com = centre_of_mass(&particles, rest, weight);
                 let rest_offsets: Vec<Vec3> =
                     particles.iter().map(|&i| rest[i as usize] - com).collect();
                 let mut a_qq = Mat3::ZERO;
                 for (&i, q) in particles.iter().zip(&rest_offsets) {
-                    a_qq += outer(*q * mass[i as usize], *q);
-                    count[i as usize] += 1.0;
+                    a_qq += outer(*q * weight(i), *q);
                 }
                 Cluster {
                     particles,
@@ -91,7 +95,7 @@ impl ShapeMatching {
             clusters,
             goals: rest.to_vec(),
             offsets: vec![Vec3::ZERO; n],
-            inv_cluster_count: count.iter().map(|&c| 1.0 / c.max(1.0)).collect(),
+            inv_cluster_count,
             built_for: k,
         }
     }
@@ -112,21 +116,23 @@ impl ShapeMatching {
     /// Goals `g_i = G (x_i0 − x_cm0) + x_cm` (seed 000 eq. 12) from the current positions,
     /// with `G = R` or Müller's `β A + (1 − β) R`. Allocates nothing.
     ///
-    /// The offsets `g_i − x_i = G q_i − (x_i − x_cm)` are formed from the small relative
-    /// positions, and each cluster's mean offset is removed (weighted as the update moves
-    /// the particles), so a cluster's pushes sum to zero and conserve momentum, as Müller
-    /// et al. 2005's do for one cluster in exact arithmetic. In `f32` the mean would
-    /// otherwise be the rounding of the centre of mass (1e-8–1e-6 m on a 144-particle
-    /// cloth), a net force `α N δ` that accelerates the whole cloth at `δ α/m` and, at stiff
-    /// pulls on light particles, pumped energy into it; overlapping clusters averaged per
-    /// particle would not conserve momentum even in exact arithmetic.
+    /// Each cluster weighs its particles by `m_i / n_i` (n_i: the clusters holding the
+    /// particle), as lattice shape matching does (Rivers and James 2007), so the averaged
+    /// goals conserve momentum with overlapping clusters too. The offsets
+    /// `g_i − x_i = G q_i − (x_i − x_cm)` are formed from the small relative positions, and
+    /// each cluster's weighted mean offset (zero in exact arithmetic) is removed: in `f32`
+    /// it is the rounding of the centre of mass (1e-8–1e-6 m on a 144-particle cloth), a
+    /// net force `α N δ` that accelerated the whole cloth at `δ α/m` and, at stiff pulls on
+    /// light particles, pumped energy into it.
     pub fn compute_goals(&mut self, x: &[Vec3], mass: &[f32], params: &ShapeMatchingParams) {
         self.offsets.fill(Vec3::ZERO);
+        let inv_count = &self.inv_cluster_count;
+        let weight = |i: u32| mass[i as usize] * inv_count[i as usize];
         for c in &mut self.clusters {
-            let com = centre_of_mass(&c.particles, x, mass); // seed 000 eq. 4
+            let com = centre_of_mass(&c.particles, x, weight); // seed 000 eq. 4
             let mut a_pq = Mat3::ZERO;
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
-                a_pq += outer((x[i as usize] - com) * mass[i as usize], *q);
+                a_pq += outer((x[i as usize] - com) * weight(i), *q);
             }
             let rotation = match params.rotation {
                 RotationMethod::QuaternionAverage { normalize_each } => {
@@ -150,20 +156,10 @@ impl ShapeMatching {
                 r
             };
             let offset = |i: u32, q: &Vec3| g * *q - (x[i as usize] - com);
-            // The force update moves particle i by α d_i / n_i (n_i: its clusters), the
-            // velocity update by α d_i m_i / n_i: removing the mean with those weights makes
-            // every cluster's pushes sum to zero.
-            let weight = |i: u32| {
-                let w = self.inv_cluster_count[i as usize] as f64;
-                match params.update {
-                    GoalUpdate::Force => w,
-                    GoalUpdate::Velocity => w * mass[i as usize] as f64,
-                }
-            };
             let (mut mean, mut weights) = (bevy::math::DVec3::ZERO, 0.0f64);
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
-                mean += offset(i, q).as_dvec3() * weight(i);
-                weights += weight(i);
+                mean += offset(i, q).as_dvec3() * weight(i) as f64;
+                weights += weight(i) as f64;
             }
             let mean = (mean / weights).as_vec3();
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
@@ -183,14 +179,14 @@ impl ShapeMatching {
     }
 }
 
-/// Centre of mass of `particles`, summed in `f64` (in `f32` the sum's rounding grows
-/// with the particle count).
-fn centre_of_mass(particles: &[u32], x: &[Vec3], mass: &[f32]) -> Vec3 {
+/// Centre of `particles` under `weight`, summed in `f64` (in `f32` the sum's rounding
+/// grows with the particle count).
+fn centre_of_mass(particles: &[u32], x: &[Vec3], weight: impl Fn(u32) -> f32) -> Vec3 {
     let mut total = 0.0f64;
     let mut com = bevy::math::DVec3::ZERO;
     for &i in particles {
-        total += mass[i as usize] as f64;
-        com += x[i as usize].as_dvec3() * mass[i as usize] as f64;
+        total += weight(i) as f64;
+        com += x[i as usize].as_dvec3() * weight(i) as f64;
     }
     (com / total).as_vec3()
 }
