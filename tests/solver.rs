@@ -84,6 +84,39 @@ fn free_fall_follows_half_g_t_squared() {
     }
 }
 
+#[test]
+fn free_fall_is_not_lost_to_rounding_at_many_substeps() {
+    // At 2048 substeps of 16 ms, g h² = 6e-10 m is far below the spacing of floats near
+    // y = 2 m (2.4e-7 m): plain position Verlet never moved. Both integrators must fall
+    // g h² n(n+1)/2 with n = all substeps taken.
+    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        let params = ClothParams {
+            springs: no_springs(),
+            substeps: Substeps::Fixed(2048),
+            ..conservative(integrator)
+        };
+        let shape = ClothShape::Grid {
+            width: 2,
+            height: 2,
+            spacing: 0.1,
+        };
+        let frame = Affine3A::from_translation(Vec3::new(0.0, 2.0, 0.0));
+        let mut cloth = Solver::new(&shape, &Pins::None, &params, frame).unwrap();
+        let y0 = cloth.positions()[0].y;
+        let steps = 10;
+        for _ in 0..steps {
+            cloth.step(DT, &no_wind());
+        }
+        let (n, h) = ((steps * 2048) as f64, DT as f64 / 2048.0);
+        let discrete = 0.5 * 9.81 * h * h * n * (n + 1.0);
+        let drop = (y0 - cloth.positions()[0].y) as f64;
+        assert!(
+            (drop - discrete).abs() < 1e-3 * discrete,
+            "{integrator:?}: fell {drop} m, expected {discrete} m"
+        );
+    }
+}
+
 /// A particle of mass m on one spring k to a pin, displaced along the spring, oscillates
 /// with period 2π√(m/k).
 #[test]

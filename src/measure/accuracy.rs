@@ -217,9 +217,10 @@ impl Case {
         let solver = SceneRun::new(scene)?;
         let auto = solver.cloths[0].1.stable_substeps(scene.timestep);
         let substeps = auto * factor;
-        // Symplectic Euler, not Verlet: in `f32`, Verlet's `a h²` vanishes below the
-        // rounding of a position (at 512 substeps of 16 ms, g h² = 1e-8 m against
-        // 2.4e-7 m spacing of floats near 2 m), while Euler carries the velocity itself.
+        // Symplectic Euler, not Verlet: at hundreds of substeps per step a displacement
+        // is a few float spacings of the position, and Verlet's velocity, a difference of
+        // positions, picks up the rounding of every strain-limiter correction; Euler
+        // carries its velocity exactly.
         let params = ClothParams {
             substeps: Substeps::Fixed(substeps),
             integrator: Integrator::SemiImplicitEuler,

@@ -344,6 +344,7 @@ impl Cloth {
             p.position[i] = x;
             p.previous[i] = x;
             p.velocity[i] = Vec3::ZERO;
+            p.residue[i] = Vec3::ZERO;
             p.force[i] = Vec3::ZERO;
             p.mass[i] = mass * p.lump[i];
             p.inv_mass[i] = 1.0 / p.mass[i];

@@ -11,6 +11,9 @@ pub struct Particles {
     pub previous: Vec<Vec3>,
     /// Velocity `v` in m/s (integrated by Euler, `(x − x_prev)/h` for Verlet).
     pub velocity: Vec<Vec3>,
+    /// The part of Verlet's last displacement that rounding the position lost, carried
+    /// into the next one (compensated summation); zero for Euler.
+    pub residue: Vec<Vec3>,
     /// Mass `m` in kg (kept for pinned particles too, for energies and centres of mass).
     pub mass: Vec<f32>,
     /// `1/m`, or 0 for a pinned particle.
@@ -29,6 +32,7 @@ impl Particles {
             position: vec![Vec3::ZERO; n],
             previous: vec![Vec3::ZERO; n],
             velocity: vec![Vec3::ZERO; n],
+            residue: vec![Vec3::ZERO; n],
             mass: vec![0.0; n],
             inv_mass: vec![0.0; n],
             force: vec![Vec3::ZERO; n],
