@@ -153,6 +153,22 @@ fn bad_input_exits_2_with_one_line_naming_the_problem() {
             vec!["bench".into(), "--models".into(), "9".into()],
             "no model `9`",
         ),
+        (
+            vec!["bench".into(), "--chart".into(), "bench.jpg".into()],
+            "must end in .png",
+        ),
+        (
+            vec!["accuracy".into(), "--scenes".into(), "curtain,sail".into()],
+            "no scene `sail`",
+        ),
+        (
+            vec!["accuracy".into(), "--seconds".into(), "-1".into()],
+            "--seconds",
+        ),
+        (
+            vec!["stability".into(), "--models".into(), "cloth".into()],
+            "no model `cloth`",
+        ),
     ];
     for (args, needle) in cases {
         let out = cloth().args(&args).output().unwrap();

@@ -37,12 +37,7 @@ fn both(
     draw_svg: impl Fn(&DrawingArea<SVGBackend, Shift>) -> Result<()>,
 ) -> Result<()> {
     register_font()?;
-    if png.extension().and_then(|e| e.to_str()) != Some("png") {
-        return Err(format!(
-            "--chart {}: the file must end in .png (an .svg is written beside it)",
-            png.display()
-        ));
-    }
+    check_path(png)?;
     if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("--chart {}: {e}", png.display()))?;
     }
@@ -59,6 +54,17 @@ fn both(
     draw_svg(&root)?;
     root.present()
         .map_err(|e| format!("--chart {}: {e}", svg.display()))?;
+    Ok(())
+}
+
+/// Checks a `--chart` path before anything is measured.
+pub fn check_path(png: &Path) -> Result<()> {
+    if png.extension().and_then(|e| e.to_str()) != Some("png") {
+        return Err(format!(
+            "--chart {}: the file must end in .png (an .svg is written beside it)",
+            png.display()
+        ));
+    }
     Ok(())
 }
 

@@ -322,6 +322,9 @@ fn bench(args: &[String]) -> Result<(), String> {
     if let Some(extra) = opts.positional.first() {
         return Err(format!("bench takes no argument `{extra}`\n{USAGE}"));
     }
+    if let Some(chart) = opts.get("--chart") {
+        charts::check_path(Path::new(chart))?;
+    }
     let max: usize = opts.number("--max", 65_536)?;
     let repeats: usize = opts.number("--repeats", 15)?;
     let models = model_list(&opts, "--models", &SEED_MODELS)?;
@@ -449,6 +452,9 @@ fn accuracy(args: &[String]) -> Result<(), String> {
     if let Some(extra) = opts.positional.first() {
         return Err(format!("accuracy takes no argument `{extra}`\n{USAGE}"));
     }
+    if let Some(chart) = opts.get("--chart") {
+        charts::check_path(Path::new(chart))?;
+    }
     let seconds = number_f32(&opts, "--seconds", 3.0)?;
     let names: Vec<&str> = opts
         .get("--scenes")
@@ -529,6 +535,9 @@ fn stability(args: &[String]) -> Result<(), String> {
     let opts = options(args, &["--models", "--chart"], &["--json"])?;
     if let Some(extra) = opts.positional.first() {
         return Err(format!("stability takes no argument `{extra}`\n{USAGE}"));
+    }
+    if let Some(chart) = opts.get("--chart") {
+        charts::check_path(Path::new(chart))?;
     }
     let models = model_list(&opts, "--models", &MODELS)?;
     let mut cells = Vec::new();
