@@ -353,7 +353,11 @@ fn bench(args: &[String]) -> Result<(), String> {
     if with_app {
         for &model in &app_models {
             for count in APP_COUNTS.into_iter().filter(|&c| c <= max) {
-                let frames_measured = if count >= 16_384 { 10 } else { 30 };
+                let frames_measured = if count >= 16_384 { 20 } else { 100 };
+                // Every app starts from idle worker threads: Bevy's executor runs a small
+                // app's frame in 0.1 ms or 0.5 ms depending on the state it finds its
+                // threads in (the README's Results), and this makes the rows comparable.
+                std::thread::sleep(std::time::Duration::from_millis(500));
                 let row =
                     fps::app_frame(model, count, 5, frames_measured).map_err(|e| e.to_string())?;
                 eprintln!(
