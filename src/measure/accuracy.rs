@@ -54,6 +54,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
                 Integrator::SemiImplicitEuler => "Euler",
             };
             let steps = match substeps {
+                Substeps::Fixed(1) => "1 substep".into(),
                 Substeps::Fixed(n) => format!("{n} substeps"),
                 Substeps::Auto { .. } => "auto substeps".into(),
             };

@@ -396,6 +396,23 @@ fn bench(args: &[String]) -> Result<(), String> {
             }
             println!();
         }
+        println!();
+        println!("speed-up over seed 000 (its ms / ours; - where it printed 0 ms)");
+        for &model in &models {
+            print!("{model:>8}");
+            for &count in &counts {
+                let cell = cells
+                    .iter()
+                    .find(|c| c.model == model && c.particles == count)
+                    .expect("measured");
+                let speedup = match cell.seed_ms {
+                    Some(seed) if seed > 0.0 => format!("{:.0}×", seed / cell.ms_per_step),
+                    _ => "-".to_string(),
+                };
+                print!(" {speedup:>17}");
+            }
+            println!();
+        }
     }
     if !frames.is_empty() {
         println!();
