@@ -81,6 +81,25 @@ fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
     lo / 1.6..hi * 1.6
 }
 
+/// Ticks at 1, 2 and 5 times the powers of ten inside `range` (plotters' log axes label
+/// only the powers, which leaves a narrow range bare).
+fn ticks_125(range: &Range<f64>) -> Vec<f64> {
+    let (lo, hi) = (
+        range.start.log10().floor() as i32,
+        range.end.log10().ceil() as i32,
+    );
+    (lo..=hi)
+        .flat_map(|e| [1.0, 2.0, 5.0].map(|m| m * 10f64.powi(e)))
+        .filter(|v| range.contains(v))
+        .collect()
+}
+
+/// A tick label with as many decimals as the value needs.
+fn tick_label(v: &f64) -> String {
+    let decimals = (-v.log10().floor()).max(0.0) as usize;
+    format!("{v:.decimals$}")
+}
+
 fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
@@ -244,24 +263,25 @@ fn draw_accuracy<DB: DrawingBackend>(
     for (panel, scene) in panels.iter().zip(scenes) {
         let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == *scene).collect();
         let ok: Vec<&&Row> = rows.iter().filter(|r| r.error.is_some()).collect();
+        let xs = log_range(ok.iter().map(|r| r.ms_per_second));
+        let ys = log_range(ok.iter().filter_map(|r| r.error));
+        let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
         let mut chart = ChartBuilder::on(panel)
             .caption(*scene, (FONT, 22))
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(65)
             .build_cartesian_2d(
-                log_range(ok.iter().map(|r| r.ms_per_second)).log_scale(),
-                log_range(ok.iter().filter_map(|r| r.error)).log_scale(),
+                xs.log_scale().with_key_points(x_ticks),
+                ys.log_scale().with_key_points(y_ticks),
             )
             .map_err(err)?;
         chart
             .configure_mesh()
             .x_desc("ms per simulated second")
             .y_desc("RMS error / diagonal")
-            .x_labels(6)
-            .y_labels(6)
-            .x_label_formatter(&|x| format!("{x:.3}"))
-            .y_label_formatter(&|y| format!("{y:.3}"))
+            .x_label_formatter(&tick_label)
+            .y_label_formatter(&tick_label)
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
             .draw()
@@ -310,7 +330,7 @@ fn draw_accuracy<DB: DrawingBackend>(
         }
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
+            .position(SeriesLabelPosition::LowerLeft)
             .label_font((FONT, 14))
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK)
