@@ -140,6 +140,11 @@ pub enum Integrator {
     SemiImplicitEuler,
 }
 
+impl Integrator {
+    /// Every integrator.
+    pub const ALL: [Integrator; 2] = [Integrator::Verlet, Integrator::SemiImplicitEuler];
+}
+
 /// How many substeps one fixed step is split into.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum Substeps {

@@ -39,9 +39,14 @@ fn no_wind() -> Environment {
 
 /// Four unpinned particles with no springs: each falls freely, one substep per step.
 fn free_particles(integrator: Integrator) -> Solver {
+    free_particles_at(integrator, 1, Affine3A::IDENTITY)
+}
+
+/// Four unconnected particles placed by `frame`, stepped in `substeps` substeps.
+fn free_particles_at(integrator: Integrator, substeps: u32, frame: Affine3A) -> Solver {
     let params = ClothParams {
         springs: no_springs(),
-        substeps: Substeps::Fixed(1),
+        substeps: Substeps::Fixed(substeps),
         ..conservative(integrator)
     };
     let shape = ClothShape::Grid {
@@ -49,12 +54,12 @@ fn free_particles(integrator: Integrator) -> Solver {
         height: 2,
         spacing: 0.1,
     };
-    Solver::new(&shape, &Pins::None, &params, Affine3A::IDENTITY).unwrap()
+    Solver::new(&shape, &Pins::None, &params, frame).unwrap()
 }
 
 #[test]
 fn free_fall_follows_half_g_t_squared() {
-    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+    for integrator in Integrator::ALL {
         let mut cloth = free_particles(integrator);
         let y0 = cloth.positions()[0].y;
         let env = no_wind();
@@ -89,19 +94,9 @@ fn free_fall_is_not_lost_to_rounding_at_many_substeps() {
     // At 2048 substeps of 16 ms, g h² = 6e-10 m is far below the spacing of floats near
     // y = 2 m (2.4e-7 m): plain position Verlet never moved. Both integrators must fall
     // g h² n(n+1)/2 with n = all substeps taken.
-    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
-        let params = ClothParams {
-            springs: no_springs(),
-            substeps: Substeps::Fixed(2048),
-            ..conservative(integrator)
-        };
-        let shape = ClothShape::Grid {
-            width: 2,
-            height: 2,
-            spacing: 0.1,
-        };
+    for integrator in Integrator::ALL {
         let frame = Affine3A::from_translation(Vec3::new(0.0, 2.0, 0.0));
-        let mut cloth = Solver::new(&shape, &Pins::None, &params, frame).unwrap();
+        let mut cloth = free_particles_at(integrator, 2048, frame);
         let y0 = cloth.positions()[0].y;
         let steps = 10;
         for _ in 0..steps {
@@ -121,7 +116,7 @@ fn free_fall_is_not_lost_to_rounding_at_many_substeps() {
 /// with period 2π√(m/k).
 #[test]
 fn spring_period_matches_two_pi_sqrt_m_over_k() {
-    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+    for integrator in Integrator::ALL {
         let (m, k) = (0.01f32, 100.0f32);
         let params = ClothParams {
             node_mass: m,

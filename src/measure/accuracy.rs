@@ -41,7 +41,7 @@ pub struct Config {
 /// at 3k.
 pub fn configs(base: &ClothParams) -> Vec<Config> {
     let mut out = Vec::new();
-    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+    for integrator in Integrator::ALL {
         for substeps in [
             Substeps::Fixed(1),
             Substeps::Fixed(2),

@@ -113,7 +113,8 @@ fn hash(i: usize, axis: u32) -> f32 {
     (x % 2_000_001) as f32 / 1_000_000.0 - 1.0
 }
 
-/// Kinetic energy of the free particles, J.
+/// Kinetic energy of the free particles, J, summed in `f64` (`Cloth::energy` counts the
+/// patch model's part lattice instead, whose perturbation averages out).
 pub fn kinetic(cloth: &solver::Cloth) -> f64 {
     let p = cloth.particles();
     (0..p.len())

@@ -155,15 +155,16 @@ impl ShapeMatching {
             } else {
                 r
             };
-            let offset = |i: u32, q: &Vec3| g * *q - (x[i as usize] - com);
             let (mut mean, mut weights) = (bevy::math::DVec3::ZERO, 0.0f64);
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
-                mean += offset(i, q).as_dvec3() * weight(i) as f64;
+                let d = g * *q - (x[i as usize] - com);
+                self.offsets[i as usize] += d;
+                mean += d.as_dvec3() * weight(i) as f64;
                 weights += weight(i) as f64;
             }
             let mean = (mean / weights).as_vec3();
-            for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
-                self.offsets[i as usize] += offset(i, q) - mean;
+            for &i in &c.particles {
+                self.offsets[i as usize] -= mean;
             }
         }
         for (((d, w), g), x) in self

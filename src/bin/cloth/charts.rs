@@ -29,29 +29,29 @@ fn register_font() -> Result<()> {
         .map_err(|_| "the bundled chart font could not be read".to_string())
 }
 
-/// Draws `draw` to `png` and to the same name with `.svg`.
-fn both(
-    png: &Path,
-    size: (u32, u32),
-    draw: impl Fn(&DrawingArea<BitMapBackend, Shift>) -> Result<()>,
-    draw_svg: impl Fn(&DrawingArea<SVGBackend, Shift>) -> Result<()>,
-) -> Result<()> {
+/// A chart that draws itself on any plotters backend: the PNG and the SVG.
+trait Chart {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()>;
+}
+
+/// Draws `chart` to `png` (checked by [`check_path`] before measuring) and to the same
+/// name with `.svg`.
+fn both(png: &Path, size: (u32, u32), chart: &impl Chart) -> Result<()> {
     register_font()?;
-    check_path(png)?;
     if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("--chart {}: {e}", png.display()))?;
     }
     {
         let root = BitMapBackend::new(png, size).into_drawing_area();
         root.fill(&WHITE).map_err(|e| e.to_string())?;
-        draw(&root)?;
+        chart.draw(&root)?;
         root.present()
             .map_err(|e| format!("--chart {}: {e}", png.display()))?;
     }
     let svg = png.with_extension("svg");
     let root = SVGBackend::new(&svg, size).into_drawing_area();
     root.fill(&WHITE).map_err(|e| e.to_string())?;
-    draw_svg(&root)?;
+    chart.draw(&root)?;
     root.present()
         .map_err(|e| format!("--chart {}: {e}", svg.display()))?;
     Ok(())
@@ -110,125 +110,126 @@ fn err<E: std::fmt::Display>(e: E) -> String {
 /// 000's Slika 23 as hollow markers of the same colour; the full app's ms per frame and
 /// seed 002's (from its frames per second) in black.
 pub fn bench(png: &Path, cells: &[BenchCell], app: &[AppFrame]) -> Result<()> {
-    both(
-        png,
-        (1100, 750),
-        |a| draw_bench(a, cells, app),
-        |a| draw_bench(a, cells, app),
-    )
+    both(png, (1100, 750), &Bench { cells, app })
 }
 
-fn draw_bench<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    cells: &[BenchCell],
-    app: &[AppFrame],
-) -> Result<()> {
-    let ys = cells
-        .iter()
-        .map(|c| c.ms_per_step)
-        .chain(SEED_MS.iter().flatten().copied())
-        .chain(app.iter().map(|a| a.ms_per_frame))
-        .chain(SEED_002_FPS.iter().map(|(_, f)| 1e3 / f));
-    let xs = (SEED_COUNTS[0] as f64 / 1.5)..(SEED_COUNTS[SEED_COUNTS.len() - 1] as f64 * 1.5);
-    let mut chart = ChartBuilder::on(area)
-        .caption(
-            "One 16 ms step: ours (lines) against the seeds (hollow)",
-            (FONT, 24),
-        )
-        .margin(14)
-        .x_label_area_size(45)
-        .y_label_area_size(70)
-        .build_cartesian_2d(xs.log_scale(), log_range(ys).log_scale())
-        .map_err(err)?;
-    chart
-        .configure_mesh()
-        .x_desc("particles")
-        .y_desc("ms per step (app: ms per frame)")
-        .x_label_formatter(&|x| format!("{x:.0}"))
-        .label_style((FONT, 15))
-        .axis_desc_style((FONT, 17))
-        .draw()
-        .map_err(err)?;
-    let names = [
-        "1 mass-spring",
-        "2 shape matching",
-        "3a patches 2×2",
-        "3b patches 4×4",
-        "3c patches 8×8",
-    ];
-    for (m, model) in SEED_MODELS.iter().enumerate() {
-        let color = PALETTE[m];
-        let ours: Vec<(f64, f64)> = cells
+struct Bench<'a> {
+    cells: &'a [BenchCell],
+    app: &'a [AppFrame],
+}
+
+impl Chart for Bench<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
+        let Bench { cells, app } = *self;
+        let ys = cells
             .iter()
-            .filter(|c| c.model == *model)
-            .map(|c| (c.particles as f64, c.ms_per_step))
-            .collect();
-        if !ours.is_empty() {
+            .map(|c| c.ms_per_step)
+            .chain(SEED_MS.iter().flatten().copied())
+            .chain(app.iter().map(|a| a.ms_per_frame))
+            .chain(SEED_002_FPS.iter().map(|(_, f)| 1e3 / f));
+        let xs = (SEED_COUNTS[0] as f64 / 1.5)..(SEED_COUNTS[SEED_COUNTS.len() - 1] as f64 * 1.5);
+        let mut chart = ChartBuilder::on(area)
+            .caption(
+                "One 16 ms step: ours (lines) against the seeds (hollow)",
+                (FONT, 24),
+            )
+            .margin(14)
+            .x_label_area_size(45)
+            .y_label_area_size(70)
+            .build_cartesian_2d(xs.log_scale(), log_range(ys).log_scale())
+            .map_err(err)?;
+        chart
+            .configure_mesh()
+            .x_desc("particles")
+            .y_desc("ms per step (app: ms per frame)")
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .label_style((FONT, 15))
+            .axis_desc_style((FONT, 17))
+            .draw()
+            .map_err(err)?;
+        let names = [
+            "1 mass-spring",
+            "2 shape matching",
+            "3a patches 2×2",
+            "3b patches 4×4",
+            "3c patches 8×8",
+        ];
+        for (m, model) in SEED_MODELS.iter().enumerate() {
+            let color = PALETTE[m];
+            let ours: Vec<(f64, f64)> = cells
+                .iter()
+                .filter(|c| c.model == *model)
+                .map(|c| (c.particles as f64, c.ms_per_step))
+                .collect();
+            if !ours.is_empty() {
+                chart
+                    .draw_series(LineSeries::new(ours.clone(), color.stroke_width(2)))
+                    .map_err(err)?
+                    .label(names[m])
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                    });
+                chart
+                    .draw_series(ours.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                    .map_err(err)?;
+            }
+            // The seed's zeros (under its 1 ms resolution) have no place on a log axis.
+            let seed = SEED_COUNTS
+                .iter()
+                .zip(SEED_MS[m])
+                .filter(|(_, ms)| *ms > 0.0)
+                .map(|(&c, ms)| TriangleMarker::new((c as f64, ms), 6, color.stroke_width(2)));
+            let series = chart.draw_series(seed).map_err(err)?;
+            if m == 0 {
+                series
+                    .label("seed 000 Slika 23 (hollow triangles, model colour)")
+                    .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
+            }
+        }
+        let mut app_models: Vec<&str> = app.iter().map(|a| a.model.as_str()).collect();
+        app_models.dedup();
+        for (i, model) in app_models.iter().enumerate() {
+            let color = if i == 0 {
+                BLACK
+            } else {
+                RGBColor(120, 120, 120)
+            };
+            let line: Vec<(f64, f64)> = app
+                .iter()
+                .filter(|a| a.model == *model)
+                .map(|a| (a.particles as f64, a.ms_per_frame))
+                .collect();
             chart
-                .draw_series(LineSeries::new(ours.clone(), color.stroke_width(2)))
+                .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
                 .map_err(err)?
-                .label(names[m])
+                .label(format!("full app, model {model}: ms per frame"))
                 .legend(move |(x, y)| {
                     PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                 });
             chart
-                .draw_series(ours.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                .draw_series(line.iter().map(|&p| Circle::new(p, 4, color.filled())))
                 .map_err(err)?;
         }
-        // The seed's zeros (under its 1 ms resolution) have no place on a log axis.
-        let seed = SEED_COUNTS
-            .iter()
-            .zip(SEED_MS[m])
-            .filter(|(_, ms)| *ms > 0.0)
-            .map(|(&c, ms)| TriangleMarker::new((c as f64, ms), 6, color.stroke_width(2)));
-        let series = chart.draw_series(seed).map_err(err)?;
-        if m == 0 {
-            series
-                .label("seed 000 Slika 23 (hollow triangles, model colour)")
-                .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
-        }
-    }
-    let mut app_models: Vec<&str> = app.iter().map(|a| a.model.as_str()).collect();
-    app_models.dedup();
-    for (i, model) in app_models.iter().enumerate() {
-        let color = if i == 0 {
-            BLACK
-        } else {
-            RGBColor(120, 120, 120)
-        };
-        let line: Vec<(f64, f64)> = app
-            .iter()
-            .filter(|a| a.model == *model)
-            .map(|a| (a.particles as f64, a.ms_per_frame))
-            .collect();
         chart
-            .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
+            .draw_series(SEED_002_FPS.iter().map(|&(c, f)| {
+                EmptyElement::at((c as f64, 1e3 / f))
+                    + Rectangle::new([(-5, -5), (5, 5)], BLACK.stroke_width(2))
+            }))
             .map_err(err)?
-            .label(format!("full app, model {model}: ms per frame"))
-            .legend(move |(x, y)| {
-                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            .label("seed 002 table 4.1: 1000 / fps (hollow squares)")
+            .legend(|(x, y)| {
+                Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], BLACK.stroke_width(2))
             });
         chart
-            .draw_series(line.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .label_font((FONT, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
             .map_err(err)?;
+        Ok(())
     }
-    chart
-        .draw_series(SEED_002_FPS.iter().map(|&(c, f)| {
-            EmptyElement::at((c as f64, 1e3 / f))
-                + Rectangle::new([(-5, -5), (5, 5)], BLACK.stroke_width(2))
-        }))
-        .map_err(err)?
-        .label("seed 002 table 4.1: 1000 / fps (hollow squares)")
-        .legend(|(x, y)| Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], BLACK.stroke_width(2)));
-    chart
-        .configure_series_labels()
-        .position(SeriesLabelPosition::UpperLeft)
-        .label_font((FONT, 15))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(err)?;
-    Ok(())
 }
 
 // ----- accuracy -----------------------------------------------------------------------
@@ -246,98 +247,100 @@ pub fn accuracy(png: &Path, rows: &[Row]) -> Result<()> {
         }
     }
     let width = 520 * scenes.len().max(1) as u32;
-    both(
-        png,
-        (width, 560),
-        |a| draw_accuracy(a, rows, &scenes),
-        |a| draw_accuracy(a, rows, &scenes),
-    )
+    let scenes = &scenes;
+    both(png, (width, 560), &Accuracy { rows, scenes })
 }
 
-fn draw_accuracy<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    rows: &[Row],
-    scenes: &[&str],
-) -> Result<()> {
-    let panels = area.split_evenly((1, scenes.len().max(1)));
-    for (panel, scene) in panels.iter().zip(scenes) {
-        let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == *scene).collect();
-        let ok: Vec<&&Row> = rows.iter().filter(|r| r.error.is_some()).collect();
-        let xs = log_range(ok.iter().map(|r| r.ms_per_second));
-        let ys = log_range(ok.iter().filter_map(|r| r.error));
-        let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
-        let mut chart = ChartBuilder::on(panel)
-            .caption(*scene, (FONT, 22))
-            .margin(12)
-            .x_label_area_size(45)
-            .y_label_area_size(65)
-            .build_cartesian_2d(
-                xs.log_scale().with_key_points(x_ticks),
-                ys.log_scale().with_key_points(y_ticks),
-            )
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("ms per simulated second")
-            .y_desc("RMS error / diagonal")
-            .x_label_formatter(&tick_label)
-            .y_label_formatter(&tick_label)
-            .label_style((FONT, 14))
-            .axis_desc_style((FONT, 16))
-            .draw()
-            .map_err(err)?;
-        let mut frontier: Vec<(f64, f64)> = ok
-            .iter()
-            .filter(|r| r.pareto)
-            .map(|r| (r.ms_per_second, r.error.expect("ok")))
-            .collect();
-        frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let mut stairs = Vec::new();
-        for (i, p) in frontier.iter().enumerate() {
-            if i > 0 {
-                stairs.push((p.0, frontier[i - 1].1));
-            }
-            stairs.push(*p);
-        }
-        chart
-            .draw_series(LineSeries::new(stairs, BLACK.stroke_width(1)))
-            .map_err(err)?
-            .label("Pareto frontier")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
-        for (m, model) in ACCURACY_MODELS.iter().enumerate() {
-            let color = PALETTE[m];
-            let points: Vec<(f64, f64)> = ok
+struct Accuracy<'a> {
+    rows: &'a [Row],
+    scenes: &'a [&'a str],
+}
+
+impl Chart for Accuracy<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
+        let Accuracy { rows, scenes } = *self;
+        let panels = area.split_evenly((1, scenes.len().max(1)));
+        for (panel, scene) in panels.iter().zip(scenes) {
+            let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == *scene).collect();
+            let ok: Vec<&&Row> = rows.iter().filter(|r| r.error.is_some()).collect();
+            let xs = log_range(ok.iter().map(|r| r.ms_per_second));
+            let ys = log_range(ok.iter().filter_map(|r| r.error));
+            let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
+            let mut chart = ChartBuilder::on(panel)
+                .caption(*scene, (FONT, 22))
+                .margin(12)
+                .x_label_area_size(45)
+                .y_label_area_size(65)
+                .build_cartesian_2d(
+                    xs.log_scale().with_key_points(x_ticks),
+                    ys.log_scale().with_key_points(y_ticks),
+                )
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc("ms per simulated second")
+                .y_desc("RMS error / diagonal")
+                .x_label_formatter(&tick_label)
+                .y_label_formatter(&tick_label)
+                .label_style((FONT, 14))
+                .axis_desc_style((FONT, 16))
+                .draw()
+                .map_err(err)?;
+            let mut frontier: Vec<(f64, f64)> = ok
                 .iter()
-                .filter(|r| r.model == *model)
+                .filter(|r| r.pareto)
                 .map(|r| (r.ms_per_second, r.error.expect("ok")))
                 .collect();
-            let style = color.filled();
-            let anno = match m {
-                0 => chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, style))),
-                1 => chart.draw_series(points.iter().map(|&p| TriangleMarker::new(p, 7, style))),
-                _ => chart.draw_series(
-                    points
-                        .iter()
-                        .map(|&p| EmptyElement::at(p) + Rectangle::new([(-5, -5), (5, 5)], style)),
-                ),
+            frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut stairs = Vec::new();
+            for (i, p) in frontier.iter().enumerate() {
+                if i > 0 {
+                    stairs.push((p.0, frontier[i - 1].1));
+                }
+                stairs.push(*p);
             }
-            .map_err(err)?;
-            anno.label(*model).legend(move |(x, y)| match m {
-                0 => Circle::new((x + 10, y), 5, style).into_dyn(),
-                1 => TriangleMarker::new((x + 10, y), 7, style).into_dyn(),
-                _ => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
-            });
+            chart
+                .draw_series(LineSeries::new(stairs, BLACK.stroke_width(1)))
+                .map_err(err)?
+                .label("Pareto frontier")
+                .legend(|(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1))
+                });
+            for (m, model) in ACCURACY_MODELS.iter().enumerate() {
+                let color = PALETTE[m];
+                let points: Vec<(f64, f64)> = ok
+                    .iter()
+                    .filter(|r| r.model == *model)
+                    .map(|r| (r.ms_per_second, r.error.expect("ok")))
+                    .collect();
+                let style = color.filled();
+                let anno =
+                    match m {
+                        0 => chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, style))),
+                        1 => chart
+                            .draw_series(points.iter().map(|&p| TriangleMarker::new(p, 7, style))),
+                        _ => chart.draw_series(points.iter().map(|&p| {
+                            EmptyElement::at(p) + Rectangle::new([(-5, -5), (5, 5)], style)
+                        })),
+                    }
+                    .map_err(err)?;
+                anno.label(*model).legend(move |(x, y)| match m {
+                    0 => Circle::new((x + 10, y), 5, style).into_dyn(),
+                    1 => TriangleMarker::new((x + 10, y), 7, style).into_dyn(),
+                    _ => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
+                });
+            }
+            chart
+                .configure_series_labels()
+                .position(SeriesLabelPosition::LowerLeft)
+                .label_font((FONT, 14))
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK)
+                .draw()
+                .map_err(err)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerLeft)
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        Ok(())
     }
-    Ok(())
 }
 
 // ----- stability ----------------------------------------------------------------------
@@ -347,88 +350,86 @@ fn draw_accuracy<DB: DrawingBackend>(
 /// ran stable, a red cross when it failed. The line is the explicit bound `ω_max·h = 2`
 /// with `ω_max = factor·√(k/m)`, `factors` per model as in [`MODELS`].
 pub fn stability(png: &Path, cells: &[Cell], factors: &[f32; 3]) -> Result<()> {
-    both(
-        png,
-        (1500, 1050),
-        |a| draw_stability(a, cells, factors),
-        |a| draw_stability(a, cells, factors),
-    )
+    both(png, (1500, 1050), &Stability { cells, factors })
 }
 
-fn draw_stability<DB: DrawingBackend>(
-    area: &DrawingArea<DB, Shift>,
-    cells: &[Cell],
-    factors: &[f32; 3],
-) -> Result<()> {
-    let columns = [
-        (Integrator::Verlet, false, "Verlet, 1 substep"),
-        (Integrator::SemiImplicitEuler, false, "Euler, 1 substep"),
-        (Integrator::Verlet, true, "Verlet, auto substeps"),
-        (Integrator::SemiImplicitEuler, true, "Euler, auto substeps"),
-    ];
-    let (title, body) = area.split_vertically(40);
-    title
-        .titled(
-            "Stable (green) and failed (red ×) cells; line: ω_max·h = 2",
-            (FONT, 24),
-        )
-        .map_err(err)?;
-    let panels = body.split_evenly((MODELS.len(), columns.len()));
-    let xs = 0.0007f64..0.05;
-    let ys = log_range(cells.iter().map(|c| c.omega0 as f64));
-    for (i, panel) in panels.iter().enumerate() {
-        let (m, col) = (i / columns.len(), i % columns.len());
-        let (integrator, auto, name) = columns[col];
-        let model = MODELS[m];
-        let mut chart = ChartBuilder::on(panel)
-            .caption(format!("{model}: {name}"), (FONT, 17))
-            .margin(8)
-            .x_label_area_size(35)
-            .y_label_area_size(55)
-            .build_cartesian_2d(xs.clone().log_scale(), ys.clone().log_scale())
-            .map_err(err)?;
-        chart
-            .configure_mesh()
-            .x_desc("h, s")
-            .y_desc("√(k/m), rad/s")
-            .y_label_formatter(&|y| format!("{y:.0}"))
-            .label_style((FONT, 12))
-            .axis_desc_style((FONT, 13))
-            .x_labels(4)
-            .y_labels(5)
-            .draw()
-            .map_err(err)?;
-        let factor = factors[m] as f64;
-        let bound: Vec<(f64, f64)> = (0..=60)
-            .map(|j| {
-                let h = xs.start * (xs.end / xs.start).powf(j as f64 / 60.0);
-                (h, 2.0 / (factor * h))
-            })
-            .filter(|(_, w)| ys.contains(w))
-            .collect();
-        chart
-            .draw_series(LineSeries::new(bound, BLACK.stroke_width(2)))
-            .map_err(err)?;
-        let here = cells
-            .iter()
-            .filter(|c| c.model == model && c.integrator == integrator && c.auto == auto);
-        let (failed, stable): (Vec<&Cell>, Vec<&Cell>) = here.partition(|c| c.failure.is_some());
-        chart
-            .draw_series(
-                stable.iter().map(|c| {
-                    Circle::new((c.timestep as f64, c.omega0 as f64), 4, PALETTE[2].filled())
-                }),
+struct Stability<'a> {
+    cells: &'a [Cell],
+    factors: &'a [f32; 3],
+}
+
+impl Chart for Stability<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
+        let Stability { cells, factors } = *self;
+        let columns = [
+            (Integrator::Verlet, false, "Verlet, 1 substep"),
+            (Integrator::SemiImplicitEuler, false, "Euler, 1 substep"),
+            (Integrator::Verlet, true, "Verlet, auto substeps"),
+            (Integrator::SemiImplicitEuler, true, "Euler, auto substeps"),
+        ];
+        let (title, body) = area.split_vertically(40);
+        title
+            .titled(
+                "Stable (green) and failed (red ×) cells; line: ω_max·h = 2",
+                (FONT, 24),
             )
             .map_err(err)?;
-        chart
-            .draw_series(failed.iter().map(|c| {
-                Cross::new(
-                    (c.timestep as f64, c.omega0 as f64),
-                    5,
-                    PALETTE[0].stroke_width(2),
-                )
-            }))
-            .map_err(err)?;
+        let panels = body.split_evenly((MODELS.len(), columns.len()));
+        let xs = 0.0007f64..0.05;
+        let ys = log_range(cells.iter().map(|c| c.omega0 as f64));
+        for (i, panel) in panels.iter().enumerate() {
+            let (m, col) = (i / columns.len(), i % columns.len());
+            let (integrator, auto, name) = columns[col];
+            let model = MODELS[m];
+            let mut chart = ChartBuilder::on(panel)
+                .caption(format!("{model}: {name}"), (FONT, 17))
+                .margin(8)
+                .x_label_area_size(35)
+                .y_label_area_size(55)
+                .build_cartesian_2d(xs.clone().log_scale(), ys.clone().log_scale())
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc("h, s")
+                .y_desc("√(k/m), rad/s")
+                .y_label_formatter(&|y| format!("{y:.0}"))
+                .label_style((FONT, 12))
+                .axis_desc_style((FONT, 13))
+                .x_labels(4)
+                .y_labels(5)
+                .draw()
+                .map_err(err)?;
+            let factor = factors[m] as f64;
+            let bound: Vec<(f64, f64)> = (0..=60)
+                .map(|j| {
+                    let h = xs.start * (xs.end / xs.start).powf(j as f64 / 60.0);
+                    (h, 2.0 / (factor * h))
+                })
+                .filter(|(_, w)| ys.contains(w))
+                .collect();
+            chart
+                .draw_series(LineSeries::new(bound, BLACK.stroke_width(2)))
+                .map_err(err)?;
+            let here = cells
+                .iter()
+                .filter(|c| c.model == model && c.integrator == integrator && c.auto == auto);
+            let (failed, stable): (Vec<&Cell>, Vec<&Cell>) =
+                here.partition(|c| c.failure.is_some());
+            chart
+                .draw_series(stable.iter().map(|c| {
+                    Circle::new((c.timestep as f64, c.omega0 as f64), 4, PALETTE[2].filled())
+                }))
+                .map_err(err)?;
+            chart
+                .draw_series(failed.iter().map(|c| {
+                    Cross::new(
+                        (c.timestep as f64, c.omega0 as f64),
+                        5,
+                        PALETTE[0].stroke_width(2),
+                    )
+                }))
+                .map_err(err)?;
+        }
+        Ok(())
     }
-    Ok(())
 }

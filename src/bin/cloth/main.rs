@@ -23,7 +23,7 @@ use std::process::ExitCode;
 use bevy_cloth::measure::accuracy::{self, Case};
 use bevy_cloth::measure::fps::{self, APP_COUNTS};
 use bevy_cloth::measure::stability::{self, MASS, MODELS, STIFFNESS, TIMESTEP};
-use bevy_cloth::measure::{self, SEED_COUNTS, SEED_MODELS, SceneRun};
+use bevy_cloth::measure::{self, BenchCell, SEED_COUNTS, SEED_MODELS, SceneRun};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver;
 
@@ -85,6 +85,10 @@ fn options(args: &[String], with_value: &[&str], switches: &[&str]) -> Result<Op
 }
 
 impl Options {
+    fn switch(&self, flag: &str) -> bool {
+        self.switches.iter().any(|s| s == flag)
+    }
+
     fn get(&self, flag: &str) -> Option<&str> {
         self.pairs
             .iter()
@@ -307,6 +311,24 @@ fn model_list<'a>(
     Ok(models)
 }
 
+/// The options of a measuring verb (`bench`, `accuracy`, `stability`): no positional
+/// argument, and a `--chart` path that is checked before anything is measured.
+fn verb_options(
+    verb: &str,
+    args: &[String],
+    with_value: &[&str],
+    switches: &[&str],
+) -> Result<Options, String> {
+    let opts = options(args, with_value, switches)?;
+    if let Some(extra) = opts.positional.first() {
+        return Err(format!("{verb} takes no argument `{extra}`\n{USAGE}"));
+    }
+    if let Some(chart) = opts.get("--chart") {
+        charts::check_path(Path::new(chart))?;
+    }
+    Ok(opts)
+}
+
 fn print_json<T: serde::Serialize>(value: &T) -> Result<(), String> {
     let json = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
     println!("{json}");
@@ -314,22 +336,17 @@ fn print_json<T: serde::Serialize>(value: &T) -> Result<(), String> {
 }
 
 fn bench(args: &[String]) -> Result<(), String> {
-    let opts = options(
+    let opts = verb_options(
+        "bench",
         args,
         &["--max", "--models", "--repeats", "--app-models", "--chart"],
         &["--json", "--app"],
     )?;
-    if let Some(extra) = opts.positional.first() {
-        return Err(format!("bench takes no argument `{extra}`\n{USAGE}"));
-    }
-    if let Some(chart) = opts.get("--chart") {
-        charts::check_path(Path::new(chart))?;
-    }
     let max: usize = opts.number("--max", 65_536)?;
     let repeats: usize = opts.number("--repeats", 15)?;
     let models = model_list(&opts, "--models", &SEED_MODELS)?;
     let app_models = model_list(&opts, "--app-models", &SEED_MODELS)?;
-    let with_app = opts.switches.iter().any(|s| s == "--app") || opts.get("--app-models").is_some();
+    let with_app = opts.switch("--app") || opts.get("--app-models").is_some();
     let counts: Vec<usize> = SEED_COUNTS.into_iter().filter(|&c| c <= max).collect();
     let mut cells = Vec::new();
     for &model in &models {
@@ -371,7 +388,7 @@ fn bench(args: &[String]) -> Result<(), String> {
     if let Some(chart) = opts.get("--chart") {
         charts::bench(Path::new(chart), &cells, &frames)?;
     }
-    if opts.switches.iter().any(|s| s == "--json") {
+    if opts.switch("--json") {
         return print_json(&serde_json::json!({ "solver": cells, "app": frames }));
     }
     if !cells.is_empty() {
@@ -383,36 +400,16 @@ fn bench(args: &[String]) -> Result<(), String> {
             print!(" {c:>17}");
         }
         println!();
-        for &model in &models {
-            print!("{model:>8}");
-            for &count in &counts {
-                let cell = cells
-                    .iter()
-                    .find(|c| c.model == model && c.particles == count)
-                    .expect("measured");
-                let ours = format!("{:.3}[{}]", cell.ms_per_step, cell.substeps);
-                let seed = cell.seed_ms.map_or("-".to_string(), |s| format!("{s:.0}"));
-                print!(" {:>17}", format!("{ours}/{seed}"));
-            }
-            println!();
-        }
+        print_by_model(&cells, counts.len(), |cell| {
+            let seed = cell.seed_ms.map_or("-".to_string(), |s| format!("{s:.0}"));
+            format!("{:.3}[{}]/{seed}", cell.ms_per_step, cell.substeps)
+        });
         println!();
         println!("speed-up over seed 000 (its ms / ours; - where it printed 0 ms)");
-        for &model in &models {
-            print!("{model:>8}");
-            for &count in &counts {
-                let cell = cells
-                    .iter()
-                    .find(|c| c.model == model && c.particles == count)
-                    .expect("measured");
-                let speedup = match cell.seed_ms {
-                    Some(seed) if seed > 0.0 => format!("{:.0}×", seed / cell.ms_per_step),
-                    _ => "-".to_string(),
-                };
-                print!(" {speedup:>17}");
-            }
-            println!();
-        }
+        print_by_model(&cells, counts.len(), |cell| match cell.seed_ms {
+            Some(seed) if seed > 0.0 => format!("{:.0}×", seed / cell.ms_per_step),
+            _ => "-".to_string(),
+        });
     }
     if !frames.is_empty() {
         println!();
@@ -427,6 +424,18 @@ fn bench(args: &[String]) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// One row per model of `cells` (measured model by model, `per_model` counts each),
+/// each cell as `show` writes it.
+fn print_by_model(cells: &[BenchCell], per_model: usize, show: impl Fn(&BenchCell) -> String) {
+    for row in cells.chunks(per_model.max(1)) {
+        print!("{:>8}", row[0].model);
+        for cell in row {
+            print!(" {:>17}", show(cell));
+        }
+        println!();
+    }
 }
 
 /// The accuracy study's cases: the curtain without and with its wind, and the card.
@@ -469,13 +478,12 @@ fn number_f32(opts: &Options, flag: &str, default: f32) -> Result<f32, String> {
 }
 
 fn accuracy(args: &[String]) -> Result<(), String> {
-    let opts = options(args, &["--scenes", "--seconds", "--chart"], &["--json"])?;
-    if let Some(extra) = opts.positional.first() {
-        return Err(format!("accuracy takes no argument `{extra}`\n{USAGE}"));
-    }
-    if let Some(chart) = opts.get("--chart") {
-        charts::check_path(Path::new(chart))?;
-    }
+    let opts = verb_options(
+        "accuracy",
+        args,
+        &["--scenes", "--seconds", "--chart"],
+        &["--json"],
+    )?;
     let seconds = number_f32(&opts, "--seconds", 3.0)?;
     let names: Vec<&str> = opts
         .get("--scenes")
@@ -508,7 +516,7 @@ fn accuracy(args: &[String]) -> Result<(), String> {
     if let Some(chart) = opts.get("--chart") {
         charts::accuracy(Path::new(chart), &rows)?;
     }
-    if opts.switches.iter().any(|s| s == "--json") {
+    if opts.switch("--json") {
         return print_json(&serde_json::json!({ "references": references, "rows": rows }));
     }
     println!(
@@ -553,17 +561,11 @@ fn accuracy(args: &[String]) -> Result<(), String> {
 }
 
 fn stability(args: &[String]) -> Result<(), String> {
-    let opts = options(args, &["--models", "--chart"], &["--json"])?;
-    if let Some(extra) = opts.positional.first() {
-        return Err(format!("stability takes no argument `{extra}`\n{USAGE}"));
-    }
-    if let Some(chart) = opts.get("--chart") {
-        charts::check_path(Path::new(chart))?;
-    }
+    let opts = verb_options("stability", args, &["--models", "--chart"], &["--json"])?;
     let models = model_list(&opts, "--models", &MODELS)?;
     let mut cells = Vec::new();
     for &model in &models {
-        for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        for integrator in Integrator::ALL {
             for auto in [false, true] {
                 let (mut failed, mut total) = (0, 0);
                 for &k in &STIFFNESS {
@@ -585,7 +587,7 @@ fn stability(args: &[String]) -> Result<(), String> {
         }
     }
     let mut thresholds = Vec::new();
-    for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+    for integrator in Integrator::ALL {
         for (k, m) in [(100.0, 1e-3), (1_000.0, 1e-4), (25_000.0, 1e-6)] {
             thresholds.push(stability::single_spring(k, m, integrator).map_err(|e| e.to_string())?);
             thresholds.push(stability::lattice(k, m, integrator).map_err(|e| e.to_string())?);
@@ -595,7 +597,7 @@ fn stability(args: &[String]) -> Result<(), String> {
     if let Some(chart) = opts.get("--chart") {
         charts::stability(Path::new(chart), &cells, &factors)?;
     }
-    if opts.switches.iter().any(|s| s == "--json") {
+    if opts.switch("--json") {
         return print_json(&serde_json::json!({
             "cells": cells,
             "thresholds": thresholds,
@@ -607,7 +609,7 @@ fn stability(args: &[String]) -> Result<(), String> {
     );
     println!("|---|---|---|---:|---:|---:|");
     for &model in &models {
-        for integrator in [Integrator::Verlet, Integrator::SemiImplicitEuler] {
+        for integrator in Integrator::ALL {
             for auto in [false, true] {
                 let here: Vec<_> = cells
                     .iter()
