@@ -102,13 +102,35 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
         Some(indices) => indices.iter().map(|i| i as u32).collect(),
         None => (0..positions.len() as u32).collect(),
     };
-    let triangles = flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    if let Some(i) = flat.iter().find(|&&i| i as usize >= positions.len()) {
+        return Err(bad(&format!(
+            "index {i} is past its {} vertices",
+            positions.len()
+        )));
+    }
+    if positions.iter().any(|p| !p.is_finite()) {
+        return Err(bad("a vertex position is not finite"));
+    }
+    // One particle per place: coincident vertices (a non-indexed mesh, a UV seam) are
+    // welded, the way `solver::Cloth::from_mesh` welds them, and keep the first UV.
+    let welded = solver::topology::weld(&positions);
+    let triangles = flat
+        .chunks_exact(3)
+        .map(|t| [t[0], t[1], t[2]].map(|v| welded.particle_of[v as usize]))
+        .filter(|t: &[u32; 3]| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .collect();
     let uvs = match mesh.attribute(Mesh::ATTRIBUTE_UV_0) {
-        Some(VertexAttributeValues::Float32x2(uv)) => Some(uv.clone()),
+        Some(VertexAttributeValues::Float32x2(uv)) if uv.len() == positions.len() => {
+            let mut out = vec![[0.0; 2]; welded.positions.len()];
+            for (v, &k) in welded.particle_of.iter().enumerate().rev() {
+                out[k as usize] = uv[v];
+            }
+            Some(out)
+        }
         _ => None,
     };
     Ok(MeshSource {
-        positions,
+        positions: welded.positions,
         triangles,
         uvs,
     })

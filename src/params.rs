@@ -177,15 +177,14 @@ fn check_exponent(exponent: f32) -> Result<(), ClothError> {
 /// How shape matching finds the rotation of a cluster.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum RotationMethod {
-    /// Seed 000 eq. 6–9 and its pseudocode: the rotation of each particle's rest offset
-    /// onto its current offset as a quaternion, averaged component-wise. Fast; an
-    /// approximation that is exact for rotations about the cloth's normal and degrades for
-    /// large rotations about in-plane axes (see the tests' report).
-    QuaternionAverage {
-        /// Normalise the running sum after every particle, as the pseudocode does;
-        /// otherwise once at the end (the thesis's faster alternative).
-        normalize_each: bool,
-    },
+    /// Seed 000 eq. 6–9: the rotation of each particle's rest offset onto its current
+    /// offset as a quaternion, averaged component-wise and normalised once (the thesis's
+    /// faster variant). Fast; an approximation that is exact for rotations about the
+    /// cloth's normal and degrades for large rotations about in-plane axes (see the
+    /// tests' report). The pseudocode's other variant, normalising the running sum after
+    /// every particle, weighs the last particle ½, the one before ¼, …: its rotation
+    /// depends on the particles' order, so it is not offered.
+    QuaternionAverage,
     /// Seed 000 eq. 14–16: the rotation part of `A_pq = Σ m p qᵀ`, found by the iterative
     /// method of Müller et al. 2016 (robust for the rank-2 `A_pq` of a flat cloth and
     /// rank-1 of a strip; never a reflection; warm-started from the last step).
@@ -314,10 +313,14 @@ pub struct PatchParams {
     pub particle_damping_ratio: f32,
     /// Extra damping of the part centres, N·s/m per particle (added to the drag).
     pub part_damping: f32,
-    /// The thesis's proposed correction (seed targets only): shift each part's targets by
-    /// the offset from their centre of mass to the part's centre, less with distance.
+    /// The thesis's proposed correction: shift each part's targets by the offset from
+    /// their centre of mass to the part's centre, less with distance. Acts only with
+    /// [`PatchTargets::Seed`]: the bilinear targets ignore it (a per-part shift would
+    /// break their continuity across part borders).
     pub center_correction: bool,
-    /// "Tiles" (Slika 12): particles sit exactly on their targets, no oscillation.
+    /// "Tiles" (Slika 12): particles sit exactly on their targets, no oscillation. The
+    /// pull is then neither computed nor integrated, and only the part lattice sets the
+    /// substeps: the cheap end of the model.
     pub tiles: bool,
     /// The target interpolation.
     pub targets: PatchTargets,
@@ -409,8 +412,13 @@ pub struct ClothParams {
     /// Provot (1995) strain limit: springs longer than `(1 + limit)·rest` are shortened
     /// after each substep. `None` switches it off.
     pub strain_limit: Option<f32>,
-    /// Gauss–Seidel sweeps of the strain limiter per substep.
+    /// Gauss–Seidel sweeps of the strain limiter per substep (with a tolerance: at most
+    /// this many).
     pub strain_limit_iterations: u32,
+    /// Run the limiter to convergence instead of a fixed number of sweeps: sweeps stop
+    /// once a sweep finds no spring longer than `(1 + limit + tolerance)·l0`. `None`:
+    /// exactly `strain_limit_iterations` sweeps (a game's fixed cost).
+    pub strain_limit_tolerance: Option<f32>,
     /// A spring longer than `tear_ratio · rest_length` breaks (seed 000 §3.2). `None`: never.
     pub tear_ratio: Option<f32>,
 }
@@ -426,6 +434,7 @@ impl Default for ClothParams {
             substeps: Substeps::default(),
             strain_limit: Some(0.1),
             strain_limit_iterations: 4,
+            strain_limit_tolerance: None,
             tear_ratio: None,
         }
     }
@@ -511,6 +520,14 @@ impl ClothParams {
         }
         if let Some(limit) = self.strain_limit {
             check("strain_limit", limit, limit > 0.0, "a strain limit > 0")?;
+        }
+        if let Some(tolerance) = self.strain_limit_tolerance {
+            check(
+                "strain_limit_tolerance",
+                tolerance,
+                tolerance > 0.0,
+                "a tolerance > 0",
+            )?;
         }
         if let Some(ratio) = self.tear_ratio {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;

@@ -395,9 +395,12 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                         "Seed (per part, §3.4)",
                     );
                 });
-            ui.checkbox(
-                &mut patch.center_correction,
-                "centre correction (seed targets)",
+            ui.add_enabled(
+                patch.targets == PatchTargets::Seed,
+                egui::Checkbox::new(
+                    &mut patch.center_correction,
+                    "centre correction (seed targets only)",
+                ),
             );
             ui.checkbox(&mut patch.tiles, "tiles (no oscillation)");
             ui.label("part springs:");
@@ -439,21 +442,10 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
 }
 
 fn shape_matching_controls(ui: &mut egui::Ui, sm: &mut ShapeMatchingParams) {
-    let quaternion = RotationMethod::QuaternionAverage {
-        normalize_each: false,
-    };
-    let quaternion_each = RotationMethod::QuaternionAverage {
-        normalize_each: true,
-    };
     egui::ComboBox::from_label("rotation")
         .selected_text(match sm.rotation {
             RotationMethod::PolarDecomposition => "polar decomposition",
-            RotationMethod::QuaternionAverage {
-                normalize_each: false,
-            } => "quaternion average",
-            RotationMethod::QuaternionAverage {
-                normalize_each: true,
-            } => "quaternion avg. (normalise each)",
+            RotationMethod::QuaternionAverage => "quaternion average",
         })
         .show_ui(ui, |ui| {
             ui.selectable_value(
@@ -461,11 +453,10 @@ fn shape_matching_controls(ui: &mut egui::Ui, sm: &mut ShapeMatchingParams) {
                 RotationMethod::PolarDecomposition,
                 "polar decomposition",
             );
-            ui.selectable_value(&mut sm.rotation, quaternion, "quaternion average");
             ui.selectable_value(
                 &mut sm.rotation,
-                quaternion_each,
-                "quaternion avg. (normalise each)",
+                RotationMethod::QuaternionAverage,
+                "quaternion average",
             );
         });
     egui::ComboBox::from_label("update")

@@ -66,7 +66,7 @@ impl Cloth {
                 continue;
             }
             let dir = d / len;
-            let mut magnitude = k * (len - s.rest_length[idx]);
+            let mut magnitude = k * s.stiffness_scale[idx] * (len - s.rest_length[idx]);
             if damping > 0.0 {
                 magnitude += damping * (p.velocity[b] - p.velocity[a]).dot(dir);
             }
@@ -92,26 +92,50 @@ impl Cloth {
             return;
         };
         let (l, exponent) = (self.length_scale, sm.exponent);
+        if exponent == 1.0 {
+            // The offsets already sum to zero (mean removed per cluster).
+            for i in 0..p.position.len() {
+                p.force[i] += state.offsets[i] * sm.stiffness;
+            }
+            return;
+        }
+        // For p ≠ 1 each particle's own scale (|d|/L)^(p−1) undoes the zero sum of the
+        // offsets: take the net force back out, shared by mass, so the goal forces
+        // conserve momentum (pinned particles take their share, so a pin still holds).
+        let (mut net, mut mass) = (bevy::math::DVec3::ZERO, 0.0f64);
         for i in 0..p.position.len() {
             let d = state.offsets[i];
-            p.force[i] += d * (sm.stiffness * pull_scale(d.length(), l, exponent));
+            let f = d * (sm.stiffness * pull_scale(d.length(), l, exponent));
+            net += f.as_dvec3();
+            mass += p.mass[i] as f64;
+            p.force[i] += f;
+        }
+        let per_kg = (net / mass.max(f64::MIN_POSITIVE)).as_vec3();
+        for i in 0..p.position.len() {
+            p.force[i] -= per_kg * p.mass[i];
         }
     }
 
     /// The patch model: the part lattice's forces, and each particle's pull toward its
-    /// target `α (|d|/L)^(p−1) d` damped at `ratio · 2√(α m)`.
+    /// target `α (|d|/L)^(p−1) d` damped at `ratio · 2√(α m)` on its velocity relative to
+    /// the target (damping the absolute velocity would be a drag the lattice never
+    /// feels). With tiles the particles sit on their targets: no pull at all.
     fn pull_forces(&mut self, env: &Environment, patch: &PatchParams) {
         let Some(patches) = &mut self.patches else {
             return;
         };
         patches.parts.accumulate_forces(env);
+        if patch.tiles {
+            return;
+        }
         let (l, exponent) = (self.length_scale, patch.exponent);
         let p = &mut self.particles;
         for i in 0..p.position.len() {
             let d = patches.targets[i] - p.position[i];
             let scale = pull_scale(d.length(), l, exponent);
             let damping = patch.particle_damping_ratio * 2.0 * (patch.stiffness * p.mass[i]).sqrt();
-            p.force[i] = d * (patch.stiffness * scale) - damping * p.velocity[i];
+            let relative = p.velocity[i] - patches.target_velocity[i];
+            p.force[i] = d * (patch.stiffness * scale) - damping * relative;
         }
     }
 

@@ -6,12 +6,19 @@ use crate::params::{GoalUpdate, Integrator, Model};
 impl Cloth {
     /// Advances every free particle by one substep `h` from its accumulated force.
     pub fn integrate(&mut self) {
+        let h = self.h;
         if let Some(patches) = &mut self.patches {
-            // The part lattice takes its whole substep first; particles follow.
+            // The part lattice takes its whole substep first, held by the pins at their
+            // place at the end of this substep; particles follow.
             patches.parts.integrate();
             patches.parts.constrain();
+            let t = (self.substep_index + 1) as f32 / self.substeps.max(1) as f32;
+            let (from, to) = (&self.pin_from, &self.pin_to);
+            patches.hold_parts(|k| from[k].lerp(to[k], t), h);
+            if matches!(self.params.model, Model::Patches(patch) if patch.tiles) {
+                return; // tiles: particles are placed on their targets, not integrated
+            }
         }
-        let h = self.h;
         let h2 = h * h;
         let p = &mut self.particles;
         match self.params.integrator {
@@ -61,12 +68,24 @@ impl Cloth {
     pub fn fit_targets(&mut self) {
         if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
             let p = &mut self.particles;
-            patches.compute_targets(&p.position, &patch);
             let h = self.h;
+            if patch.tiles {
+                // Tiles (Slika 12): every free particle on its target.
+                patches.compute_targets(&p.position, &patch);
+                for i in 0..p.position.len() {
+                    if p.inv_mass[i] != 0.0 {
+                        let target = patches.targets[i];
+                        p.previous[i] = p.position[i];
+                        p.velocity[i] = (target - p.position[i]) / h;
+                        p.position[i] = target;
+                    }
+                }
+                return;
+            }
+            patches.advance_targets(&p.position, &patch, h);
             for i in 0..p.position.len() {
-                // Tiles (Slika 12): every particle on its target; otherwise only the
-                // particles that are parts of their own.
-                if p.inv_mass[i] != 0.0 && (patch.tiles || patches.is_single(i)) {
+                // A particle that is a part of its own is its part's centre.
+                if p.inv_mass[i] != 0.0 && patches.is_single(i) {
                     let target = patches.targets[i];
                     p.velocity[i] = (target - p.previous[i]) / h;
                     p.position[i] = target;
@@ -127,11 +146,15 @@ impl Cloth {
     /// Provot (1995): springs longer than `(1 + limit)·l0` are shortened to that length,
     /// each end moved by its share of inverse mass (seed 000 eq. 2); Gauss–Seidel sweeps
     /// over the structural and shear springs. Velocities take the same correction over `h`.
+    /// With `strain_limit_tolerance`, sweeping stops once a sweep finds every spring
+    /// within `(1 + limit + tolerance)·l0`.
     fn limit_strain(&mut self, limit: f32, h: f32) {
         let s = &self.springs;
         let p = &mut self.particles;
         let families = [SpringKind::Structural, SpringKind::Shear];
+        let tolerance = self.params.strain_limit_tolerance;
         for _ in 0..self.params.strain_limit_iterations {
+            let mut worst = 0.0f32;
             for kind in families {
                 if !self.params.springs.structural.enabled && kind == SpringKind::Structural
                     || !self.params.springs.shear.enabled && kind == SpringKind::Shear
@@ -154,12 +177,16 @@ impl Cloth {
                     if len <= max {
                         continue;
                     }
+                    worst = worst.max((len - max) / s.rest_length[idx]);
                     let correction = d * ((len - max) / (len * w));
                     p.position[a] += correction * wa;
                     p.position[b] -= correction * wb;
                     p.velocity[a] += correction * (wa / h);
                     p.velocity[b] -= correction * (wb / h);
                 }
+            }
+            if tolerance.is_some_and(|t| worst <= t) {
+                break;
             }
         }
     }

@@ -181,8 +181,10 @@ impl Cloth {
         Ok(cloth)
     }
 
-    /// Builds a cloth from a triangle mesh: vertices become particles, edges structural
-    /// springs, and the far corners of triangles sharing an edge bend springs.
+    /// Builds a cloth from a triangle mesh: vertices become particles (coincident ones
+    /// welded into one, see [`topology::weld`]), edges structural springs, and the far
+    /// corners of triangles sharing an edge bend springs. Triangles that welding
+    /// collapses are dropped.
     pub fn from_mesh(
         positions: &[Vec3],
         triangles: &[[u32; 3]],
@@ -219,11 +221,22 @@ impl Cloth {
                 reason: format!("triangle {t:?} is degenerate or indexes past the vertices"),
             });
         }
-        let pairs = topology::mesh_spring_pairs(triangles);
+        let welded = topology::weld(positions);
+        let triangles: Vec<[u32; 3]> = triangles
+            .iter()
+            .map(|t| t.map(|v| welded.particle_of[v as usize]))
+            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+            .collect();
+        if triangles.is_empty() {
+            return Err(ClothError::BadMesh {
+                reason: "every triangle collapses when coincident vertices are welded".into(),
+            });
+        }
+        let pairs = topology::mesh_spring_pairs(&triangles);
         Self::build(
-            positions.to_vec(),
+            welded.positions,
             pairs,
-            triangles.to_vec(),
+            triangles,
             None,
             pins,
             params,
@@ -468,6 +481,9 @@ impl Cloth {
         if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
             patches.set_params(&self.params, &patch, n);
             patches.parts.set_frame(self.frame);
+            // The part centres meet the colliders too: otherwise the targets sink into a
+            // collider and pull the particles in after it.
+            patches.parts.set_colliders(self.colliders.iter().copied());
             patches.parts.begin_step(dt);
         }
         // Pins move from where they are to where the frame puts them, over the substeps.
@@ -585,8 +601,11 @@ impl Cloth {
         let (omega2, gamma) = match (&self.params.model, &self.shape_matching, &self.patches) {
             (Model::ShapeMatching(sm), Some(state), _) => self.goal_frequency(sm, state),
             (Model::Patches(patch), _, Some(patches)) => {
-                let pull = self.pull_frequency(patch, patches);
                 let lattice = patches.lattice_substeps(dt);
+                if patch.tiles {
+                    return lattice; // no pull to resolve
+                }
+                let pull = self.pull_frequency(patch, patches);
                 return substeps_for(dt, pull.0, pull.1).max(lattice);
             }
             _ => self.spring_frequency(),
@@ -598,7 +617,7 @@ impl Cloth {
     fn state_dependent_stiffness(&self) -> bool {
         match self.params.model {
             Model::ShapeMatching(_) => true,
-            Model::Patches(p) => p.exponent != 1.0,
+            Model::Patches(p) => p.exponent != 1.0 && !p.tiles,
             Model::MassSpring => false,
         }
     }
@@ -614,15 +633,17 @@ impl Cloth {
     }
 
     /// ω² bound of a pull `α (d/L)^(p−1) d` toward `targets`: its stiffness along `d` is
-    /// `p α (d/L)^(p−1)`; the target moves with the particle (centre of mass, rotation,
-    /// interpolation), bounded by a factor 2. Over the free particles.
+    /// `p α (d/L)^(p−1)` and across `d` it is `α (d/L)^(p−1)`, so the larger of the two
+    /// is `max(p, 1) α (d/L)^(p−1)` (across wins for p < 1); the target moves with the
+    /// particle (centre of mass, rotation, interpolation), bounded by a factor 2. Over
+    /// the free particles.
     fn pull_omega2(&self, targets: &[Vec3], stiffness: f32, exponent: f32) -> f32 {
         let p = &self.particles;
         (0..p.len())
             .filter(|&i| p.inv_mass[i] > 0.0)
             .map(|i| {
                 let d = targets[i].distance(p.position[i]);
-                2.0 * exponent * stiffness * self.goal_scale(d, exponent) * p.inv_mass[i]
+                2.0 * stiffness * pull_stiffness(d, self.length_scale, exponent) * p.inv_mass[i]
             })
             .fold(0.0, f32::max)
     }
@@ -647,7 +668,7 @@ impl Cloth {
             for s in self.springs.ranges[kind as usize].clone() {
                 if self.springs.alive[s] {
                     for p in [self.springs.a[s], self.springs.b[s]] {
-                        k_sum[p as usize] += k;
+                        k_sum[p as usize] += k * self.springs.stiffness_scale[s];
                         c_sum[p as usize] += c;
                     }
                 }
@@ -674,12 +695,6 @@ impl Cloth {
             omega2,
             (sm.damping + self.params.drag) * self.max_free_inv_mass(),
         )
-    }
-
-    /// `(d/L)^(p−1)` for this cloth's length scale (see [`pull_scale`]).
-    #[inline]
-    fn goal_scale(&self, d: f32, exponent: f32) -> f32 {
-        pull_scale(d, self.length_scale, exponent)
     }
 
     /// Builds or drops the model state (shape-matching clusters, patch lattice) when the
@@ -778,14 +793,7 @@ impl Cloth {
         if self.params.model != Model::MassSpring {
             return 0.0;
         }
-        let s = &self.params.springs;
-        match kind {
-            SpringKind::Structural => s.structural.effective(),
-            SpringKind::Shear => s.shear.effective(),
-            SpringKind::Bend => s.bend.effective(),
-            SpringKind::BendDiagonal => s.bend_diagonal.effective(),
-            SpringKind::Seam => s.seam.effective(),
-        }
+        family_stiffness(&self.params.springs, kind)
     }
 
     // ----- queries --------------------------------------------------------------------
@@ -912,12 +920,12 @@ impl Cloth {
             && self.particles.velocity.iter().all(|v| v.is_finite())
     }
 
-    /// Kinetic, gravitational and spring energy under `env`.
+    /// Kinetic, gravitational and spring energy of the particles under `env`, the same
+    /// quantity for every model: the springs count at the cloth's spring parameters
+    /// (`params.springs`) whichever model moves the particles, so a shape-matched or
+    /// patch cloth is measured as the same cloth a mass-spring run would be (its goal
+    /// pull or part lattice is not counted).
     pub fn energy(&self, env: &Environment) -> Energy {
-        if let Some(patches) = &self.patches {
-            // The patch model's mechanics is its part lattice; particles only follow.
-            return patches.parts.energy(env);
-        }
         let g = env.effective_gravity();
         let p = &self.particles;
         let mut e = Energy::default();
@@ -927,35 +935,29 @@ impl Cloth {
                 e.gravitational -= p.mass[i] * g.dot(p.position[i]);
             }
         }
-        if let (Model::ShapeMatching(sm), Some(state)) = (&self.params.model, &self.shape_matching)
-        {
-            // Potential of the goal force: α L² (d/L)^(p+1) / (p+1); ½ α d² for p = 1.
-            if sm.update == GoalUpdate::Force {
-                let l = self.length_scale;
-                for i in 0..p.len() {
-                    if p.inv_mass[i] > 0.0 {
-                        let d = state.offsets[i].length() / l;
-                        e.spring +=
-                            sm.stiffness * l * l * d.powf(sm.exponent + 1.0) / (sm.exponent + 1.0);
-                    }
-                }
-            }
-            return e;
-        }
+        e.spring = self.spring_energy(&self.params.springs);
+        e
+    }
+
+    /// `Σ ½ k (l − l0)²` over the whole springs, with each family's stiffness from
+    /// `springs`.
+    fn spring_energy(&self, springs: &crate::params::SpringParams) -> f32 {
+        let x = &self.particles.position;
+        let s = &self.springs;
+        let mut energy = 0.0;
         for kind in SpringKind::ALL {
-            let k = self.stiffness(kind);
+            let k = family_stiffness(springs, kind);
             if k == 0.0 {
                 continue;
             }
-            for s in self.springs.ranges[kind as usize].clone() {
-                if self.springs.alive[s] {
-                    let l = p.position[self.springs.a[s] as usize]
-                        .distance(p.position[self.springs.b[s] as usize]);
-                    e.spring += 0.5 * k * (l - self.springs.rest_length[s]).powi(2);
+            for i in s.ranges[kind as usize].clone() {
+                if s.alive[i] {
+                    let l = x[s.a[i] as usize].distance(x[s.b[i] as usize]);
+                    energy += 0.5 * k * s.stiffness_scale[i] * (l - s.rest_length[i]).powi(2);
                 }
             }
         }
-        e
+        energy
     }
 
     /// Stretch of the whole structural springs.
@@ -1003,6 +1005,17 @@ impl Cloth {
     }
 }
 
+/// The acting stiffness of family `kind` in `springs` (0 when switched off).
+fn family_stiffness(springs: &crate::params::SpringParams, kind: SpringKind) -> f32 {
+    match kind {
+        SpringKind::Structural => springs.structural.effective(),
+        SpringKind::Shear => springs.shear.effective(),
+        SpringKind::Bend => springs.bend.effective(),
+        SpringKind::BendDiagonal => springs.bend_diagonal.effective(),
+        SpringKind::Seam => springs.seam.effective(),
+    }
+}
+
 /// The patch model needs a grid cloth (its parts are blocks of rows and columns).
 fn check_model_fits(params: &ClothParams, grid: Option<(u32, u32)>) -> Result<(), ClothError> {
     if matches!(params.model, Model::Patches(_)) && grid.is_none() {
@@ -1032,6 +1045,16 @@ fn substeps_for(dt: f32, omega2: f32, gamma: f32) -> u32 {
     }
 }
 
+/// The largest stiffness of the pull `(d/L)^(p−1) d` per unit α at distance `d`: along
+/// `d` it is `p (d/L)^(p−1)`, across `d` it is `(d/L)^(p−1)`, so `max(p, 1) (d/L)^(p−1)`
+/// (inside the clamp at `d/L = 0.05` the pull is linear: both are the clamped scale).
+#[inline]
+fn pull_stiffness(d: f32, length_scale: f32, exponent: f32) -> f32 {
+    let clamped = d / length_scale < 0.05;
+    let factor = if clamped { 1.0 } else { exponent.max(1.0) };
+    factor * pull_scale(d, length_scale, exponent)
+}
+
 /// The scale `(d/L)^(p−1)` of the pull `α (d/L)^(p−1) d` toward a goal or target used by
 /// shape matching and the patch model (seed 000 §4's exponent p), with `d/L` kept ≥ 0.05
 /// so that `p < 1` stays finite at the goal.
@@ -1041,5 +1064,46 @@ pub(crate) fn pull_scale(d: f32, length_scale: f32, exponent: f32) -> f32 {
         1.0
     } else {
         (d / length_scale).max(0.05).powf(exponent - 1.0)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The largest singular value of the Jacobian of `f(d) = (|d|/L)^(p−1) d` at `d`, by
+    /// central differences.
+    fn jacobian_norm(d: Vec3, l: f32, p: f32) -> f32 {
+        let f = |d: Vec3| d.as_dvec3() * pull_scale(d.length(), l, p) as f64;
+        let eps = d.length() * 1e-3;
+        let columns: Vec<bevy::math::DVec3> = [Vec3::X, Vec3::Y, Vec3::Z]
+            .iter()
+            .map(|&e| (f(d + e * eps) - f(d - e * eps)) / (2.0 * eps as f64))
+            .collect();
+        let j = bevy::math::DMat3::from_cols(columns[0], columns[1], columns[2]);
+        // Power iteration on JᵀJ.
+        let mut v = bevy::math::DVec3::new(0.3, 0.5, 0.8).normalize();
+        for _ in 0..200 {
+            v = (j.transpose() * (j * v)).normalize();
+        }
+        (j * v).length() as f32
+    }
+
+    #[test]
+    fn the_pull_bound_covers_its_stiffness_along_and_across_the_pull() {
+        // For p < 1 the pull is stiffer across d than along it; a bound from the axial
+        // stiffness p·(d/L)^(p−1) alone is too small by 1/p.
+        let l = 0.05;
+        for p in [0.5, 0.75, 1.0, 2.0, 3.0] {
+            for ratio in [0.01, 0.1, 0.3, 1.0, 2.5] {
+                let d = Vec3::new(0.6, -0.3, 0.74).normalize() * (ratio * l);
+                let exact = jacobian_norm(d, l, p);
+                let bound = pull_stiffness(d.length(), l, p);
+                assert!(
+                    bound >= exact * 0.999 && bound <= exact * 1.01,
+                    "p {p}, d/L {ratio}: bound {bound}, largest stiffness {exact}"
+                );
+            }
+        }
     }
 }

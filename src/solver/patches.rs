@@ -6,8 +6,14 @@
 //! Coupling rule (the thesis warns that parts fly apart when the two are not matched):
 //! the coupling is one-way. External forces act on the part centres, which carry the
 //! particles' mass; particles feel only the pull toward their targets, damped at a
-//! fraction of critical (`2√(α m)`), so they follow their parts and cannot push them
-//! apart. Automatic substeps cover both the part lattice and the pull.
+//! fraction of critical (`2√(α m)`) on their velocity *relative to the target*, so they
+//! follow their parts without a hidden drag and cannot push them apart. Automatic
+//! substeps cover both the part lattice and the pull (only the lattice with tiles).
+//!
+//! Pins hold particles, not parts: a pinned particle is kinematic, and its part's centre
+//! is kept at its rest distance from the pin (a rod), so the part swings about its pins
+//! instead of freezing as a rigid block. A part of one particle is that particle, so its
+//! centre is pinned outright.
 
 use bevy::math::{Affine3A, Vec3};
 
@@ -15,6 +21,17 @@ use super::{Cloth, topology};
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model, PatchParams, PatchTargets, Substeps};
 use crate::shape::Pins;
+
+/// A pin's hold on its part: the part's centre stays `length` from the pin.
+#[derive(Clone, Copy, Debug)]
+struct Anchor {
+    /// The part lattice node.
+    part: u32,
+    /// Index into the cloth's pin list.
+    pin: u32,
+    /// Rest distance from the pinned particle to the part's centre.
+    length: f32,
+}
 
 /// One part: a block of the particle grid.
 #[derive(Clone, Copy, Debug)]
@@ -43,6 +60,16 @@ pub struct Patches {
     /// Bilinear stencil per particle: the four centres (x0y0, x1y0, x0y1, x1y1) and the
     /// weights along x and y (outside [0, 1] beyond the outer centres).
     stencil: Vec<([u32; 4], f32, f32)>,
+    /// Velocity of every particle's target over the last substep, `(t' − t)/h`: the pull's
+    /// damping acts on the particle's velocity relative to it.
+    pub target_velocity: Vec<Vec3>,
+    /// The targets before the last `compute_targets` of a substep (for `target_velocity`).
+    previous_targets: Vec<Vec3>,
+    /// Rods from pins to the centres of their parts (parts larger than one particle).
+    anchors: Vec<Anchor>,
+    /// Rest distance between neighbouring particles along x and y (the length of the
+    /// per-particle step of a cloth one part across).
+    rest_step: (f32, f32),
     /// `(part_width, part_height)` these were built for.
     pub(super) built_for: (u32, u32),
     /// The lattice's stable substeps for (its parameters, dt): they do not depend on the
@@ -144,9 +171,22 @@ impl Patches {
             let (i, j) = (k % w, k / w);
             (j / ph) * nx + i / pw
         };
-        let mut pinned_parts: Vec<u32> = pins.iter().map(|&k| part_of(k)).collect();
-        pinned_parts.sort_unstable();
-        pinned_parts.dedup();
+        // A part of one particle is that particle: pinned outright. A larger part is held
+        // at its rest distance from each of its pins (see the module doc).
+        let mut pinned_parts = Vec::new();
+        let mut anchors = Vec::new();
+        for (slot, &k) in pins.iter().enumerate() {
+            let part = part_of(k);
+            if lumps[part as usize] == 1.0 {
+                pinned_parts.push(part);
+            } else {
+                anchors.push(Anchor {
+                    part,
+                    pin: slot as u32,
+                    length: local_rest[k as usize].distance(centres[part as usize]),
+                });
+            }
+        }
         let pairs = topology::grid_spring_pairs(nx, ny);
         let mut parts = Cloth::build(
             centres,
@@ -158,19 +198,28 @@ impl Patches {
             frame,
         )?;
         parts.particles.lump = lumps;
+        scale_for_aspect(&mut parts.springs, nx, (pw, ph));
         parts.reset();
+        let step =
+            |a: usize, b: usize| local_rest.get(b).map_or(0.0, |x| x.distance(local_rest[a]));
+        let rest_step = (step(0, 1), step(0, w as usize));
+        let targets: Vec<Vec3> = local_rest
+            .iter()
+            .map(|x| frame.transform_point3(*x))
+            .collect();
         Ok(Patches {
             parts: Box::new(parts),
             part_grid: (nx, ny),
             layout,
             grid,
-            targets: local_rest
-                .iter()
-                .map(|x| frame.transform_point3(*x))
-                .collect(),
+            target_velocity: vec![Vec3::ZERO; targets.len()],
+            previous_targets: targets.clone(),
+            targets,
             correction_weight,
             single,
             stencil,
+            anchors,
+            rest_step,
             lattice_substeps: None,
             built_for: (patch.part_width, patch.part_height),
         })
@@ -191,6 +240,49 @@ impl Patches {
             parts.position[k] = mean(&particles.position);
             parts.previous[k] = mean(&particles.previous);
             parts.velocity[k] = mean(&particles.velocity);
+        }
+        // Until the targets have moved once, each particle moves with its target.
+        self.target_velocity.copy_from_slice(&particles.velocity);
+    }
+
+    /// Recomputes the targets after a substep of `h` and their velocities `(t' − t)/h`.
+    /// Allocates nothing.
+    pub fn advance_targets(&mut self, x: &[Vec3], patch: &PatchParams, h: f32) {
+        self.previous_targets.copy_from_slice(&self.targets);
+        self.compute_targets(x, patch);
+        let inv_h = 1.0 / h;
+        for ((v, t), t0) in self
+            .target_velocity
+            .iter_mut()
+            .zip(&self.targets)
+            .zip(&self.previous_targets)
+        {
+            *v = (*t - *t0) * inv_h;
+        }
+    }
+
+    /// Keeps each pinned part's centre at its rest distance from its pins (`pin_at(k)`:
+    /// where pin `k` is now), moving it along the rod and changing its velocity by the
+    /// same over `h`. Gauss–Seidel over the anchors, a few sweeps (a part with a row of
+    /// pins hangs from all of them).
+    pub fn hold_parts(&mut self, pin_at: impl Fn(usize) -> Vec3, h: f32) {
+        const SWEEPS: usize = 4;
+        let p = &mut self.parts.particles;
+        for _ in 0..SWEEPS {
+            for anchor in &self.anchors {
+                let k = anchor.part as usize;
+                let pin = pin_at(anchor.pin as usize);
+                let d = p.position[k] - pin;
+                let len = d.length();
+                let goal = if len > f32::EPSILON {
+                    pin + d * (anchor.length / len)
+                } else {
+                    pin
+                };
+                let delta = goal - p.position[k];
+                p.position[k] = goal;
+                p.velocity[k] += delta / h;
+            }
         }
     }
 
@@ -295,8 +387,15 @@ impl Patches {
                     (Some((m, d)), None) => ((m, d), (2.0 * c - m, d)),
                     (None, Some((p, d))) => ((2.0 * c - p, d), (p, d)),
                     // One part across: measure the direction from the part's own particles.
+                    // Its length is the rest spacing, so the pull restores the cloth's
+                    // extent along that axis (a measured length would give no stiffness).
                     (None, None) => {
-                        let step = own_step(&part, x, w, horizontal);
+                        let rest = if horizontal {
+                            self.rest_step.0
+                        } else {
+                            self.rest_step.1
+                        };
+                        let step = own_step(&part, x, w, horizontal).normalize_or_zero() * rest;
                         let n = size(part, horizontal);
                         ((c - step * n, n), (c + step * n, n))
                     }
@@ -342,6 +441,26 @@ impl Patches {
     /// Acting springs of the part lattice.
     pub fn spring_count(&self) -> usize {
         self.parts.spring_count()
+    }
+}
+
+/// Scales the part lattice's springs for parts of `pw × ph` particles: a horizontal
+/// spring stands for `ph` rows of particle springs in parallel, each `pw` springs in
+/// series, so its stiffness is `k·ph/pw` (vertical: `k·pw/ph`). A diagonal spring spans
+/// `(pw, ph)`; its share along each axis is weighed the same way, `2·pw·ph/(pw² + ph²)`.
+/// Square parts keep the particle constants.
+fn scale_for_aspect(springs: &mut topology::Springs, nx: u32, (pw, ph): (u32, u32)) {
+    let (w, h) = (pw as f32, ph as f32);
+    let (horizontal, vertical, diagonal) = (h / w, w / h, 2.0 * w * h / (w * w + h * h));
+    for s in 0..springs.len() {
+        let (a, b) = (springs.a[s], springs.b[s]);
+        springs.stiffness_scale[s] = if a / nx == b / nx {
+            horizontal
+        } else if a % nx == b % nx {
+            vertical
+        } else {
+            diagonal
+        };
     }
 }
 

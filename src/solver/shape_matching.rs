@@ -135,14 +135,12 @@ impl ShapeMatching {
                 a_pq += outer((x[i as usize] - com) * weight(i), *q);
             }
             let rotation = match params.rotation {
-                RotationMethod::QuaternionAverage { normalize_each } => {
-                    average_rotation(c, x, com, normalize_each)
-                }
+                RotationMethod::QuaternionAverage => average_rotation(c, x, com),
                 RotationMethod::PolarDecomposition => {
                     let start = if c.warm {
                         c.rotation
                     } else {
-                        average_rotation(c, x, com, false)
+                        average_rotation(c, x, com)
                     };
                     extract_rotation(&a_pq, start)
                 }
@@ -206,25 +204,22 @@ fn regularised_inverse(a_qq: Mat3) -> Mat3 {
     if inv.is_finite() { inv } else { Mat3::ZERO }
 }
 
-/// Seed 000 eq. 6–9 and pseudocode: per particle, the rotation of the rest offset onto the
-/// current offset; the quaternions summed component-wise and normalised. Each quaternion
-/// is flipped into the running sum's hemisphere first (q and −q are the same rotation; the
-/// thesis does not say, and without it a sum can cancel to nothing).
-fn average_rotation(c: &Cluster, x: &[Vec3], com: Vec3, normalize_each: bool) -> Quat {
+/// Seed 000 eq. 6–9: per particle, the rotation of the rest offset onto the current
+/// offset; the quaternions summed component-wise and normalised once, so every particle
+/// weighs the same whatever its place in the order. Each quaternion is flipped into the
+/// hemisphere of the cluster's previous rotation first (q and −q are the same rotation;
+/// the thesis does not say, and without it a sum can cancel to nothing). A fixed
+/// reference, not the running sum, keeps the flips independent of the order too.
+fn average_rotation(c: &Cluster, x: &[Vec3], com: Vec3) -> Quat {
+    let reference = Vec4::from(c.rotation);
     let mut sum = Vec4::ZERO;
     for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
         let p = x[i as usize] - com;
         let (Some(from), Some(to)) = (q.try_normalize(), p.try_normalize()) else {
             continue;
         };
-        let mut r = Vec4::from(Quat::from_rotation_arc(from, to));
-        if sum.dot(r) < 0.0 {
-            r = -r;
-        }
-        sum += r;
-        if normalize_each {
-            sum = sum.normalize_or_zero();
-        }
+        let r = Vec4::from(Quat::from_rotation_arc(from, to));
+        sum += if reference.dot(r) < 0.0 { -r } else { r };
     }
     match sum.try_normalize() {
         Some(v) => Quat::from_vec4(v),

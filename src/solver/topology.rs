@@ -43,6 +43,9 @@ pub struct Springs {
     pub rest_length: Vec<f32>,
     /// False once a spring has torn.
     pub alive: Vec<bool>,
+    /// Factor on the family's stiffness for each spring (1 for a particle cloth; the
+    /// patch model's part lattice scales its springs by the parts' aspect ratio).
+    pub stiffness_scale: Vec<f32>,
     /// The index range of each kind, in `SpringKind` order.
     pub ranges: [Range<usize>; 5],
 }
@@ -86,6 +89,7 @@ impl Springs {
                     .rest_length
                     .push(positions[a as usize].distance(positions[b as usize]));
                 springs.alive.push(true);
+                springs.stiffness_scale.push(1.0);
             }
             springs.ranges[kind as usize] = start..springs.a.len();
         }
@@ -192,4 +196,55 @@ pub fn triangle_edge_springs(
         })
         .collect();
     (edges, spring_triangles)
+}
+
+/// Vertices welded into particles: vertices closer than a millionth of the mesh's size
+/// become one (a non-indexed mesh repeats each shared corner; a mesh split along UV seams
+/// repeats the seam's vertices). The first vertex of each group is kept, in order.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Welded {
+    /// One position per particle.
+    pub positions: Vec<Vec3>,
+    /// For each input vertex, its particle.
+    pub particle_of: Vec<u32>,
+}
+
+/// Welds coincident vertices (see [`Welded`]); positions must be finite.
+pub fn weld(positions: &[Vec3]) -> Welded {
+    let (lo, hi) = positions.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+    );
+    let tolerance = ((hi - lo).length() * 1e-6).max(f32::MIN_POSITIVE);
+    let cell = |p: Vec3| (p / tolerance).floor().as_ivec3();
+    let mut grid: HashMap<bevy::math::IVec3, Vec<u32>> = HashMap::new();
+    let mut welded = Welded {
+        positions: Vec::with_capacity(positions.len()),
+        particle_of: Vec::with_capacity(positions.len()),
+    };
+    for &p in positions {
+        let c = cell(p);
+        let mut found = None;
+        'search: for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let near = grid.get(&(c + bevy::math::IVec3::new(dx, dy, dz)));
+                    for &k in near.into_iter().flatten() {
+                        if welded.positions[k as usize].distance(p) <= tolerance {
+                            found = Some(k);
+                            break 'search;
+                        }
+                    }
+                }
+            }
+        }
+        let k = found.unwrap_or_else(|| {
+            let k = welded.positions.len() as u32;
+            welded.positions.push(p);
+            grid.entry(c).or_default().push(k);
+            k
+        });
+        welded.particle_of.push(k);
+    }
+    welded
 }
