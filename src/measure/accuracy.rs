@@ -3,9 +3,17 @@
 //!
 //! The reference is the scene's cloth as a mass-spring cloth at the same resolution, with
 //! the substep divided by 64: 64 times the substeps the explicit bound asks for (the
-//! scene's 16 ms step divided by 64 would be unstable for a stiff card). It is checked
-//! by halving the substep once more. It integrates with symplectic Euler (see
-//! [`Case::reference`]).
+//! scene's 16 ms step divided by 64 would be unstable for a stiff card). It is the same
+//! material as the configurations: the same springs, and the same strain limit, which
+//! the reference runs to convergence (a tolerance, not a fixed number of sweeps), so a
+//! configuration that limits less is measured as the softer material it is. It is
+//! checked by halving the substep once more; a scene whose reference does not converge
+//! gets no Pareto flags. It integrates with symplectic Euler (see [`Case::reference`]).
+//!
+//! Times are the median of several runs with their spread (fastest and slowest); a
+//! configuration is on the cost–error frontier only when no other one is at least as
+//! good in both beyond the spread of the times and the reference's own uncertainty
+//! (see [`pareto`]). A run that failed gets neither a time nor a flag.
 
 use std::time::Instant;
 
@@ -20,6 +28,12 @@ use super::SceneRun;
 
 /// Seconds between error samples.
 pub const SAMPLE_INTERVAL: f64 = 0.1;
+
+/// The reference's strain limiter: sweeps until no spring is past the limit by more than
+/// this (a fraction of its rest length) …
+pub const REFERENCE_LIMITER_TOLERANCE: f32 = 1e-4;
+/// … or at most this many sweeps per substep.
+pub const REFERENCE_LIMITER_SWEEPS: u32 = 500;
 
 /// A configuration: a model with its knobs set.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -221,11 +235,15 @@ impl Case {
         // Symplectic Euler, not Verlet: at hundreds of substeps per step a displacement
         // is a few float spacings of the position, and Verlet's velocity, a difference of
         // positions, picks up the rounding of every strain-limiter correction; Euler
-        // carries its velocity exactly.
+        // carries its velocity exactly. The strain limiter (when the material has one)
+        // runs until every spring is within 0.01% of the limit.
+        let base = self.base();
         let params = ClothParams {
             substeps: Substeps::Fixed(substeps),
             integrator: Integrator::SemiImplicitEuler,
-            ..self.base()
+            strain_limit_iterations: REFERENCE_LIMITER_SWEEPS,
+            strain_limit_tolerance: base.strain_limit.map(|_| REFERENCE_LIMITER_TOLERANCE),
+            ..base
         };
         Ok((substeps, self.simulate(&params)?))
     }
@@ -299,8 +317,10 @@ pub struct Row {
     pub model: &'static str,
     /// Its knobs.
     pub label: String,
-    /// Wall-clock ms per simulated second.
-    pub ms_per_second: f64,
+    /// Wall-clock ms per simulated second, the median of the timed runs (`None`: failed).
+    pub ms_per_second: Option<f64>,
+    /// The fastest and slowest timed run, ms per simulated second.
+    pub ms_range: Option<(f64, f64)>,
     /// Substeps per 16 ms step, on average.
     pub substeps: f64,
     /// RMS particle distance to the reference over the run / diagonal (`None`: failed).
@@ -309,7 +329,9 @@ pub struct Row {
     pub final_error: Option<f64>,
     /// Largest structural strain over the run.
     pub max_strain: f32,
-    /// Final total energy minus the reference's, over `M g D` (mass, gravity, diagonal).
+    /// Final total energy minus the reference's, over `M g D` (mass, gravity, diagonal);
+    /// the same quantity for every model: the particles' kinetic, gravitational and
+    /// spring energy at the scene's spring parameters ([`crate::solver::Cloth::energy`]).
     pub energy_drift: Option<f64>,
     /// When the run failed, s.
     pub failed_at: Option<f32>,
@@ -334,11 +356,12 @@ pub struct Reference {
     pub milliseconds: f64,
 }
 
-/// Measures every configuration of `case` against its reference; `progress` hears of
-/// each row as it is done.
+/// Measures every configuration of `case` against its reference, timing each stable one
+/// `repeats` times (at least 1); `progress` hears of each row as it is done.
 pub fn measure(
     case: &Case,
     configs: &[Config],
+    repeats: usize,
     mut progress: impl FnMut(&Row),
 ) -> Result<(Reference, Vec<Row>), ClothError> {
     let (substeps, reference) = case.reference(64)?;
@@ -357,11 +380,25 @@ pub fn measure(
     for config in configs {
         let run = case.simulate(&config.params)?;
         let errors = run.error_against(&reference);
+        let (ms_per_second, ms_range) = match errors {
+            Some(_) => {
+                let mut times = vec![run.milliseconds / case.seconds as f64];
+                for _ in 1..repeats.max(1) {
+                    times.push(case.simulate(&config.params)?.milliseconds / case.seconds as f64);
+                }
+                let range = times.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
+                    (lo.min(t), hi.max(t))
+                });
+                (Some(super::median(&mut times)), Some(range))
+            }
+            None => (None, None),
+        };
         let row = Row {
             scene: case.name.clone(),
             model: config.model,
             label: config.label.clone(),
-            ms_per_second: run.milliseconds / case.seconds as f64,
+            ms_per_second,
+            ms_range,
             substeps: run.mean_substeps,
             error: errors.map(|e| e.0),
             final_error: errors.map(|e| e.1),
@@ -374,48 +411,79 @@ pub fn measure(
         progress(&row);
         rows.push(row);
     }
-    let points: Vec<Option<(f64, f64)>> = rows
-        .iter()
-        .map(|r| r.error.map(|e| (r.ms_per_second, e)))
-        .collect();
-    for i in pareto(&points) {
-        rows[i].pareto = true;
-    }
     let smallest_error = rows
         .iter()
         .filter_map(|r| r.error)
         .filter(|e| *e > 0.0)
         .fold(f64::INFINITY, f64::min);
+    let converged = halving_change < 0.05 * smallest_error;
+    if converged {
+        let points: Vec<Option<Point>> = rows
+            .iter()
+            .map(|r| {
+                Some(Point {
+                    cost: r.ms_range?,
+                    error: r.error?,
+                })
+            })
+            .collect();
+        for i in pareto(&points, halving_change) {
+            rows[i].pareto = true;
+        }
+    }
     Ok((
         Reference {
             scene: case.name.clone(),
             substeps,
             halving_change,
             smallest_error,
-            converged: halving_change < 0.05 * smallest_error,
+            converged,
             milliseconds: reference.milliseconds,
         },
         rows,
     ))
 }
 
-/// Indices of the points (cost, error) no other point beats in both, cheapest first;
-/// `None` points are left out.
-pub fn pareto(points: &[Option<(f64, f64)>]) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..points.len()).filter(|&i| points[i].is_some()).collect();
-    order.sort_by(|&a, &b| {
-        let (pa, pb) = (points[a].expect("some"), points[b].expect("some"));
-        pa.0.total_cmp(&pb.0).then(pa.1.total_cmp(&pb.1))
-    });
-    let mut best = f64::INFINITY;
-    let mut out = Vec::new();
-    for i in order {
-        let error = points[i].expect("some").1;
-        if error < best {
-            best = error;
-            out.push(i);
-        }
+/// A measured configuration: its cost as the range of its timed runs, and its error.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// Fastest and slowest run.
+    pub cost: (f64, f64),
+    /// Error against the reference.
+    pub error: f64,
+}
+
+impl Point {
+    /// True when `self` is at least as good as `other` in cost and error, and better in
+    /// one of them beyond the uncertainty: cost ranges that overlap are equal, and errors
+    /// within `uncertainty` (the reference's own) are equal.
+    fn dominates(&self, other: &Point, uncertainty: f64) -> bool {
+        let cost_no_worse = self.cost.0 <= other.cost.1;
+        let cost_better = self.cost.1 < other.cost.0;
+        let error_no_worse = self.error <= other.error + uncertainty;
+        let error_better = self.error + uncertainty < other.error;
+        cost_no_worse && error_no_worse && (cost_better || error_better)
     }
+}
+
+/// Indices of the points no other point dominates ([`Point::dominates`]: at least as
+/// good in both, better in one beyond the spread of the times and `uncertainty` in the
+/// error), cheapest first; `None` points (failed runs) are left out. Two configurations
+/// that cannot be told apart are flagged alike.
+pub fn pareto(points: &[Option<Point>], uncertainty: f64) -> Vec<usize> {
+    let mut out: Vec<usize> = (0..points.len())
+        .filter(|&i| {
+            let Some(p) = points[i] else { return false };
+            !points
+                .iter()
+                .flatten()
+                .any(|q| q.dominates(&p, uncertainty))
+        })
+        .collect();
+    out.sort_by(|&a, &b| {
+        let (pa, pb) = (points[a].expect("some"), points[b].expect("some"));
+        pa.cost.0.total_cmp(&pb.cost.0)
+    });
     out
 }
 
@@ -423,16 +491,38 @@ pub fn pareto(points: &[Option<(f64, f64)>]) -> Vec<usize> {
 mod tests {
     use super::*;
 
+    fn point(lo: f64, hi: f64, error: f64) -> Option<Point> {
+        Some(Point {
+            cost: (lo, hi),
+            error,
+        })
+    }
+
     #[test]
     fn pareto_keeps_points_nothing_beats_in_cost_and_error() {
         let points = [
-            Some((1.0, 0.5)),
-            Some((2.0, 0.6)), // beaten by the first
-            Some((3.0, 0.1)),
+            point(1.0, 1.1, 0.5),
+            point(2.0, 2.1, 0.6), // beaten by the first in both
+            point(3.0, 3.1, 0.1),
             None,
-            Some((0.5, 0.9)),
-            Some((3.0, 0.2)), // same cost as the third, worse error
+            point(0.5, 0.6, 0.9),
+            point(3.0, 3.1, 0.2), // same cost as the third, worse error
         ];
-        assert_eq!(pareto(&points), vec![4, 0, 2]);
+        assert_eq!(pareto(&points, 0.0), vec![4, 0, 2]);
+    }
+
+    #[test]
+    fn pareto_needs_a_difference_beyond_the_spread() {
+        // The same simulation timed twice (equal errors, overlapping times): flagged alike,
+        // whichever single timing happened to be lower.
+        let twins = [point(40.0, 46.0, 0.0165), point(41.0, 45.0, 0.0165)];
+        assert_eq!(pareto(&twins, 0.0), vec![0, 1]);
+        // A slower run whose times overlap a more accurate one is not beaten on cost.
+        let overlap = [point(10.0, 14.0, 0.010), point(12.0, 16.0, 0.020)];
+        assert_eq!(pareto(&overlap, 0.0), vec![0]);
+        let apart = [point(10.0, 11.0, 0.010), point(5.0, 6.0, 0.020)];
+        assert_eq!(pareto(&apart, 0.0), vec![1, 0]);
+        // An error gap inside the reference's uncertainty is no gap: the cheaper one wins.
+        assert_eq!(pareto(&apart, 0.05), vec![1]);
     }
 }

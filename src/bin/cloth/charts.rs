@@ -7,7 +7,7 @@ use std::path::Path;
 
 use bevy_cloth::measure::accuracy::Row;
 use bevy_cloth::measure::fps::{AppFrame, SEED_002_FPS};
-use bevy_cloth::measure::stability::{Cell, MODELS};
+use bevy_cloth::measure::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
 use bevy_cloth::measure::{BenchCell, SEED_COUNTS, SEED_MODELS, SEED_MS};
 use bevy_cloth::prelude::Integrator;
 use plotters::coord::Shift;
@@ -123,7 +123,7 @@ impl Chart for Bench<'_> {
         let Bench { cells, app } = *self;
         let ys = cells
             .iter()
-            .map(|c| c.ms_per_step)
+            .filter_map(|c| c.ms_per_step)
             .chain(SEED_MS.iter().flatten().copied())
             .chain(app.iter().map(|a| a.ms_per_frame))
             .chain(SEED_002_FPS.iter().map(|(_, f)| 1e3 / f));
@@ -149,7 +149,7 @@ impl Chart for Bench<'_> {
             .map_err(err)?;
         let names = [
             "1 mass-spring",
-            "2 shape matching",
+            "2 shape matching (α = 1280 N/m)",
             "3a patches 2×2",
             "3b patches 4×4",
             "3c patches 8×8",
@@ -159,7 +159,7 @@ impl Chart for Bench<'_> {
             let ours: Vec<(f64, f64)> = cells
                 .iter()
                 .filter(|c| c.model == *model)
-                .map(|c| (c.particles as f64, c.ms_per_step))
+                .filter_map(|c| Some((c.particles as f64, c.ms_per_step?)))
                 .collect();
             if !ours.is_empty() {
                 chart
@@ -262,12 +262,26 @@ impl Chart for Accuracy<'_> {
         let panels = area.split_evenly((1, scenes.len().max(1)));
         for (panel, scene) in panels.iter().zip(scenes) {
             let rows: Vec<&Row> = rows.iter().filter(|r| r.scene == *scene).collect();
-            let ok: Vec<&&Row> = rows.iter().filter(|r| r.error.is_some()).collect();
-            let xs = log_range(ok.iter().map(|r| r.ms_per_second));
-            let ys = log_range(ok.iter().filter_map(|r| r.error));
+            // Failed runs have neither a time nor an error: not drawn.
+            let ok: Vec<(&Row, f64, f64)> = rows
+                .iter()
+                .filter_map(|r| Some((*r, r.ms_per_second?, r.error?)))
+                .collect();
+            let xs = log_range(
+                ok.iter()
+                    .flat_map(|(r, _, _)| r.ms_range.map(|(lo, hi)| [lo, hi]))
+                    .flatten(),
+            );
+            let ys = log_range(ok.iter().map(|(_, _, e)| *e));
+            let converged = rows.iter().any(|r| r.pareto);
+            let caption = if converged {
+                scene.to_string()
+            } else {
+                format!("{scene} (reference not converged: no frontier)")
+            };
             let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
             let mut chart = ChartBuilder::on(panel)
-                .caption(*scene, (FONT, 22))
+                .caption(caption, (FONT, 20))
                 .margin(12)
                 .x_label_area_size(45)
                 .y_label_area_size(65)
@@ -286,10 +300,17 @@ impl Chart for Accuracy<'_> {
                 .axis_desc_style((FONT, 16))
                 .draw()
                 .map_err(err)?;
+            // The spread of each configuration's timed runs, fastest to slowest.
+            chart
+                .draw_series(ok.iter().filter_map(|(r, _, e)| {
+                    let (lo, hi) = r.ms_range?;
+                    Some(PathElement::new(vec![(lo, *e), (hi, *e)], BLACK.mix(0.5)))
+                }))
+                .map_err(err)?;
             let mut frontier: Vec<(f64, f64)> = ok
                 .iter()
-                .filter(|r| r.pareto)
-                .map(|r| (r.ms_per_second, r.error.expect("ok")))
+                .filter(|(r, _, _)| r.pareto)
+                .map(|(_, ms, e)| (*ms, *e))
                 .collect();
             frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
             let mut stairs = Vec::new();
@@ -310,8 +331,8 @@ impl Chart for Accuracy<'_> {
                 let color = PALETTE[m];
                 let points: Vec<(f64, f64)> = ok
                     .iter()
-                    .filter(|r| r.model == *model)
-                    .map(|r| (r.ms_per_second, r.error.expect("ok")))
+                    .filter(|(r, _, _)| r.model == *model)
+                    .map(|(_, ms, e)| (*ms, *e))
                     .collect();
                 let style = color.filled();
                 let anno =
@@ -347,42 +368,103 @@ impl Chart for Accuracy<'_> {
 
 /// `docs/stability.png`: a panel per model (rows) and integrator with automatic
 /// substeps off and on (columns); a cell is drawn at (timestep, `√(k/m)`), green when it
-/// ran stable, a red cross when it failed. The line is the explicit bound `ω_max·h = 2`
-/// with `ω_max = factor·√(k/m)`, `factors` per model as in [`MODELS`].
+/// ran stable, a red cross when it failed, an orange square when the automatic substeps
+/// hit their cap (8192; a cross on it when it also failed). The line is the explicit
+/// bound `ω_max·h = 2` with `ω_max = factor·√(k/m)`, `factors` per model as in
+/// [`MODELS`].
 pub fn stability(png: &Path, cells: &[Cell], factors: &[f32; 3]) -> Result<()> {
-    both(png, (1500, 1050), &Stability { cells, factors })
+    let columns = [
+        (Integrator::Verlet, false, "Verlet, 1 substep"),
+        (Integrator::SemiImplicitEuler, false, "Euler, 1 substep"),
+        (Integrator::Verlet, true, "Verlet, auto substeps"),
+        (Integrator::SemiImplicitEuler, true, "Euler, auto substeps"),
+    ];
+    let mut panels = Vec::new();
+    for (m, model) in MODELS.iter().enumerate() {
+        for (integrator, auto, name) in columns {
+            panels.push(Panel {
+                title: format!("{model}: {name}"),
+                bound: Some(factors[m]),
+                cells: cells
+                    .iter()
+                    .filter(|c| {
+                        c.regime == Regime::Linear
+                            && c.model == *model
+                            && c.integrator == integrator
+                            && c.auto == auto
+                    })
+                    .collect(),
+            });
+        }
+    }
+    let title = "Linear regime: stable (green), failed (red ×), over the substep cap (orange); line: ω_max·h = 2";
+    both(
+        png,
+        (1500, 1050),
+        &Stability {
+            title,
+            panels: &panels,
+            grid: (MODELS.len(), columns.len()),
+        },
+    )
+}
+
+/// `docs/stability_nonlinear.png`: the nonlinear regimes (rows) for each model of
+/// [`NONLINEAR_MODELS`] (columns), Verlet with automatic substeps; colours as in
+/// [`stability`].
+pub fn stability_nonlinear(png: &Path, cells: &[Cell]) -> Result<()> {
+    let mut panels = Vec::new();
+    for regime in Regime::NONLINEAR {
+        for model in NONLINEAR_MODELS {
+            panels.push(Panel {
+                title: format!("{regime:?}: {model}"),
+                bound: None,
+                cells: cells
+                    .iter()
+                    .filter(|c| c.regime == regime && c.model == model)
+                    .collect(),
+            });
+        }
+    }
+    let title = "Nonlinear regimes, Verlet, automatic substeps: stable (green), failed (red ×), over the substep cap (orange)";
+    both(
+        png,
+        (2600, 1000),
+        &Stability {
+            title,
+            panels: &panels,
+            grid: (Regime::NONLINEAR.len(), NONLINEAR_MODELS.len()),
+        },
+    )
+}
+
+struct Panel<'a> {
+    title: String,
+    /// `ω_max/√(k/m)` for the line `ω_max·h = 2`, if drawn.
+    bound: Option<f32>,
+    cells: Vec<&'a Cell>,
 }
 
 struct Stability<'a> {
-    cells: &'a [Cell],
-    factors: &'a [f32; 3],
+    title: &'a str,
+    panels: &'a [Panel<'a>],
+    grid: (usize, usize),
 }
 
 impl Chart for Stability<'_> {
     fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
-        let Stability { cells, factors } = *self;
-        let columns = [
-            (Integrator::Verlet, false, "Verlet, 1 substep"),
-            (Integrator::SemiImplicitEuler, false, "Euler, 1 substep"),
-            (Integrator::Verlet, true, "Verlet, auto substeps"),
-            (Integrator::SemiImplicitEuler, true, "Euler, auto substeps"),
-        ];
         let (title, body) = area.split_vertically(40);
-        title
-            .titled(
-                "Stable (green) and failed (red ×) cells; line: ω_max·h = 2",
-                (FONT, 24),
-            )
-            .map_err(err)?;
-        let panels = body.split_evenly((MODELS.len(), columns.len()));
+        title.titled(self.title, (FONT, 22)).map_err(err)?;
+        let areas = body.split_evenly(self.grid);
         let xs = 0.0007f64..0.05;
-        let ys = log_range(cells.iter().map(|c| c.omega0 as f64));
-        for (i, panel) in panels.iter().enumerate() {
-            let (m, col) = (i / columns.len(), i % columns.len());
-            let (integrator, auto, name) = columns[col];
-            let model = MODELS[m];
-            let mut chart = ChartBuilder::on(panel)
-                .caption(format!("{model}: {name}"), (FONT, 17))
+        let ys = log_range(
+            self.panels
+                .iter()
+                .flat_map(|p| p.cells.iter().map(|c| c.omega0 as f64)),
+        );
+        for (area, panel) in areas.iter().zip(self.panels) {
+            let mut chart = ChartBuilder::on(area)
+                .caption(&panel.title, (FONT, 16))
                 .margin(8)
                 .x_label_area_size(35)
                 .y_label_area_size(55)
@@ -399,35 +481,42 @@ impl Chart for Stability<'_> {
                 .y_labels(5)
                 .draw()
                 .map_err(err)?;
-            let factor = factors[m] as f64;
-            let bound: Vec<(f64, f64)> = (0..=60)
-                .map(|j| {
-                    let h = xs.start * (xs.end / xs.start).powf(j as f64 / 60.0);
-                    (h, 2.0 / (factor * h))
-                })
-                .filter(|(_, w)| ys.contains(w))
-                .collect();
+            if let Some(factor) = panel.bound {
+                let bound: Vec<(f64, f64)> = (0..=60)
+                    .map(|j| {
+                        let h = xs.start * (xs.end / xs.start).powf(j as f64 / 60.0);
+                        (h, 2.0 / (factor as f64 * h))
+                    })
+                    .filter(|(_, w)| ys.contains(w))
+                    .collect();
+                chart
+                    .draw_series(LineSeries::new(bound, BLACK.stroke_width(2)))
+                    .map_err(err)?;
+            }
+            let at = |c: &Cell| (c.timestep as f64, c.omega0 as f64);
             chart
-                .draw_series(LineSeries::new(bound, BLACK.stroke_width(2)))
-                .map_err(err)?;
-            let here = cells
-                .iter()
-                .filter(|c| c.model == model && c.integrator == integrator && c.auto == auto);
-            let (failed, stable): (Vec<&Cell>, Vec<&Cell>) =
-                here.partition(|c| c.failure.is_some());
-            chart
-                .draw_series(stable.iter().map(|c| {
-                    Circle::new((c.timestep as f64, c.omega0 as f64), 4, PALETTE[2].filled())
+                .draw_series(panel.cells.iter().filter(|c| c.under_resolved).map(|c| {
+                    EmptyElement::at(at(c))
+                        + Rectangle::new([(-5, -5), (5, 5)], PALETTE[3].filled())
                 }))
                 .map_err(err)?;
             chart
-                .draw_series(failed.iter().map(|c| {
-                    Cross::new(
-                        (c.timestep as f64, c.omega0 as f64),
-                        5,
-                        PALETTE[0].stroke_width(2),
-                    )
-                }))
+                .draw_series(
+                    panel
+                        .cells
+                        .iter()
+                        .filter(|c| c.failure.is_none() && !c.under_resolved)
+                        .map(|c| Circle::new(at(c), 4, PALETTE[2].filled())),
+                )
+                .map_err(err)?;
+            chart
+                .draw_series(
+                    panel
+                        .cells
+                        .iter()
+                        .filter(|c| c.failure.is_some())
+                        .map(|c| Cross::new(at(c), 5, PALETTE[0].stroke_width(2))),
+                )
                 .map_err(err)?;
         }
         Ok(())

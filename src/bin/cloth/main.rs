@@ -5,7 +5,8 @@
 //!                 [--set key=value]... [--dump FILE.json|.csv|.obj] [--every K]
 //! cloth bench [--max PARTICLES] [--models 1,2,3a,3b,3c] [--repeats N] [--app]
 //!             [--app-models 1,3b] [--json] [--chart FILE.png]
-//! cloth accuracy [--scenes curtain,curtain-wind,card] [--seconds S] [--json] [--chart FILE.png]
+//! cloth accuracy [--scenes curtain,curtain-wind,card] [--seconds S] [--repeats N] [--json]
+//!                [--chart FILE.png]
 //! cloth stability [--models mass-spring,shape-matching,patches] [--json] [--chart FILE.png]
 //! ```
 //! `run` prints a JSON summary on stdout; `bench` prints seed 000's timing table (Slika
@@ -22,7 +23,9 @@ use std::process::ExitCode;
 
 use bevy_cloth::measure::accuracy::{self, Case};
 use bevy_cloth::measure::fps::{self, APP_COUNTS};
-use bevy_cloth::measure::stability::{self, MASS, MODELS, STIFFNESS, TIMESTEP};
+use bevy_cloth::measure::stability::{
+    self, MASS, MODELS, NONLINEAR_MODELS, NONLINEAR_TIMESTEP, Regime, STIFFNESS, TIMESTEP,
+};
 use bevy_cloth::measure::{self, BenchCell, SEED_COUNTS, SEED_MODELS, SceneRun};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver;
@@ -359,10 +362,17 @@ fn bench(args: &[String]) -> Result<(), String> {
             };
             let cell =
                 measure::bench_cell(model, count, 3, repeats.max(1)).map_err(|e| e.to_string())?;
-            eprintln!(
-                "model {model:>2}, {count:>6} particles: {:8.3} ms per step ({} substeps)",
-                cell.ms_per_step, cell.substeps
-            );
+            match (cell.ms_per_step, cell.failed_at_step) {
+                (Some(ms), _) => eprintln!(
+                    "model {model:>2}, {count:>6} particles: {ms:8.3} ms per step ({} substeps)",
+                    cell.substeps
+                ),
+                (None, step) => eprintln!(
+                    "model {model:>2}, {count:>6} particles: FAILED after step {} (strain {:.0}%): not timed",
+                    step.unwrap_or(0),
+                    cell.max_strain * 100.0
+                ),
+            }
             cells.push(cell);
         }
     }
@@ -393,7 +403,8 @@ fn bench(args: &[String]) -> Result<(), String> {
     }
     if !cells.is_empty() {
         println!(
-            "ms per 16 ms step: ours (median) / seed 000 Slika 23; substeps per step in brackets"
+            "ms per 16 ms step: ours (median) / seed 000 Slika 23; substeps per step in brackets; \
+             `failed` where the cloth passed 100% strain or went non-finite (not timed)"
         );
         print!("{:>8}", "model");
         for c in &counts {
@@ -402,13 +413,26 @@ fn bench(args: &[String]) -> Result<(), String> {
         println!();
         print_by_model(&cells, counts.len(), |cell| {
             let seed = cell.seed_ms.map_or("-".to_string(), |s| format!("{s:.0}"));
-            format!("{:.3}[{}]/{seed}", cell.ms_per_step, cell.substeps)
+            match cell.ms_per_step {
+                Some(ms) => format!("{ms:.3}[{}]/{seed}", cell.substeps),
+                None => format!("failed/{seed}"),
+            }
         });
         println!();
-        println!("speed-up over seed 000 (its ms / ours; - where it printed 0 ms)");
-        print_by_model(&cells, counts.len(), |cell| match cell.seed_ms {
-            Some(seed) if seed > 0.0 => format!("{:.0}×", seed / cell.ms_per_step),
-            _ => "-".to_string(),
+        println!("spread of the timed steps: fastest–slowest, ms");
+        print_by_model(&cells, counts.len(), |cell| match cell.ms_range {
+            Some((lo, hi)) => format!("{lo:.3}–{hi:.3}"),
+            None => "failed".to_string(),
+        });
+        println!();
+        println!(
+            "speed-up over seed 000 (its ms / ours; - where it printed 0 ms or our cloth failed)"
+        );
+        print_by_model(&cells, counts.len(), |cell| {
+            match (cell.seed_ms, cell.ms_per_step) {
+                (Some(seed), Some(ms)) if seed > 0.0 => format!("{:.0}×", seed / ms),
+                _ => "-".to_string(),
+            }
         });
     }
     if !frames.is_empty() {
@@ -481,10 +505,11 @@ fn accuracy(args: &[String]) -> Result<(), String> {
     let opts = verb_options(
         "accuracy",
         args,
-        &["--scenes", "--seconds", "--chart"],
+        &["--scenes", "--seconds", "--chart", "--repeats"],
         &["--json"],
     )?;
     let seconds = number_f32(&opts, "--seconds", 3.0)?;
+    let repeats: usize = opts.number("--repeats", 5)?;
     let names: Vec<&str> = opts
         .get("--scenes")
         .map_or(vec!["curtain", "curtain-wind", "card"], |s| {
@@ -500,12 +525,12 @@ fn accuracy(args: &[String]) -> Result<(), String> {
             case.name,
             configs.len()
         );
-        let (reference, case_rows) = accuracy::measure(case, &configs, |r| {
+        let (reference, case_rows) = accuracy::measure(case, &configs, repeats, |r| {
             eprintln!(
-                "  {:<15} {:<36} {:>10.1} ms/s  error {}",
+                "  {:<15} {:<36} {:>10} ms/s  error {}",
                 r.model,
                 r.label,
-                r.ms_per_second,
+                r.ms_per_second.map_or("-".into(), |ms| format!("{ms:.1}")),
                 r.error.map_or("failed".into(), |e| format!("{e:.2e}"))
             );
         })
@@ -535,7 +560,7 @@ fn accuracy(args: &[String]) -> Result<(), String> {
     }
     println!();
     println!(
-        "| scene | model | configuration | ms per simulated s | substeps | error | final drape error | max strain | energy drift | Pareto |"
+        "| scene | model | configuration | ms per simulated s, median [fastest–slowest of {repeats}] | substeps | error | final drape error | max strain | energy drift | Pareto |"
     );
     println!("|---|---|---|---:|---:|---:|---:|---:|---:|---|");
     for r in &rows {
@@ -544,12 +569,15 @@ fn accuracy(args: &[String]) -> Result<(), String> {
             (None, Some(t)) => format!("fails at {t:.2} s"),
             (None, None) => "-".into(),
         };
+        let time = match (r.ms_per_second, r.ms_range) {
+            (Some(ms), Some((lo, hi))) => format!("{ms:.1} [{lo:.1}–{hi:.1}]"),
+            _ => "-".into(),
+        };
         println!(
-            "| {} | {} | {} | {:.1} | {:.1} | {error} | {} | {:.1}% | {} | {} |",
+            "| {} | {} | {} | {time} | {:.1} | {error} | {} | {:.1}% | {} | {} |",
             r.scene,
             r.model,
             r.label,
-            r.ms_per_second,
             r.substeps,
             r.final_error.map_or("-".into(), |e| format!("{e:.2e}")),
             r.max_strain * 100.0,
@@ -586,6 +614,31 @@ fn stability(args: &[String]) -> Result<(), String> {
             }
         }
     }
+    // The nonlinear regimes: Verlet with automatic substeps, the claim under test.
+    let mut nonlinear = Vec::new();
+    let in_list = |model: &str| models.iter().any(|m| model.split(' ').next() == Some(*m));
+    for regime in Regime::NONLINEAR {
+        for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(m)) {
+            let mut here = Vec::new();
+            for &k in &STIFFNESS {
+                for &m in &MASS {
+                    for &dt in &NONLINEAR_TIMESTEP {
+                        here.push(
+                            stability::cell_in(regime, model, Integrator::Verlet, true, k, m, dt)
+                                .map_err(|e| e.to_string())?,
+                        );
+                    }
+                }
+            }
+            let failed = here.iter().filter(|c| c.failure.is_some()).count();
+            let capped = here.iter().filter(|c| c.under_resolved).count();
+            eprintln!(
+                "{regime:?}, {model}: {failed} of {} cells fail, {capped} over the substep cap",
+                here.len()
+            );
+            nonlinear.extend(here);
+        }
+    }
     let mut thresholds = Vec::new();
     for integrator in Integrator::ALL {
         for (k, m) in [(100.0, 1e-3), (1_000.0, 1e-4), (25_000.0, 1e-6)] {
@@ -595,19 +648,31 @@ fn stability(args: &[String]) -> Result<(), String> {
     }
     let factors = [stability::lattice_factor(), 1.0, 1.0];
     if let Some(chart) = opts.get("--chart") {
-        charts::stability(Path::new(chart), &cells, &factors)?;
+        let chart = Path::new(chart);
+        charts::stability(chart, &cells, &factors)?;
+        let stem = chart
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("stability");
+        charts::stability_nonlinear(
+            &chart.with_file_name(format!("{stem}_nonlinear.png")),
+            &nonlinear,
+        )?;
     }
     if opts.switch("--json") {
         return print_json(&serde_json::json!({
             "cells": cells,
+            "nonlinear": nonlinear,
             "thresholds": thresholds,
             "lattice_factor": factors[0],
         }));
     }
+    println!("Linear regime (free 12×12 cloth, 1% perturbation, no gravity, no limiter):");
+    println!();
     println!(
-        "| model | integrator | substeps | failed cells | first failure: smallest ω₀·h that failed | largest ω₀·h that ran stable |"
+        "| model | integrator | substeps | failed cells | over the substep cap | first failure: smallest ω₀·h that failed | largest ω₀·h that ran stable |"
     );
-    println!("|---|---|---|---:|---:|---:|");
+    println!("|---|---|---|---:|---:|---:|---:|");
     for &model in &models {
         for integrator in Integrator::ALL {
             for auto in [false, true] {
@@ -627,8 +692,9 @@ fn stability(args: &[String]) -> Result<(), String> {
                     .map(wh)
                     .fold(0.0, f32::max);
                 let failed = here.iter().filter(|c| c.failure.is_some()).count();
+                let capped = here.iter().filter(|c| c.under_resolved).count();
                 println!(
-                    "| {model} | {integrator:?} | {} | {failed} of {} | {} | {last_ok:.3} |",
+                    "| {model} | {integrator:?} | {} | {failed} of {} | {capped} | {} | {last_ok:.3} |",
                     if auto { "auto" } else { "1" },
                     here.len(),
                     if first_fail.is_finite() {
@@ -636,6 +702,50 @@ fn stability(args: &[String]) -> Result<(), String> {
                     } else {
                         "none".into()
                     },
+                );
+            }
+        }
+    }
+    if !nonlinear.is_empty() {
+        println!();
+        println!(
+            "Nonlinear regimes (Verlet, automatic substeps; limiter on; {} stiffnesses × {} masses × {} timesteps each):",
+            STIFFNESS.len(),
+            MASS.len(),
+            NONLINEAR_TIMESTEP.len()
+        );
+        println!();
+        println!(
+            "| regime | model | failed cells | of them over the substep cap | over the cap in all | failures |"
+        );
+        println!("|---|---|---:|---:|---:|---|");
+        for regime in Regime::NONLINEAR {
+            for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(m)) {
+                let here: Vec<_> = nonlinear
+                    .iter()
+                    .filter(|c| c.regime == regime && c.model == model)
+                    .collect();
+                let failed: Vec<_> = here.iter().filter(|c| c.failure.is_some()).collect();
+                let capped = here.iter().filter(|c| c.under_resolved).count();
+                let kinds: Vec<String> = failed
+                    .iter()
+                    .take(3)
+                    .map(|c| {
+                        format!(
+                            "{:?} at k {} N/m, m {} g, h {} ms",
+                            c.failure.expect("failed"),
+                            c.stiffness,
+                            c.mass * 1e3,
+                            c.timestep * 1e3
+                        )
+                    })
+                    .collect();
+                println!(
+                    "| {regime:?} | {model} | {} of {} | {} | {capped} | {} |",
+                    failed.len(),
+                    here.len(),
+                    failed.iter().filter(|c| c.under_resolved).count(),
+                    kinds.join("; ")
                 );
             }
         }
