@@ -53,6 +53,26 @@ impl Cloth {
     /// spring. Each spring pushes its ends with equal and opposite forces; dividing by each
     /// end's mass in `integrate` shares the motion by inverse mass, as seed 000 eq. 2 asks.
     fn spring_forces(&mut self, range: std::ops::Range<usize>, k: f32, damping: f32) {
+        // A particle cloth's springs all take their family's constant; only the patch
+        // model's part lattice scales them one by one. Two instances of one loop, so the
+        // common case reads no per-spring factor.
+        match self.springs.stiffness_scale.take() {
+            None => self.spring_forces_scaled(range, k, damping, |_| 1.0),
+            Some(scale) => {
+                self.spring_forces_scaled(range, k, damping, |i| scale[i]);
+                self.springs.stiffness_scale = Some(scale);
+            }
+        }
+    }
+
+    #[inline(always)]
+    fn spring_forces_scaled(
+        &mut self,
+        range: std::ops::Range<usize>,
+        k: f32,
+        damping: f32,
+        scale: impl Fn(usize) -> f32,
+    ) {
         let s = &self.springs;
         let p = &mut self.particles;
         for idx in range {
@@ -66,7 +86,7 @@ impl Cloth {
                 continue;
             }
             let dir = d / len;
-            let mut magnitude = k * s.stiffness_scale[idx] * (len - s.rest_length[idx]);
+            let mut magnitude = k * scale(idx) * (len - s.rest_length[idx]);
             if damping > 0.0 {
                 magnitude += damping * (p.velocity[b] - p.velocity[a]).dot(dir);
             }

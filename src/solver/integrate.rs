@@ -149,46 +149,64 @@ impl Cloth {
     /// With `strain_limit_tolerance`, sweeping stops once a sweep finds every spring
     /// within `(1 + limit + tolerance)·l0`.
     fn limit_strain(&mut self, limit: f32, h: f32) {
-        let s = &self.springs;
-        let p = &mut self.particles;
-        let families = [SpringKind::Structural, SpringKind::Shear];
-        let tolerance = self.params.strain_limit_tolerance;
-        for _ in 0..self.params.strain_limit_iterations {
-            let mut worst = 0.0f32;
-            for kind in families {
-                if !self.params.springs.structural.enabled && kind == SpringKind::Structural
-                    || !self.params.springs.shear.enabled && kind == SpringKind::Shear
-                {
-                    continue;
-                }
-                for idx in s.ranges[kind as usize].clone() {
-                    if !s.alive[idx] {
-                        continue;
-                    }
-                    let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
-                    let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
-                    let w = wa + wb;
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let d = p.position[b] - p.position[a];
-                    let len = d.length();
-                    let max = (1.0 + limit) * s.rest_length[idx];
-                    if len <= max {
-                        continue;
-                    }
-                    worst = worst.max((len - max) / s.rest_length[idx]);
-                    let correction = d * ((len - max) / (len * w));
-                    p.position[a] += correction * wa;
-                    p.position[b] -= correction * wb;
-                    p.velocity[a] += correction * (wa / h);
-                    p.velocity[b] -= correction * (wb / h);
+        let sweeps = self.params.strain_limit_iterations;
+        match self.params.strain_limit_tolerance {
+            None => {
+                for _ in 0..sweeps {
+                    self.limit_strain_sweep::<false>(limit, f32::INFINITY, h);
                 }
             }
-            if tolerance.is_some_and(|t| worst <= t) {
-                break;
+            Some(tolerance) => {
+                let past = 1.0 + limit + tolerance;
+                for _ in 0..sweeps {
+                    if !self.limit_strain_sweep::<true>(limit, past, h) {
+                        break;
+                    }
+                }
             }
         }
+    }
+
+    /// One Gauss–Seidel sweep of [`Self::limit_strain`]. With `TRACK`, returns whether a
+    /// spring was longer than `past·l0` (not yet converged); the fixed-sweep limiter
+    /// compiles without that test.
+    fn limit_strain_sweep<const TRACK: bool>(&mut self, limit: f32, past: f32, h: f32) -> bool {
+        let s = &self.springs;
+        let p = &mut self.particles;
+        let mut unconverged = false;
+        for kind in [SpringKind::Structural, SpringKind::Shear] {
+            if !self.params.springs.structural.enabled && kind == SpringKind::Structural
+                || !self.params.springs.shear.enabled && kind == SpringKind::Shear
+            {
+                continue;
+            }
+            for idx in s.ranges[kind as usize].clone() {
+                if !s.alive[idx] {
+                    continue;
+                }
+                let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
+                let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
+                let w = wa + wb;
+                if w == 0.0 {
+                    continue;
+                }
+                let d = p.position[b] - p.position[a];
+                let len = d.length();
+                let max = (1.0 + limit) * s.rest_length[idx];
+                if len <= max {
+                    continue;
+                }
+                if TRACK {
+                    unconverged |= len > past * s.rest_length[idx];
+                }
+                let correction = d * ((len - max) / (len * w));
+                p.position[a] += correction * wa;
+                p.position[b] -= correction * wb;
+                p.velocity[a] += correction * (wa / h);
+                p.velocity[b] -= correction * (wb / h);
+            }
+        }
+        unconverged
     }
 
     /// Keeps Verlet's implicit velocity `(x − x_prev)/h` when `h` changes by `ratio`.

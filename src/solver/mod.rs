@@ -688,7 +688,7 @@ impl Cloth {
             for s in self.springs.ranges[kind as usize].clone() {
                 if self.springs.alive[s] {
                     for p in [self.springs.a[s], self.springs.b[s]] {
-                        k_sum[p as usize] += k * self.springs.stiffness_scale[s];
+                        k_sum[p as usize] += k * self.springs.scale(s);
                         c_sum[p as usize] += c;
                     }
                 }
@@ -973,7 +973,7 @@ impl Cloth {
             for i in s.ranges[kind as usize].clone() {
                 if s.alive[i] {
                     let l = x[s.a[i] as usize].distance(x[s.b[i] as usize]);
-                    energy += 0.5 * k * s.stiffness_scale[i] * (l - s.rest_length[i]).powi(2);
+                    energy += 0.5 * k * s.scale(i) * (l - s.rest_length[i]).powi(2);
                 }
             }
         }

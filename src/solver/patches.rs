@@ -248,9 +248,25 @@ impl Patches {
     /// Recomputes the targets after a substep of `h` and their velocities `(t' − t)/h`.
     /// Allocates nothing.
     pub fn advance_targets(&mut self, x: &[Vec3], patch: &PatchParams, h: f32) {
+        let inv_h = 1.0 / h;
+        if self.bilinear(patch) {
+            // One pass: each new target and its velocity together.
+            let c = &self.parts.particles.position;
+            for ((target, v), &([a, b, d, e], s, t)) in self
+                .targets
+                .iter_mut()
+                .zip(&mut self.target_velocity)
+                .zip(&self.stencil)
+            {
+                let [a, b, d, e] = [a, b, d, e].map(|k| c[k as usize]);
+                let new = (a * (1.0 - s) + b * s) * (1.0 - t) + (d * (1.0 - s) + e * s) * t;
+                *v = (new - *target) * inv_h;
+                *target = new;
+            }
+            return;
+        }
         self.previous_targets.copy_from_slice(&self.targets);
         self.compute_targets(x, patch);
-        let inv_h = 1.0 / h;
         for ((v, t), t0) in self
             .target_velocity
             .iter_mut()
@@ -344,7 +360,7 @@ impl Patches {
     /// high). Allocates nothing.
     pub fn compute_targets(&mut self, x: &[Vec3], patch: &PatchParams) {
         let (nx, ny) = self.part_grid;
-        if patch.targets == PatchTargets::Bilinear && nx > 1 && ny > 1 {
+        if self.bilinear(patch) {
             let c = &self.parts.particles.position;
             for (target, &([a, b, d, e], s, t)) in self.targets.iter_mut().zip(&self.stencil) {
                 let [a, b, d, e] = [a, b, d, e].map(|k| c[k as usize]);
@@ -433,6 +449,13 @@ impl Patches {
         }
     }
 
+    /// True when the targets are the bilinear ones (a cloth one part across uses the
+    /// seed's).
+    fn bilinear(&self, patch: &PatchParams) -> bool {
+        let (nx, ny) = self.part_grid;
+        patch.targets == PatchTargets::Bilinear && nx > 1 && ny > 1
+    }
+
     /// Springs of the part lattice torn so far.
     pub fn torn_count(&self) -> usize {
         self.parts.torn_count()
@@ -450,18 +473,25 @@ impl Patches {
 /// `(pw, ph)`; its share along each axis is weighed the same way, `2·pw·ph/(pw² + ph²)`.
 /// Square parts keep the particle constants.
 fn scale_for_aspect(springs: &mut topology::Springs, nx: u32, (pw, ph): (u32, u32)) {
+    if pw == ph {
+        springs.stiffness_scale = None;
+        return;
+    }
     let (w, h) = (pw as f32, ph as f32);
     let (horizontal, vertical, diagonal) = (h / w, w / h, 2.0 * w * h / (w * w + h * h));
-    for s in 0..springs.len() {
-        let (a, b) = (springs.a[s], springs.b[s]);
-        springs.stiffness_scale[s] = if a / nx == b / nx {
-            horizontal
-        } else if a % nx == b % nx {
-            vertical
-        } else {
-            diagonal
-        };
-    }
+    let scale = (0..springs.len())
+        .map(|s| {
+            let (a, b) = (springs.a[s], springs.b[s]);
+            if a / nx == b / nx {
+                horizontal
+            } else if a % nx == b % nx {
+                vertical
+            } else {
+                diagonal
+            }
+        })
+        .collect();
+    springs.stiffness_scale = Some(scale);
 }
 
 fn part_particles(part: &Part, w: u32) -> impl Iterator<Item = usize> + '_ {

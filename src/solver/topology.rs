@@ -43,9 +43,10 @@ pub struct Springs {
     pub rest_length: Vec<f32>,
     /// False once a spring has torn.
     pub alive: Vec<bool>,
-    /// Factor on the family's stiffness for each spring (1 for a particle cloth; the
-    /// patch model's part lattice scales its springs by the parts' aspect ratio).
-    pub stiffness_scale: Vec<f32>,
+    /// Factor on the family's stiffness for each spring; `None`: 1 for every spring (a
+    /// particle cloth). The patch model's part lattice scales its springs by the parts'
+    /// aspect ratio.
+    pub stiffness_scale: Option<Vec<f32>>,
     /// The index range of each kind, in `SpringKind` order.
     pub ranges: [Range<usize>; 5],
 }
@@ -59,6 +60,12 @@ impl Springs {
     /// True when there are no springs.
     pub fn is_empty(&self) -> bool {
         self.a.is_empty()
+    }
+
+    /// The factor on spring `s`'s family stiffness (see `stiffness_scale`).
+    #[inline]
+    pub fn scale(&self, s: usize) -> f32 {
+        self.stiffness_scale.as_ref().map_or(1.0, |f| f[s])
     }
 
     /// The kind of spring `s`.
@@ -89,7 +96,6 @@ impl Springs {
                     .rest_length
                     .push(positions[a as usize].distance(positions[b as usize]));
                 springs.alive.push(true);
-                springs.stiffness_scale.push(1.0);
             }
             springs.ranges[kind as usize] = start..springs.a.len();
         }
