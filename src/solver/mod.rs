@@ -745,7 +745,7 @@ impl Cloth {
             }
             Model::Patches(patch) => {
                 self.shape_matching = None;
-                let size = (patch.part_width, patch.part_height);
+                let size = (patch.part_width, patch.part_height, patch.targets);
                 let built = self.patches.as_ref().is_none_or(|p| p.built_for != size);
                 if built && let Some(grid) = self.grid {
                     self.patches = Patches::new(

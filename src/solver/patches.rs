@@ -10,10 +10,11 @@
 //! follow their parts without a hidden drag and cannot push them apart. Automatic
 //! substeps cover both the part lattice and the pull (only the lattice with tiles).
 //!
-//! Pins hold particles, not parts: a pinned particle is kinematic, and its part's centre
-//! is kept at its rest distance from the pin (a rod), so the part swings about its pins
-//! instead of freezing as a rigid block. A part of one particle is that particle, so its
-//! centre is pinned outright.
+//! Pins hold particles, not parts: a pinned particle is kinematic, and with the bilinear
+//! targets its part's centre is kept at its rest distance from the pin (a rod), so the
+//! part swings about its pins instead of freezing as a rigid block. A part of one particle
+//! is that particle, so its centre is pinned outright; with the seed's targets, or a
+//! cloth one part across, a pin fixes its part, as in the thesis (see `Patches::new`).
 
 use bevy::math::{Affine3A, Vec3};
 
@@ -70,8 +71,9 @@ pub struct Patches {
     /// Rest distance between neighbouring particles along x and y (the length of the
     /// per-particle step of a cloth one part across).
     rest_step: (f32, f32),
-    /// `(part_width, part_height)` these were built for.
-    pub(super) built_for: (u32, u32),
+    /// `(part_width, part_height, targets)` these were built for (the targets decide how
+    /// pins hold the lattice).
+    pub(super) built_for: (u32, u32, PatchTargets),
     /// The lattice's stable substeps for (its parameters, dt): they do not depend on the
     /// state, so a state-dependent pull (p ≠ 1) does not recompute (and allocate) them.
     lattice_substeps: Option<(ClothParams, f32, u32)>,
@@ -171,13 +173,18 @@ impl Patches {
             let (i, j) = (k % w, k / w);
             (j / ph) * nx + i / pw
         };
-        // A part of one particle is that particle: pinned outright. A larger part is held
-        // at its rest distance from each of its pins (see the module doc).
+        // A part of one particle is that particle: pinned outright. With the bilinear
+        // targets a larger part is held at its rest distance from each of its pins (see
+        // the module doc). The seed's targets, and a cloth one part across, take the
+        // part's orientation from its neighbours alone, so a part swinging on a rod would
+        // carry its pinned particle's target off the pin (a 16×8 curtain of 8×8 parts
+        // passed 100% strain at its pins): there a pin fixes its part, as in the thesis.
+        let bilinear = patch.targets == PatchTargets::Bilinear && nx > 1 && ny > 1;
         let mut pinned_parts = Vec::new();
         let mut anchors = Vec::new();
         for (slot, &k) in pins.iter().enumerate() {
             let part = part_of(k);
-            if lumps[part as usize] == 1.0 {
+            if lumps[part as usize] == 1.0 || !bilinear {
                 pinned_parts.push(part);
             } else {
                 anchors.push(Anchor {
@@ -187,6 +194,8 @@ impl Patches {
                 });
             }
         }
+        pinned_parts.sort_unstable();
+        pinned_parts.dedup();
         let pairs = topology::grid_spring_pairs(nx, ny);
         let mut parts = Cloth::build(
             centres,
@@ -221,7 +230,7 @@ impl Patches {
             anchors,
             rest_step,
             lattice_substeps: None,
-            built_for: (patch.part_width, patch.part_height),
+            built_for: (patch.part_width, patch.part_height, patch.targets),
         })
     }
 
