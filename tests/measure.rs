@@ -4,6 +4,7 @@
 
 use bevy::math::Vec3;
 use bevy_cloth::measure::accuracy::{Case, SAMPLE_INTERVAL, Trajectory};
+use bevy_cloth::measure::stability::Regime;
 use bevy_cloth::measure::{fps, stability};
 use bevy_cloth::prelude::*;
 
@@ -44,10 +45,21 @@ fn the_lattice_fails_where_its_largest_frequency_says() {
 #[test]
 fn grid_cells_fail_past_the_bound_and_not_with_auto_substeps() {
     // k = 1000 N/m, 0.1 g: ω₀ = 3162 rad/s, ω_max ≈ 3.9·ω₀ by the lattice factor.
-    let fixed = |dt| stability::cell("mass-spring", Integrator::Verlet, false, 1_000.0, 1e-4, dt);
+    let fixed = |dt| {
+        stability::cell(
+            Regime::Linear,
+            "mass-spring",
+            Integrator::Verlet,
+            false,
+            1_000.0,
+            1e-4,
+            dt,
+        )
+    };
     assert_eq!(fixed(0.0001).unwrap().failure, None);
     assert!(fixed(0.004).unwrap().failure.is_some());
     let auto = stability::cell(
+        Regime::Linear,
         "mass-spring",
         Integrator::Verlet,
         true,

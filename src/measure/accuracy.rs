@@ -48,7 +48,9 @@ pub struct Config {
 }
 
 /// The configurations measured on a cloth whose mass-spring parameters are `base`:
-/// mass-spring with either integrator at 1, 2, 4, 8 and automatic substeps; shape
+/// mass-spring with either integrator at 1, 2, 4, 8 and automatic substeps (and, when
+/// the material has a strain limit, at automatic substeps with the limiter converged as
+/// in the reference); shape
 /// matching with 1 and 4×4 clusters at stiffness k, 4k, 16k and 64k (k the structural
 /// spring stiffness: the pins hold a shape-matched cloth only through the fit, so a
 /// hanging cloth needs a stiff pull); patches of 1, 2, 4 and 8 particles square pulled
@@ -83,6 +85,22 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
                 },
             });
         }
+    }
+    if base.strain_limit.is_some() {
+        // The same step with the limiter run to the reference's tolerance: how much of a
+        // configuration's error is its limiter's (4 sweeps make a softer material).
+        out.push(Config {
+            model: "mass-spring",
+            label: "Verlet, auto substeps, limiter converged".into(),
+            params: ClothParams {
+                model: Model::MassSpring,
+                integrator: Integrator::Verlet,
+                substeps: Substeps::default(),
+                strain_limit_iterations: REFERENCE_LIMITER_SWEEPS,
+                strain_limit_tolerance: Some(REFERENCE_LIMITER_TOLERANCE),
+                ..*base
+            },
+        });
     }
     let k = base.springs.structural.stiffness;
     for clusters in [1, 4] {

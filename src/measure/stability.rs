@@ -311,20 +311,8 @@ pub struct Cell {
     pub persists_at_4x: Option<bool>,
 }
 
-/// Runs one cell of the linear regime for one simulated second (at least 30 steps).
-pub fn cell(
-    model: &str,
-    integrator: Integrator,
-    auto: bool,
-    k: f32,
-    m: f32,
-    dt: f32,
-) -> Result<Cell, ClothError> {
-    cell_in(Regime::Linear, model, integrator, auto, k, m, dt)
-}
-
 /// Runs one cell of `regime` for one simulated second (at least 30 steps).
-pub fn cell_in(
+pub fn cell(
     regime: Regime,
     model: &str,
     integrator: Integrator,

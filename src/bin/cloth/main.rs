@@ -599,8 +599,9 @@ fn stability(args: &[String]) -> Result<(), String> {
                 for &k in &STIFFNESS {
                     for &m in &MASS {
                         for &dt in &TIMESTEP {
-                            let cell = stability::cell(model, integrator, auto, k, m, dt)
-                                .map_err(|e| e.to_string())?;
+                            let cell =
+                                stability::cell(Regime::Linear, model, integrator, auto, k, m, dt)
+                                    .map_err(|e| e.to_string())?;
                             failed += cell.failure.is_some() as usize;
                             total += 1;
                             cells.push(cell);
@@ -624,7 +625,7 @@ fn stability(args: &[String]) -> Result<(), String> {
                 for &m in &MASS {
                     for &dt in &NONLINEAR_TIMESTEP {
                         here.push(
-                            stability::cell_in(regime, model, Integrator::Verlet, true, k, m, dt)
+                            stability::cell(regime, model, Integrator::Verlet, true, k, m, dt)
                                 .map_err(|e| e.to_string())?,
                         );
                     }
@@ -736,7 +737,7 @@ fn stability(args: &[String]) -> Result<(), String> {
                     .take(3)
                     .map(|c| {
                         format!(
-                            "{:?} at k {} N/m, m {} g, h {} ms",
+                            "{:?} at k {} N/m, m {:.3} g, h {:.0} ms",
                             c.failure.expect("failed"),
                             c.stiffness,
                             c.mass * 1e3,
