@@ -1,5 +1,5 @@
 //! Regression benches: one 16 ms step of each model of seed 000's Slika 23 on the
-//! timing table's curtain (top corners pinned, gravity, the default wind) at 4,096 and
+//! timing table's curtain (top row pinned, gravity, the default wind) at 4,096 and
 //! 65,536 particles. `cargo bench --bench step`; the tables and charts are made by
 //! `cargo run --bin cloth -- bench`.
 

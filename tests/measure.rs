@@ -157,6 +157,7 @@ fn a_coarse_configuration_is_further_from_the_reference_than_a_fine_one() {
 fn the_full_app_steps_and_writes_the_mesh_each_frame() {
     let row = fps::app_frame("1", 100, 3, 5).unwrap();
     assert_eq!(row.particles, 100);
-    assert!(row.ms_per_frame > 0.0 && row.fps.is_finite());
+    assert_eq!(row.failed_at_frame, None);
+    assert!(row.ms_per_frame.is_some_and(|ms| ms > 0.0) && row.fps.is_some_and(f64::is_finite));
     assert_eq!(row.seed_fps, Some(60.0));
 }

@@ -12,8 +12,8 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 
 use crate::error::ClothError;
-use crate::measure::{grid_for, median, seed_model_params};
-use crate::prelude::{Cloth, ClothPlugin, Pins};
+use crate::measure::{BENCH_CHECK_STEPS, BENCH_PINS, grid_for, median, seed_model_params};
+use crate::prelude::{Cloth, ClothPlugin, ClothSimulation};
 
 /// Seed 002's table 4.1: masses and the frames per second it reported.
 pub const SEED_002_FPS: [(usize, f64); 10] = [
@@ -41,10 +41,14 @@ pub struct AppFrame {
     pub model: String,
     /// Masses (particles).
     pub particles: usize,
-    /// Median wall-clock ms of one frame (one fixed step, mesh write-back).
-    pub ms_per_frame: f64,
+    /// Median wall-clock ms of one frame (one fixed step, mesh write-back); `None` when
+    /// the cloth failed within [`BENCH_CHECK_STEPS`] frames (not timed).
+    pub ms_per_frame: Option<f64>,
     /// `1000 / ms_per_frame`.
-    pub fps: f64,
+    pub fps: Option<f64>,
+    /// The first frame (1-based) after which the cloth was not stable; `None`: stable
+    /// for all [`BENCH_CHECK_STEPS`] frames.
+    pub failed_at_frame: Option<usize>,
     /// Seed 002's frames per second at this count, when it has one.
     pub seed_fps: Option<f64>,
 }
@@ -65,8 +69,10 @@ pub fn headless_app() -> App {
     app
 }
 
-/// Runs the app with one curtain of `count` particles (5 cm grid, top corners pinned,
-/// default gravity and wind) of `model`: `warmup` frames, then the median of `frames`.
+/// Runs the app with one curtain of `count` particles (5 cm grid, top row pinned,
+/// default gravity and wind) of `model`: `warmup` frames, then the median of `frames`,
+/// then untimed frames up to [`BENCH_CHECK_STEPS`]; the cloth is checked after every
+/// frame, as in [`super::bench_cell`], and a row whose cloth failed is not timed.
 pub fn app_frame(
     model: &str,
     count: usize,
@@ -82,31 +88,54 @@ pub fn app_frame(
         .world_mut()
         .spawn((
             Cloth::grid(width, height, 0.05)
-                .with_pins(Pins::TopCorners)
+                .with_pins(BENCH_PINS)
                 .with_params(params),
             Transform::from_xyz(0.0, 2.0, 0.0),
         ))
         .id();
-    for _ in 0..warmup.max(2) {
+    // Before the plugin has built the simulation (the first frame) there is nothing to
+    // check; after the warm-up it must exist (below).
+    let stable = |app: &App| {
+        app.world()
+            .get::<ClothSimulation>(entity)
+            .is_none_or(|sim| sim.solver.is_stable())
+    };
+    let warmup = warmup.max(2);
+    let mut failed_at_frame = None;
+    for frame in 1..=warmup {
         app.update();
+        if failed_at_frame.is_none() && !stable(&app) {
+            failed_at_frame = Some(frame);
+        }
     }
-    if app.world().get::<Mesh3d>(entity).is_none() {
+    if app.world().get::<Mesh3d>(entity).is_none()
+        || app.world().get::<ClothSimulation>(entity).is_none()
+    {
         return Err(ClothError::BadMesh {
             reason: "the plugin made no mesh for the cloth".into(),
         });
     }
     let mut times = Vec::with_capacity(frames);
-    for _ in 0..frames.max(1) {
+    for frame in warmup + 1..=(warmup + frames.max(1)).max(BENCH_CHECK_STEPS) {
+        if failed_at_frame.is_some() {
+            break;
+        }
         let start = Instant::now();
         app.update();
-        times.push(start.elapsed().as_secs_f64() * 1e3);
+        if times.len() < frames.max(1) {
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        if !stable(&app) {
+            failed_at_frame = Some(frame);
+        }
     }
-    let ms = median(&mut times);
+    let ms = failed_at_frame.is_none().then(|| median(&mut times));
     Ok(AppFrame {
         model: model.to_string(),
         particles: count,
         ms_per_frame: ms,
-        fps: 1e3 / ms,
+        fps: ms.map(|ms| 1e3 / ms),
+        failed_at_frame,
         seed_fps: SEED_002_FPS
             .iter()
             .find(|(c, _)| *c == count)

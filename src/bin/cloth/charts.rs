@@ -125,7 +125,7 @@ impl Chart for Bench<'_> {
             .iter()
             .filter_map(|c| c.ms_per_step)
             .chain(SEED_MS.iter().flatten().copied())
-            .chain(app.iter().map(|a| a.ms_per_frame))
+            .chain(app.iter().filter_map(|a| a.ms_per_frame))
             .chain(SEED_002_FPS.iter().map(|(_, f)| 1e3 / f));
         let xs = (SEED_COUNTS[0] as f64 / 1.5)..(SEED_COUNTS[SEED_COUNTS.len() - 1] as f64 * 1.5);
         let mut chart = ChartBuilder::on(area)
@@ -197,7 +197,7 @@ impl Chart for Bench<'_> {
             let line: Vec<(f64, f64)> = app
                 .iter()
                 .filter(|a| a.model == *model)
-                .map(|a| (a.particles as f64, a.ms_per_frame))
+                .filter_map(|a| Some((a.particles as f64, a.ms_per_frame?)))
                 .collect();
             chart
                 .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))

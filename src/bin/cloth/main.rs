@@ -387,10 +387,15 @@ fn bench(args: &[String]) -> Result<(), String> {
                 std::thread::sleep(std::time::Duration::from_millis(500));
                 let row =
                     fps::app_frame(model, count, 5, frames_measured).map_err(|e| e.to_string())?;
-                eprintln!(
-                    "app, model {model:>2}, {count:>6} particles: {:8.3} ms per frame, {:7.1} fps",
-                    row.ms_per_frame, row.fps
-                );
+                match (row.ms_per_frame, row.fps) {
+                    (Some(ms), Some(fps)) => eprintln!(
+                        "app, model {model:>2}, {count:>6} particles: {ms:8.3} ms per frame, {fps:7.1} fps"
+                    ),
+                    _ => eprintln!(
+                        "app, model {model:>2}, {count:>6} particles: FAILED after frame {}: not timed",
+                        row.failed_at_frame.unwrap_or(0)
+                    ),
+                }
                 frames.push(row);
             }
         }
@@ -441,10 +446,14 @@ fn bench(args: &[String]) -> Result<(), String> {
         println!("|---|---:|---:|---:|---:|");
         for f in &frames {
             let seed = f.seed_fps.map_or("-".to_string(), |s| format!("{s:.0}"));
-            println!(
-                "| {} | {} | {:.3} | {:.0} | {seed} |",
-                f.model, f.particles, f.ms_per_frame, f.fps
-            );
+            let (ms, fps) = match (f.ms_per_frame, f.fps, f.failed_at_frame) {
+                (Some(ms), Some(fps), _) => (format!("{ms:.3}"), format!("{fps:.0}")),
+                (_, _, frame) => (
+                    format!("failed at frame {}", frame.unwrap_or(0)),
+                    "-".to_string(),
+                ),
+            };
+            println!("| {} | {} | {ms} | {fps} | {seed} |", f.model, f.particles);
         }
     }
     Ok(())
