@@ -183,3 +183,52 @@ fn bad_input_exits_2_with_one_line_naming_the_problem() {
     }
     let _ = std::fs::remove_file(&bad_scene);
 }
+
+/// The physics does not change under a refactoring: each scene's dump after 120 steps is
+/// byte-identical to the one stored in `tests/data/golden/` (positions printed as the
+/// shortest text that reads back to the same `f32`, so equal text is equal bits). After a
+/// change that is *meant* to change the physics, `BLESS=1 cargo test --test cli golden`
+/// rewrites them; the commit then says why.
+#[test]
+fn golden_dumps_of_the_scenes_are_unchanged() {
+    let cases: [(&str, &str, &[&str]); 4] = [
+        ("curtain", "assets/scenes/curtain.ron", &[]),
+        (
+            "curtain_patches",
+            "assets/scenes/curtain.ron",
+            &["--model", "patches"],
+        ),
+        ("card", "assets/scenes/card.ron", &[]),
+        ("tshirt", "assets/scenes/tshirt.ron", &[]),
+    ];
+    let bless = std::env::var_os("BLESS").is_some();
+    let mut changed = Vec::new();
+    for (name, scene, extra) in cases {
+        let dump = temp(&format!("golden_{name}.csv"));
+        let mut args = vec!["run", scene, "--steps", "120", "--every", "120", "--dump"];
+        args.push(dump.to_str().unwrap());
+        args.extend_from_slice(extra);
+        run_ok(&args);
+        let got = std::fs::read_to_string(&dump).unwrap();
+        std::fs::remove_file(&dump).ok();
+        let stored = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/golden")
+            .join(format!("{name}.csv"));
+        if bless {
+            std::fs::create_dir_all(stored.parent().unwrap()).unwrap();
+            std::fs::write(&stored, &got).unwrap();
+            continue;
+        }
+        let want = std::fs::read_to_string(&stored)
+            .unwrap_or_else(|e| panic!("{}: {e} (BLESS=1 writes it)", stored.display()));
+        if got != want {
+            let line = got
+                .lines()
+                .zip(want.lines())
+                .position(|(a, b)| a != b)
+                .map_or("the line count".to_string(), |i| format!("line {}", i + 1));
+            changed.push(format!("{name}: differs at {line}"));
+        }
+    }
+    assert!(changed.is_empty(), "{}", changed.join("; "));
+}
