@@ -407,7 +407,7 @@ impl ClothStats {
                 .take_while(|s| s.time >= time - 1.0)
                 .map(|s| s.step_ms),
         );
-        self.step_ms_median = crate::measure::median(&mut self.scratch);
+        self.step_ms_median = crate::stats::median(&mut self.scratch);
     }
 }
 

@@ -36,7 +36,7 @@ pub mod components;
 pub mod controls;
 pub mod error;
 pub mod garment;
-pub mod measure;
+pub mod headless;
 pub mod mesh;
 pub mod params;
 pub mod pattern;
@@ -44,6 +44,7 @@ pub mod plugin;
 pub mod scene;
 pub mod shape;
 pub mod solver;
+pub mod stats;
 
 /// The types a user needs to add cloth to an app.
 pub mod prelude {
@@ -53,6 +54,7 @@ pub mod prelude {
     };
     pub use crate::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::error::ClothError;
+    pub use crate::headless::{SceneRun, headless_app};
     pub use crate::params::{
         ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
         RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use bevy::math::{Affine3A, Vec3};
 use bevy_cloth::garment::{GarmentLayout, asset_path};
-use bevy_cloth::measure::SceneRun;
+use bevy_cloth::headless::SceneRun;
 use bevy_cloth::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{Cloth as Solver, Collider, ColliderShape, SpringKind};

@@ -6,7 +6,7 @@ use bevy::prelude::*;
 use bevy_cloth::prelude::*;
 
 fn app() -> App {
-    bevy_cloth::measure::fps::headless_app()
+    bevy_cloth::headless::headless_app()
 }
 
 /// Default parameters: automatic substeps keep them stable.

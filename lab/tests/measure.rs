@@ -3,10 +3,15 @@
 //! metric of a known displacement, and the full app's frame loop.
 
 use bevy::math::Vec3;
-use bevy_cloth::measure::accuracy::{Case, SAMPLE_INTERVAL, Trajectory};
-use bevy_cloth::measure::stability::Regime;
-use bevy_cloth::measure::{fps, stability};
 use bevy_cloth::prelude::*;
+use bevy_cloth_lab::accuracy::{Case, SAMPLE_INTERVAL, Trajectory};
+use bevy_cloth_lab::stability::Regime;
+use bevy_cloth_lab::{fps, stability};
+
+/// A scene file of the workspace (tests run in `lab/`).
+fn scene_path(name: &str) -> String {
+    format!("{}/../assets/scenes/{name}", env!("CARGO_MANIFEST_DIR"))
+}
 
 #[test]
 fn a_single_spring_goes_unstable_at_omega_h_2() {
@@ -40,6 +45,14 @@ fn the_lattice_fails_where_its_largest_frequency_says() {
     let factor = |t: &stability::Threshold| t.omega_max / (t.stiffness / t.mass).sqrt();
     assert!((factor(&t) - factor(&other)).abs() < 0.01 * factor(&t));
     assert!((factor(&t) - stability::lattice_factor()).abs() < 0.01 * factor(&t));
+    // Seed 002's stiffest, lightest material: the automatic substep lies inside the
+    // measured threshold, and not wastefully far inside (Gershgorin overestimates ω_max
+    // by ~1.8×, the safety factor is 0.8).
+    let x = stability::lattice(25_000.0, 1e-6, Integrator::Verlet).unwrap();
+    assert!(
+        x.auto_bound < x.measured && x.auto_bound > 0.4 * x.measured,
+        "{x:?}"
+    );
 }
 
 #[test]
@@ -106,7 +119,7 @@ fn the_error_is_the_rms_distance_over_the_diagonal() {
 
 #[test]
 fn samples_are_every_tenth_of_a_second_on_every_configuration_alike() {
-    let scene = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    let scene = ClothScene::load(scene_path("curtain.ron")).unwrap();
     let case = Case::new("curtain", &scene, 0, 3.0).unwrap();
     let steps = case.sample_steps();
     assert_eq!(steps.len(), 30);
@@ -120,13 +133,13 @@ fn samples_are_every_tenth_of_a_second_on_every_configuration_alike() {
         );
     }
     // The reference must be mass-spring.
-    let card = ClothScene::load("assets/scenes/card.ron").unwrap();
+    let card = ClothScene::load(scene_path("card.ron")).unwrap();
     assert!(Case::new("card", &card, 0, 3.0).is_err());
 }
 
 #[test]
 fn a_coarse_configuration_is_further_from_the_reference_than_a_fine_one() {
-    let mut scene = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    let mut scene = ClothScene::load(scene_path("curtain.ron")).unwrap();
     scene.apply_override("cloth.shape.width=12").unwrap();
     scene.apply_override("cloth.shape.height=10").unwrap();
     let case = Case::new("small curtain", &scene, 0, 1.0).unwrap();
@@ -141,9 +154,7 @@ fn a_coarse_configuration_is_further_from_the_reference_than_a_fine_one() {
     };
     let auto = error(Substeps::default());
     let finer = error(Substeps::Fixed(
-        4 * bevy_cloth::measure::SceneRun::new(&case.scene)
-            .unwrap()
-            .cloths[0]
+        4 * bevy_cloth_lab::SceneRun::new(&case.scene).unwrap().cloths[0]
             .1
             .stable_substeps(scene.timestep),
     ));
@@ -160,4 +171,42 @@ fn the_full_app_steps_and_writes_the_mesh_each_frame() {
     assert_eq!(row.failed_at_frame, None);
     assert!(row.ms_per_frame.is_some_and(|ms| ms > 0.0) && row.fps.is_some_and(f64::is_finite));
     assert_eq!(row.seed_fps, Some(60.0));
+}
+
+#[test]
+fn goal_forces_conserve_momentum_on_a_free_cloth() {
+    // Until the goal offsets were formed from relative positions with each cluster's
+    // mean removed, the f32 rounding of the centre of mass acted as a net force: the
+    // first of these cloths drifted at ~1 m/s² and its energy grew 40× in one second.
+    // For p ≠ 1 each particle's own scale (|d|/L)^(p−1) undid the zero sum of the
+    // offsets, a net force the goal forces now take back out.
+    for (k, m) in [(1_000.0, 1e-4), (25_000.0, 1e-6), (100.0, 1e-5)] {
+        for (clusters, model) in [
+            (1, "shape-matching"),
+            (3, "shape-matching"),
+            (1, "shape-matching p=0.5"),
+            (3, "shape-matching p=3"),
+        ] {
+            let mut params =
+                stability::params(model, k, m, Integrator::Verlet, Substeps::default()).unwrap();
+            if let Model::ShapeMatching(sm) = &mut params.model {
+                sm.clusters = clusters;
+            }
+            let mut cloth = stability::probe_cloth(&params).unwrap();
+            let env = stability::quiet();
+            let e0 = cloth.energy(&env).total() as f64;
+            assert_eq!(stability::probe(&mut cloth, 0.001, 1000), None);
+            let p = cloth.particles();
+            let total: f32 = p.mass.iter().sum();
+            let momentum: Vec3 = (0..p.len()).map(|i| p.velocity[i] * p.mass[i]).sum();
+            // Against the momentum of the whole cloth moving at the perturbation's speed.
+            let v_scale = (2.0 * e0 / total as f64).sqrt() as f32;
+            assert!(
+                momentum.length() < 1e-3 * total * v_scale,
+                "{model}, k {k}, m {m}, {clusters}×{clusters}: momentum {momentum} against {}",
+                total * v_scale
+            );
+            assert!(stability::kinetic(&cloth) <= 2.0 * e0, "k {k}, m {m}");
+        }
+    }
 }

@@ -21,14 +21,14 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use bevy_cloth::measure::accuracy::{self, Case};
-use bevy_cloth::measure::fps::{self, APP_COUNTS};
-use bevy_cloth::measure::stability::{
-    self, MASS, MODELS, NONLINEAR_MODELS, NONLINEAR_TIMESTEP, Regime, STIFFNESS, TIMESTEP,
-};
-use bevy_cloth::measure::{self, BenchCell, SEED_COUNTS, SEED_MODELS, SceneRun};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver;
+use bevy_cloth_lab::accuracy::{self, Case};
+use bevy_cloth_lab::fps::{self, APP_COUNTS};
+use bevy_cloth_lab::stability::{
+    self, MASS, MODELS, NONLINEAR_MODELS, NONLINEAR_TIMESTEP, Regime, STIFFNESS, TIMESTEP,
+};
+use bevy_cloth_lab::{self as measure, BenchCell, SEED_COUNTS, SEED_MODELS, SceneRun};
 
 const USAGE: &str = "usage: cloth run SCENE [--steps N] [--model mass-spring|shape-matching|patches] [--set key=value]... [--dump FILE.json|.csv|.obj] [--every K]
        cloth bench [--max PARTICLES] [--models 1,2,3a,3b,3c] [--repeats N] [--app] [--app-models 1,3b] [--json] [--chart FILE.png]

@@ -20,9 +20,11 @@ use std::time::Instant;
 use bevy::math::Vec3;
 use serde::Serialize;
 
-use crate::error::ClothError;
-use crate::params::{ClothParams, Integrator, Model, PatchParams, ShapeMatchingParams, Substeps};
-use crate::scene::ClothScene;
+use bevy_cloth::error::ClothError;
+use bevy_cloth::params::{
+    ClothParams, Integrator, Model, PatchParams, ShapeMatchingParams, Substeps,
+};
+use bevy_cloth::scene::ClothScene;
 
 use super::SceneRun;
 
@@ -349,7 +351,7 @@ pub struct Row {
     pub max_strain: f32,
     /// Final total energy minus the reference's, over `M g D` (mass, gravity, diagonal);
     /// the same quantity for every model: the particles' kinetic, gravitational and
-    /// spring energy at the scene's spring parameters ([`crate::solver::Cloth::energy`]).
+    /// spring energy at the scene's spring parameters ([`bevy_cloth::solver::Cloth::energy`]).
     pub energy_drift: Option<f64>,
     /// When the run failed, s.
     pub failed_at: Option<f32>,

@@ -5,7 +5,8 @@ use std::process::Command;
 
 fn cloth() -> Command {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_cloth"));
-    cmd.current_dir(env!("CARGO_MANIFEST_DIR"));
+    // The workspace root, where `assets/` is.
+    cmd.current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."));
     cmd
 }
 

@@ -5,11 +5,11 @@
 use std::ops::Range;
 use std::path::Path;
 
-use bevy_cloth::measure::accuracy::Row;
-use bevy_cloth::measure::fps::{AppFrame, SEED_002_FPS};
-use bevy_cloth::measure::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
-use bevy_cloth::measure::{BenchCell, SEED_COUNTS, SEED_MODELS, SEED_MS};
 use bevy_cloth::prelude::Integrator;
+use bevy_cloth_lab::accuracy::Row;
+use bevy_cloth_lab::fps::{AppFrame, SEED_002_FPS};
+use bevy_cloth_lab::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
+use bevy_cloth_lab::{BenchCell, SEED_COUNTS, SEED_MODELS, SEED_MS};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 

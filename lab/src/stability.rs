@@ -27,13 +27,13 @@
 use bevy::math::{Affine3A, Vec3};
 use serde::Serialize;
 
-use crate::error::ClothError;
-use crate::params::{
+use bevy_cloth::error::ClothError;
+use bevy_cloth::params::{
     ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, ShapeMatchingParams,
     SpringFamily, SpringParams, Substeps, Wind,
 };
-use crate::shape::{ClothShape, Pins};
-use crate::solver::{self, SpringKind};
+use bevy_cloth::shape::{ClothShape, Pins};
+use bevy_cloth::solver::{self, SpringKind};
 
 /// Spring (and pull) stiffnesses of the grid, N/m (seed 002 §1.4's range).
 pub const STIFFNESS: [f32; 6] = [100.0, 300.0, 1_000.0, 3_000.0, 10_000.0, 25_000.0];

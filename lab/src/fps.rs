@@ -4,16 +4,15 @@
 //! exactly one 16 ms fixed step per frame, so a frame's wall-clock time is what one
 //! step of the game costs; frames per second are `1000 / ms`.
 
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-use bevy::asset::AssetPlugin;
-use bevy::mesh::{Mesh, Mesh3d};
+use bevy::mesh::Mesh3d;
 use bevy::prelude::*;
-use bevy::time::TimeUpdateStrategy;
 
-use crate::error::ClothError;
-use crate::measure::{BENCH_CHECK_STEPS, BENCH_PINS, grid_for, median, seed_model_params};
-use crate::prelude::{Cloth, ClothPlugin, ClothSimulation};
+use crate::{BENCH_CHECK_STEPS, BENCH_PINS, grid_for, median, seed_model_params};
+use bevy_cloth::error::ClothError;
+use bevy_cloth::headless::headless_app;
+use bevy_cloth::prelude::{Cloth, ClothSimulation};
 
 /// Seed 002's table 4.1: masses and the frames per second it reported.
 pub const SEED_002_FPS: [(usize, f64); 10] = [
@@ -51,22 +50,6 @@ pub struct AppFrame {
     pub failed_at_frame: Option<usize>,
     /// Seed 002's frames per second at this count, when it has one.
     pub seed_fps: Option<f64>,
-}
-
-/// The app without a window: `MinimalPlugins`, assets, meshes and `ClothPlugin`, with
-/// time advanced by exactly one 16 ms fixed step per `update`.
-pub fn headless_app() -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        MinimalPlugins,
-        AssetPlugin::default(),
-        ClothPlugin::default(),
-    ))
-    .init_asset::<Mesh>()
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
-        16,
-    )));
-    app
 }
 
 /// Runs the app with one curtain of `count` particles (5 cm grid, top row pinned,

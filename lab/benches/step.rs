@@ -5,8 +5,8 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
-use bevy_cloth::measure::{SEED_MODELS, bench_cloth};
 use bevy_cloth::prelude::Environment;
+use bevy_cloth_lab::{SEED_MODELS, bench_cloth};
 
 fn step(c: &mut Criterion) {
     let env = Environment::default();

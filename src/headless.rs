@@ -1,0 +1,159 @@
+//! Running without a window: a scene's cloths as solvers stepped directly
+//! ([`SceneRun`], for the `cloth` command line, tests and measurements), and the
+//! plugin in an [`App`] with no window and manual time ([`headless_app`], for App tests
+//! and frame timings).
+
+use std::time::{Duration, Instant};
+
+use bevy::asset::AssetPlugin;
+use bevy::mesh::Mesh;
+use bevy::prelude::*;
+use bevy::time::TimeUpdateStrategy;
+use serde::Serialize;
+
+use crate::error::ClothError;
+use crate::params::Environment;
+use crate::plugin::ClothPlugin;
+use crate::scene::ClothScene;
+use crate::solver::{self, Collider};
+use crate::stats::median;
+
+/// What a headless run of a scene did, per cloth.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ClothSummary {
+    /// The cloth's name in the scene.
+    pub name: String,
+    /// Particles.
+    pub particles: usize,
+    /// Acting springs (or part springs for the patch model).
+    pub springs: usize,
+    /// Substeps of the last step.
+    pub substeps: u32,
+    /// Largest structural strain at the end.
+    pub max_strain: f32,
+    /// Mean |strain| at the end.
+    pub mean_strain: f32,
+    /// Kinetic energy at the end, J.
+    pub kinetic_energy: f32,
+    /// Total energy at the start, J.
+    pub energy_start: f32,
+    /// Total energy at the end, J.
+    pub energy_end: f32,
+    /// Springs torn.
+    pub torn_springs: usize,
+    /// Finite everywhere and no spring past 100% strain.
+    pub stable: bool,
+}
+
+/// A headless run: the scene's cloths stepped together.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// Steps taken.
+    pub steps: usize,
+    /// Simulated seconds.
+    pub simulated_seconds: f32,
+    /// Median wall-clock time of one step of all cloths, ms (the only field that varies
+    /// between identical runs).
+    pub median_ms_per_step: f64,
+    /// Per cloth.
+    pub cloths: Vec<ClothSummary>,
+}
+
+/// A scene's cloths built as solvers, with their colliders, ready to step.
+pub struct SceneRun {
+    /// `(name, solver)` per cloth.
+    pub cloths: Vec<(String, solver::Cloth)>,
+    /// Gravity and wind.
+    pub environment: Environment,
+    /// The step, s.
+    pub timestep: f32,
+}
+
+impl SceneRun {
+    /// Builds every cloth of `scene` where its frame puts it, with the scene's colliders.
+    pub fn new(scene: &ClothScene) -> Result<Self, ClothError> {
+        let colliders: Vec<Collider> = scene
+            .colliders
+            .iter()
+            .map(|c| c.collider.to_world(&GlobalTransform::from(c.transform())))
+            .collect();
+        let mut cloths = Vec::with_capacity(scene.cloths.len());
+        for entry in &scene.cloths {
+            let mut cloth = entry.cloth.build(entry.transform().compute_affine())?;
+            cloth.set_colliders(colliders.iter().copied());
+            cloths.push((entry.name.clone(), cloth));
+        }
+        Ok(Self {
+            cloths,
+            environment: scene.environment,
+            timestep: scene.timestep,
+        })
+    }
+
+    /// Runs `steps` steps, calling `each` after every step with the step number (1-based),
+    /// and returns the summary.
+    pub fn run(
+        &mut self,
+        steps: usize,
+        mut each: impl FnMut(usize, &[(String, solver::Cloth)]),
+    ) -> RunSummary {
+        let env = self.environment;
+        let energy_start: Vec<f32> = self
+            .cloths
+            .iter()
+            .map(|(_, c)| c.energy(&env).total())
+            .collect();
+        let mut times = Vec::with_capacity(steps);
+        for step in 1..=steps {
+            let start = Instant::now();
+            for (_, cloth) in &mut self.cloths {
+                cloth.step(self.timestep, &env);
+            }
+            times.push(start.elapsed().as_secs_f64() * 1e3);
+            each(step, &self.cloths);
+        }
+        RunSummary {
+            steps,
+            simulated_seconds: steps as f32 * self.timestep,
+            median_ms_per_step: median(&mut times),
+            cloths: self
+                .cloths
+                .iter()
+                .zip(energy_start)
+                .map(|((name, c), energy_start)| {
+                    let strain = c.strain();
+                    let energy = c.energy(&env);
+                    ClothSummary {
+                        name: name.clone(),
+                        particles: c.particle_count(),
+                        springs: c.spring_count(),
+                        substeps: c.substeps(),
+                        max_strain: strain.max,
+                        mean_strain: strain.mean,
+                        kinetic_energy: energy.kinetic,
+                        energy_start,
+                        energy_end: energy.total(),
+                        torn_springs: c.torn_count(),
+                        stable: c.is_stable(),
+                    }
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The app without a window: `MinimalPlugins`, assets, meshes and `ClothPlugin`, with
+/// time advanced by exactly one 16 ms fixed step per `update`.
+pub fn headless_app() -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        ClothPlugin::default(),
+    ))
+    .init_asset::<Mesh>()
+    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
+        16,
+    )));
+    app
+}
