@@ -100,9 +100,16 @@ impl Cloth {
                 for warning in &layout.warnings {
                     warn!("{warning}");
                 }
-                solver::Cloth::from_garment(layout, &self.pins, &self.params, frame)
+                if layout.positions.is_empty() || layout.triangles.is_empty() {
+                    return Err(ClothError::BadMesh {
+                        reason: "the garment has no faces".into(),
+                    });
+                }
+                let layout = layout.into_layout();
+                let pins = self.pins.resolve_for(&layout)?;
+                solver::Cloth::new(layout, &pins, &self.params, frame)
             }
-            _ => solver::Cloth::new(&self.shape, &self.pins, &self.params, frame),
+            _ => self.shape.build_solver(&self.pins, &self.params, frame),
         }
     }
 }

@@ -30,8 +30,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
 use crate::pattern::{Pattern, PatternWarning};
-use crate::solver::SpringKind;
 use crate::solver::topology::{grid_spring_pairs, grid_triangles};
+use crate::solver::{Layout, SpringKind};
 
 /// The finest resolution a garment may be rescaled to.
 pub const MAX_RESOLUTION: u32 = 64;
@@ -106,6 +106,19 @@ pub struct GarmentLayout {
     pub seams: Vec<(String, Vec<[u32; 2]>)>,
     /// Legal but odd things in the patterns (disconnected islands).
     pub warnings: Vec<PatternWarning>,
+}
+
+impl GarmentLayout {
+    /// The solver's layout: positions, springs (seams included), triangles and pieces.
+    pub fn into_layout(self) -> Layout {
+        Layout {
+            positions: self.positions,
+            springs: self.springs,
+            triangles: self.triangles,
+            grid: None,
+            pieces: self.pieces,
+        }
+    }
 }
 
 /// The path of an asset file: under the `assets` folder where Bevy's asset server looks
@@ -272,7 +285,7 @@ impl GarmentLayout {
                 .extend(pairs.iter().map(|p| (SpringKind::Seam, p[0], p[1])));
             layout.seams.push((seam.name.clone(), pairs));
         }
-        if layout.positions.len() > crate::shape::MAX_PARTICLES {
+        if layout.positions.len() > crate::solver::MAX_PARTICLES {
             return Err(error(
                 "pieces",
                 format!(

@@ -34,7 +34,7 @@ use crate::params::{
     ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
 };
 use crate::shape::{ClothShape, Pins};
-use crate::solver;
+use crate::solver::{self, Layout};
 
 /// The ordered system sets of the cloth simulation.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -216,13 +216,9 @@ fn build_one(
                 triangles,
                 uvs,
             } = mesh_triangles(source)?;
-            let solver = solver::Cloth::from_mesh(
-                &positions,
-                &triangles,
-                &cloth.pins,
-                &cloth.params,
-                frame,
-            )?;
+            let layout = Layout::from_mesh(&positions, &triangles)?;
+            let pins = cloth.pins.resolve_for(&layout)?;
+            let solver = solver::Cloth::new(layout, &pins, &cloth.params, frame)?;
             let mesh = cloth_mesh(&solver, uvs);
             Ok(Some((solver, mesh)))
         }

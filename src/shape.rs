@@ -1,12 +1,12 @@
 //! What a cloth looks like before it moves: its shape and where it is pinned.
 
+use bevy::math::{Affine3A, Vec3};
 use bevy::reflect::Reflect;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
-
-/// The most particles one cloth may have (a 2048×2048 grid).
-pub const MAX_PARTICLES: usize = 1 << 22;
+use crate::params::ClothParams;
+use crate::solver::{self, Layout, MAX_PARTICLES, topology};
 
 /// The initial layout of a cloth's particles.
 #[derive(Clone, Debug, PartialEq, Reflect, Serialize, Deserialize)]
@@ -47,6 +47,56 @@ impl Default for ClothShape {
 }
 
 impl ClothShape {
+    /// The layout of a grid (seed 000 §3.2's construction): particle `(i, j)` at
+    /// `(i·spacing − (width−1)·spacing/2, −j·spacing, 0)`, structural, shear and bend
+    /// springs, two triangles per cell. A mesh or a garment is laid out from its data
+    /// ([`Layout::from_mesh`], [`crate::garment::GarmentLayout::into_layout`]): an error here.
+    pub fn layout(&self) -> Result<Layout, ClothError> {
+        self.validate()?;
+        match *self {
+            ClothShape::Grid {
+                width,
+                height,
+                spacing,
+            } => {
+                let half = (width - 1) as f32 * spacing * 0.5;
+                let positions = (0..height)
+                    .flat_map(|j| {
+                        (0..width).map(move |i| {
+                            Vec3::new(i as f32 * spacing - half, -(j as f32) * spacing, 0.0)
+                        })
+                    })
+                    .collect();
+                Ok(Layout {
+                    positions,
+                    springs: topology::grid_spring_pairs(width, height),
+                    triangles: topology::grid_triangles(width, height),
+                    grid: Some((width, height)),
+                    pieces: Vec::new(),
+                })
+            }
+            ClothShape::Mesh => Err(ClothError::BadMesh {
+                reason: "a mesh-shaped cloth is laid out from its mesh (`Layout::from_mesh`)"
+                    .into(),
+            }),
+            ClothShape::Garment { .. } => Err(ClothError::BadMesh {
+                reason: "a garment is laid out from its file (`GarmentLayout`)".into(),
+            }),
+        }
+    }
+
+    /// The solver cloth of a grid shape, pinned by `pins`, placed by `frame`.
+    pub fn build_solver(
+        &self,
+        pins: &Pins,
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<solver::Cloth, ClothError> {
+        let layout = self.layout()?;
+        let pins = pins.resolve_for(&layout)?;
+        solver::Cloth::new(layout, &pins, params, frame)
+    }
+
     /// Checks sizes; a grid smaller than 2×2 or with a bad spacing is an error.
     pub fn validate(&self) -> Result<(), ClothError> {
         if let ClothShape::Grid {
@@ -102,12 +152,17 @@ pub enum Pins {
 }
 
 impl Pins {
+    /// The pinned particle indices of `layout` (see [`Pins::resolve`]).
+    pub fn resolve_for(&self, layout: &Layout) -> Result<Vec<u32>, ClothError> {
+        self.resolve(&layout.positions, layout.grid.map(|g| g.0))
+    }
+
     /// The pinned particle indices. A grid of `grid_width` columns pins by row and column;
     /// a mesh (no grid) pins its highest vertices for `TopRow` and the leftmost and
     /// rightmost of those for `TopCorners`.
     pub fn resolve(
         &self,
-        positions: &[bevy::math::Vec3],
+        positions: &[Vec3],
         grid_width: Option<u32>,
     ) -> Result<Vec<u32>, ClothError> {
         let count = positions.len();

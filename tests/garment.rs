@@ -7,7 +7,7 @@ use bevy_cloth::garment::{GarmentLayout, asset_path};
 use bevy_cloth::headless::SceneRun;
 use bevy_cloth::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{Cloth as Solver, Collider, ColliderShape, SpringKind};
+use bevy_cloth::solver::{Cloth as Solver, Collider, ColliderShape, Layout, SpringKind};
 
 fn parse_err(text: &[u8]) -> (usize, usize, PatternErrorKind) {
     let e = Pattern::parse(text, "bad.txt").expect_err("must be refused");
@@ -308,8 +308,13 @@ fn drop_particle(start: Vec3, collider: Collider, seconds: f32) -> Solver {
         drag: 0.0,
         ..ClothParams::default()
     };
-    let mut cloth =
-        Solver::from_springs(&[start], &[], &Pins::None, &params, Affine3A::IDENTITY).unwrap();
+    let mut cloth = Solver::new(
+        Layout::from_springs(&[start], &[]).unwrap(),
+        &[],
+        &params,
+        Affine3A::IDENTITY,
+    )
+    .unwrap();
     cloth.set_colliders([collider]);
     let env = Environment::default();
     for _ in 0..(seconds / 0.016) as usize {

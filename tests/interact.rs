@@ -7,16 +7,12 @@ use bevy_cloth::solver::Cloth as Solver;
 const DT: f32 = 0.016;
 
 fn curtain() -> Solver {
-    Solver::new(
-        &ClothShape::Grid {
-            width: 10,
-            height: 8,
-            spacing: 0.1,
-        },
-        &Pins::TopRow,
-        &ClothParams::default(),
-        Affine3A::IDENTITY,
-    )
+    ClothShape::Grid {
+        width: 10,
+        height: 8,
+        spacing: 0.1,
+    }
+    .build_solver(&Pins::TopRow, &ClothParams::default(), Affine3A::IDENTITY)
     .unwrap()
 }
 

@@ -44,7 +44,9 @@ fn grid_cloth(params: &ClothParams) -> Solver {
         height: 16,
         spacing: 0.05,
     };
-    Solver::new(&shape, &Pins::TopCorners, params, Affine3A::IDENTITY).unwrap()
+    shape
+        .build_solver(&Pins::TopCorners, params, Affine3A::IDENTITY)
+        .unwrap()
 }
 
 /// Allocations this thread makes while running `f`.

@@ -3,7 +3,7 @@
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::Cloth as Solver;
+use bevy_cloth::solver::{Cloth as Solver, Layout};
 
 const DT: f32 = 0.016;
 
@@ -16,16 +16,12 @@ fn patch(w: u32, h: u32) -> PatchParams {
 }
 
 fn grid(width: u32, height: u32, params: ClothParams, pins: Pins, frame: Affine3A) -> Solver {
-    Solver::new(
-        &ClothShape::Grid {
-            width,
-            height,
-            spacing: 0.05,
-        },
-        &pins,
-        &params,
-        frame,
-    )
+    ClothShape::Grid {
+        width,
+        height,
+        spacing: 0.05,
+    }
+    .build_solver(&pins, &params, frame)
     .unwrap()
 }
 
@@ -177,13 +173,15 @@ fn hang_curtain(model: Model) -> (f32, f32, f32, f32) {
         model,
         ..entry.cloth.params
     };
-    let mut c = Solver::new(
-        &entry.cloth.shape,
-        &entry.cloth.pins,
-        &params,
-        Affine3A::from_translation(entry.translation),
-    )
-    .unwrap();
+    let mut c = entry
+        .cloth
+        .shape
+        .build_solver(
+            &entry.cloth.pins,
+            &params,
+            Affine3A::from_translation(entry.translation),
+        )
+        .unwrap();
     let pin_y = c.positions()[0].y;
     for _ in 0..(10.0 / DT) as usize {
         c.step(DT, &scene.environment);
@@ -283,10 +281,9 @@ fn patches_need_a_grid_and_valid_sizes() {
         ..ClothParams::default()
     };
     assert!(
-        Solver::from_mesh(
-            &positions,
-            &[[0, 1, 2]],
-            &Pins::None,
+        Solver::new(
+            Layout::from_mesh(&positions, &[[0, 1, 2]]).unwrap(),
+            &[],
             &params,
             Affine3A::IDENTITY
         )

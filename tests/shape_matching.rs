@@ -3,7 +3,7 @@
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::Cloth as Solver;
+use bevy_cloth::solver::{Cloth as Solver, Layout};
 
 const DT: f32 = 0.016;
 const POLAR: RotationMethod = RotationMethod::PolarDecomposition;
@@ -45,16 +45,12 @@ fn card(params: ShapeMatchingParams, pins: Pins) -> Solver {
         drag: 0.0,
         ..ClothParams::default()
     };
-    Solver::new(
-        &ClothShape::Grid {
-            width: 8,
-            height: 11,
-            spacing: 0.009,
-        },
-        &pins,
-        &cloth,
-        Affine3A::IDENTITY,
-    )
+    ClothShape::Grid {
+        width: 8,
+        height: 11,
+        spacing: 0.009,
+    }
+    .build_solver(&pins, &cloth, Affine3A::IDENTITY)
     .unwrap()
 }
 
@@ -152,10 +148,9 @@ fn degenerate_shapes_give_finite_goals() {
                 .map(|i| Vec3::new(i as f32 * 0.01, 0.0, 0.0))
                 .collect();
             let springs: Vec<[u32; 2]> = (0..5).map(|i| [i, i + 1]).collect();
-            let mut strip = Solver::from_springs(
-                &positions,
-                &springs,
-                &Pins::None,
+            let mut strip = Solver::new(
+                Layout::from_springs(&positions, &springs).unwrap(),
+                &[],
                 &strip_params,
                 Affine3A::IDENTITY,
             )
@@ -426,16 +421,12 @@ fn shape_matching_works_with_pins_gravity_and_wind_and_never_tears() {
         tear_ratio: Some(1.01),
         ..ClothParams::default()
     };
-    let mut c = Solver::new(
-        &ClothShape::Grid {
-            width: 8,
-            height: 11,
-            spacing: 0.009,
-        },
-        &Pins::Indices(vec![0]),
-        &cloth,
-        Affine3A::IDENTITY,
-    )
+    let mut c = ClothShape::Grid {
+        width: 8,
+        height: 11,
+        spacing: 0.009,
+    }
+    .build_solver(&Pins::Indices(vec![0]), &cloth, Affine3A::IDENTITY)
     .unwrap();
     let env = Environment {
         wind: Wind {

@@ -3,7 +3,7 @@
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{Cloth as Solver, SpringKind};
+use bevy_cloth::solver::{Cloth as Solver, Layout, SpringKind};
 
 const DT: f32 = 0.016;
 
@@ -55,7 +55,7 @@ fn free_particles_at(integrator: Integrator, substeps: u32, frame: Affine3A) -> 
         height: 2,
         spacing: 0.1,
     };
-    Solver::new(&shape, &Pins::None, &params, frame).unwrap()
+    shape.build_solver(&Pins::None, &params, frame).unwrap()
 }
 
 #[test]
@@ -126,10 +126,9 @@ fn spring_period_matches_two_pi_sqrt_m_over_k() {
             ..conservative(integrator)
         };
         let positions = [Vec3::ZERO, Vec3::new(0.0, -1.0, 0.0)];
-        let mut cloth = Solver::from_springs(
-            &positions,
-            &[[0, 1]],
-            &Pins::Indices(vec![0]),
+        let mut cloth = Solver::new(
+            Layout::from_springs(&positions, &[[0, 1]]).unwrap(),
+            &[0],
             &params,
             Affine3A::IDENTITY,
         )
@@ -177,16 +176,12 @@ fn swinging_cloth(params: &ClothParams) -> Solver {
         Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         Vec3::new(0.0, 1.0, 0.0),
     );
-    Solver::new(
-        &ClothShape::Grid {
-            width: 8,
-            height: 8,
-            spacing: 0.1,
-        },
-        &Pins::TopCorners,
-        params,
-        frame,
-    )
+    ClothShape::Grid {
+        width: 8,
+        height: 8,
+        spacing: 0.1,
+    }
+    .build_solver(&Pins::TopCorners, params, frame)
     .unwrap()
 }
 
@@ -279,16 +274,12 @@ fn tear_test_cloth(tear_ratio: f32, gravity: f32) -> (Solver, Environment) {
         drag: 1e-3,
         ..conservative(Integrator::Verlet)
     };
-    let cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 6,
-            height: 6,
-            spacing: 0.1,
-        },
-        &Pins::TopRow,
-        &params,
-        Affine3A::IDENTITY,
-    )
+    let cloth = ClothShape::Grid {
+        width: 6,
+        height: 6,
+        spacing: 0.1,
+    }
+    .build_solver(&Pins::TopRow, &params, Affine3A::IDENTITY)
     .unwrap();
     let env = Environment {
         gravity: Vec3::new(0.0, -gravity, 0.0),
@@ -335,16 +326,12 @@ fn seed_002_extreme(substeps: Substeps) -> (Solver, Environment) {
         substeps,
         ..conservative(Integrator::Verlet)
     };
-    let cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 4,
-            height: 4,
-            spacing: 0.05,
-        },
-        &Pins::TopCorners,
-        &params,
-        Affine3A::from_rotation_x(-1.2),
-    )
+    let cloth = ClothShape::Grid {
+        width: 4,
+        height: 4,
+        spacing: 0.05,
+    }
+    .build_solver(&Pins::TopCorners, &params, Affine3A::from_rotation_x(-1.2))
     .unwrap();
     let env = Environment {
         wind: Wind {
@@ -454,12 +441,12 @@ fn pins_follow_the_frame() {
 
 #[test]
 fn grid_topology_matches_the_seed() {
-    let cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 5,
-            height: 4,
-            spacing: 0.1,
-        },
+    let cloth = ClothShape::Grid {
+        width: 5,
+        height: 4,
+        spacing: 0.1,
+    }
+    .build_solver(
         &Pins::TopRow,
         &ClothParams {
             springs: SpringParams {
@@ -496,12 +483,12 @@ fn grid_topology_matches_the_seed() {
 
 #[test]
 fn a_pinned_cloth_at_rest_stays_at_rest_without_gravity() {
-    let mut cloth = Solver::new(
-        &ClothShape::Grid {
-            width: 6,
-            height: 6,
-            spacing: 0.1,
-        },
+    let mut cloth = ClothShape::Grid {
+        width: 6,
+        height: 6,
+        spacing: 0.1,
+    }
+    .build_solver(
         &Pins::TopCorners,
         &conservative(Integrator::Verlet),
         Affine3A::IDENTITY,
@@ -530,7 +517,7 @@ fn bad_parameters_return_their_error() {
     };
     let ok = ClothParams::default();
     let build = |shape: &ClothShape, pins: &Pins, params: &ClothParams| {
-        Solver::new(shape, pins, params, Affine3A::IDENTITY).err()
+        shape.build_solver(pins, params, Affine3A::IDENTITY).err()
     };
     let field = |e: Option<ClothError>| match e {
         Some(ClothError::InvalidParameter { field, .. }) => field,
@@ -634,7 +621,9 @@ fn bad_parameters_return_their_error() {
         })
     );
     // A running cloth refuses bad parameters and keeps its old ones.
-    let mut cloth = Solver::new(&grid, &Pins::None, &ok, Affine3A::IDENTITY).unwrap();
+    let mut cloth = grid
+        .build_solver(&Pins::None, &ok, Affine3A::IDENTITY)
+        .unwrap();
     assert!(
         cloth
             .set_params(&ClothParams {
@@ -674,14 +663,9 @@ fn hang_mesh(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Solver, f32) {
         springs: SpringParams::from_structural(50.0),
         ..ClothParams::default()
     };
-    let mut c = Solver::from_mesh(
-        positions,
-        triangles,
-        &Pins::TopRow,
-        &params,
-        Affine3A::IDENTITY,
-    )
-    .unwrap();
+    let layout = Layout::from_mesh(positions, triangles).unwrap();
+    let pins = Pins::TopRow.resolve_for(&layout).unwrap();
+    let mut c = Solver::new(layout, &pins, &params, Affine3A::IDENTITY).unwrap();
     for _ in 0..125 {
         c.step(DT, &no_wind());
     }

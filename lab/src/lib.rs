@@ -138,7 +138,7 @@ pub fn bench_cloth(model: &str, count: usize) -> Result<solver::Cloth, ClothErro
         height,
         spacing: 0.05,
     };
-    solver::Cloth::new(&shape, &BENCH_PINS, &params, Affine3A::IDENTITY)
+    shape.build_solver(&BENCH_PINS, &params, Affine3A::IDENTITY)
 }
 
 /// Steps every bench cell runs, timed or not: one simulated second of 16 ms steps. A
@@ -227,8 +227,9 @@ mod tests {
             spacing: 0.05,
         };
         let params = seed_model_params("1").unwrap();
-        let mut cloth =
-            solver::Cloth::new(&shape, &Pins::TopCorners, &params, Affine3A::IDENTITY).unwrap();
+        let mut cloth = shape
+            .build_solver(&Pins::TopCorners, &params, Affine3A::IDENTITY)
+            .unwrap();
         let (times, max_strain, failed) = timed_steps(&mut cloth, &Environment::default(), 3, 9);
         assert_eq!(times.len(), 9);
         let step = failed.expect("the corner-hung 128×128 curtain tears");

@@ -255,7 +255,7 @@ fn rest_lattice(params: &ClothParams) -> Result<solver::Cloth, ClothError> {
         height: PROBE_SIZE,
         spacing: SPACING,
     };
-    solver::Cloth::new(&shape, &Pins::None, params, Affine3A::IDENTITY)
+    shape.build_solver(&Pins::None, params, Affine3A::IDENTITY)
 }
 
 /// Measures the threshold of cloths from `make` and fills in the table row.
@@ -415,12 +415,11 @@ pub fn regime_cloth(
         height: PROBE_SIZE,
         spacing: SPACING,
     };
-    let free = |p: &ClothParams| solver::Cloth::new(&shape, &Pins::None, p, Affine3A::IDENTITY);
+    let free = |p: &ClothParams| shape.build_solver(&Pins::None, p, Affine3A::IDENTITY);
     Ok(match regime {
         Regime::Linear => (probe_cloth(params)?, quiet()),
         Regime::Hanging => {
-            let cloth =
-                solver::Cloth::new(&shape, &Pins::TopCorners, &limited, Affine3A::IDENTITY)?;
+            let cloth = shape.build_solver(&Pins::TopCorners, &limited, Affine3A::IDENTITY)?;
             let env = Environment {
                 wind: Wind {
                     strength: 0.0,
@@ -571,13 +570,8 @@ pub fn single_spring(k: f32, m: f32, integrator: Integrator) -> Result<Threshold
         ..params("mass-spring", k, m, integrator, Substeps::Fixed(1)).expect("model")
     };
     let make = || {
-        let mut cloth = solver::Cloth::from_springs(
-            &[Vec3::ZERO, Vec3::X * SPACING],
-            &[[0, 1]],
-            &Pins::Indices(vec![0]),
-            &params,
-            Affine3A::IDENTITY,
-        )?;
+        let layout = solver::Layout::from_springs(&[Vec3::ZERO, Vec3::X * SPACING], &[[0, 1]])?;
+        let mut cloth = solver::Cloth::new(layout, &[0], &params, Affine3A::IDENTITY)?;
         // Stretched along the spring by 1%.
         let p = cloth.particles_mut();
         p.position[1].x += SPACING * 0.01;

@@ -15,6 +15,7 @@ mod collide;
 mod forces;
 mod integrate;
 mod interact;
+mod layout;
 pub mod patches;
 pub mod shape_matching;
 mod state;
@@ -22,17 +23,16 @@ pub mod topology;
 
 pub use collide::{Collider, ColliderShape};
 pub use interact::Grab;
+pub use layout::{Layout, MAX_PARTICLES};
 pub use state::Particles;
 pub use topology::{SpringKind, Springs};
 
 use bevy::math::{Affine3A, Vec3};
 
 use crate::error::ClothError;
-use crate::garment::GarmentLayout;
 use crate::params::{
     ClothParams, Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams,
 };
-use crate::shape::{ClothShape, Pins};
 use patches::Patches;
 use shape_matching::ShapeMatching;
 
@@ -111,188 +111,29 @@ pub struct Cloth {
 }
 
 impl Cloth {
-    /// Builds a cloth of `shape` placed by `frame` (local → world). For
-    /// [`ClothShape::Mesh`] use [`Cloth::from_mesh`] instead; this returns an error for it.
+    /// Builds a cloth of `layout` placed by `frame` (local → world), with the particles
+    /// `pins` held where they start (indices into the layout's positions).
     pub fn new(
-        shape: &ClothShape,
-        pins: &Pins,
+        layout: Layout,
+        pins: &[u32],
         params: &ClothParams,
         frame: Affine3A,
     ) -> Result<Self, ClothError> {
-        shape.validate()?;
-        match *shape {
-            ClothShape::Grid {
-                width,
-                height,
-                spacing,
-            } => {
-                let half = (width - 1) as f32 * spacing * 0.5;
-                let local: Vec<Vec3> = (0..height)
-                    .flat_map(|j| {
-                        (0..width).map(move |i| {
-                            Vec3::new(i as f32 * spacing - half, -(j as f32) * spacing, 0.0)
-                        })
-                    })
-                    .collect();
-                let pairs = topology::grid_spring_pairs(width, height);
-                let triangles = topology::grid_triangles(width, height);
-                Self::build(
-                    local,
-                    pairs,
-                    triangles,
-                    Some((width, height)),
-                    pins,
-                    params,
-                    frame,
-                )
-            }
-            ClothShape::Mesh => Err(ClothError::BadMesh {
-                reason: "a mesh-shaped cloth is built with `Cloth::from_mesh`".into(),
-            }),
-            ClothShape::Garment { .. } => Err(ClothError::BadMesh {
-                reason: "a garment is built with `Cloth::from_garment`".into(),
-            }),
-        }
-    }
-
-    /// Builds a garment: its pieces' particles, springs and triangles, and seam springs
-    /// that sew the pieces together over `springs.sew_time` (seed 002 §1.4).
-    pub fn from_garment(
-        layout: GarmentLayout,
-        pins: &Pins,
-        params: &ClothParams,
-        frame: Affine3A,
-    ) -> Result<Self, ClothError> {
-        if layout.positions.is_empty() || layout.triangles.is_empty() {
-            return Err(ClothError::BadMesh {
-                reason: "the garment has no faces".into(),
-            });
-        }
-        let mut cloth = Self::build(
-            layout.positions,
-            layout.springs,
-            layout.triangles,
-            None,
-            pins,
-            params,
-            frame,
-        )?;
-        cloth.pieces = layout.pieces;
-        Ok(cloth)
-    }
-
-    /// Builds a cloth from a triangle mesh: vertices become particles (coincident ones
-    /// welded into one, see [`topology::weld`]), edges structural springs, and the far
-    /// corners of triangles sharing an edge bend springs. Triangles that welding
-    /// collapses are dropped.
-    pub fn from_mesh(
-        positions: &[Vec3],
-        triangles: &[[u32; 3]],
-        pins: &Pins,
-        params: &ClothParams,
-        frame: Affine3A,
-    ) -> Result<Self, ClothError> {
-        if positions.len() < 3 || triangles.is_empty() {
-            return Err(ClothError::BadMesh {
-                reason: format!(
-                    "{} vertices and {} triangles; at least 3 and 1 are needed",
-                    positions.len(),
-                    triangles.len()
-                ),
-            });
-        }
-        if positions.len() > crate::shape::MAX_PARTICLES {
-            return Err(ClothError::BadMesh {
-                reason: format!("{} vertices is more than the limit", positions.len()),
-            });
-        }
-        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-            return Err(ClothError::BadMesh {
-                reason: format!("a vertex position is not finite: {p}"),
-            });
-        }
-        if let Some(t) = triangles.iter().find(|t| {
-            t.iter().any(|&v| v as usize >= positions.len())
-                || t[0] == t[1]
-                || t[1] == t[2]
-                || t[0] == t[2]
-        }) {
-            return Err(ClothError::BadMesh {
-                reason: format!("triangle {t:?} is degenerate or indexes past the vertices"),
-            });
-        }
-        let welded = topology::weld(positions);
-        let triangles: Vec<[u32; 3]> = triangles
-            .iter()
-            .map(|t| t.map(|v| welded.particle_of[v as usize]))
-            .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-            .collect();
-        if triangles.is_empty() {
-            return Err(ClothError::BadMesh {
-                reason: "every triangle collapses when coincident vertices are welded".into(),
-            });
-        }
-        let pairs = topology::mesh_spring_pairs(&triangles);
-        Self::build(
-            welded.positions,
-            pairs,
+        layout.validate()?;
+        let Layout {
+            positions: local,
+            springs: pairs,
             triangles,
-            None,
-            pins,
-            params,
-            frame,
-        )
-    }
-
-    /// Builds a cloth from explicit structural springs between particles (ropes, single
-    /// springs, custom lattices); it has no triangles, so nothing is drawn for it.
-    pub fn from_springs(
-        positions: &[Vec3],
-        springs: &[[u32; 2]],
-        pins: &Pins,
-        params: &ClothParams,
-        frame: Affine3A,
-    ) -> Result<Self, ClothError> {
-        if let Some(p) = positions.iter().find(|p| !p.is_finite()) {
-            return Err(ClothError::BadMesh {
-                reason: format!("a particle position is not finite: {p}"),
-            });
+            grid,
+            pieces,
+        } = layout;
+        let count = local.len();
+        if let Some(&index) = pins.iter().find(|&&i| i as usize >= count) {
+            return Err(ClothError::PinOutOfRange { index, count });
         }
-        if let Some(s) = springs
-            .iter()
-            .find(|s| s[0] == s[1] || s.iter().any(|&i| i as usize >= positions.len()))
-        {
-            return Err(ClothError::BadMesh {
-                reason: format!("spring {s:?} joins a particle to itself or to none"),
-            });
-        }
-        let pairs = springs
-            .iter()
-            .map(|s| (SpringKind::Structural, s[0], s[1]))
-            .collect();
-        Self::build(
-            positions.to_vec(),
-            pairs,
-            Vec::new(),
-            None,
-            pins,
-            params,
-            frame,
-        )
-    }
-
-    fn build(
-        local: Vec<Vec3>,
-        pairs: Vec<(SpringKind, u32, u32)>,
-        triangles: Vec<[u32; 3]>,
-        grid: Option<(u32, u32)>,
-        pins: &Pins,
-        params: &ClothParams,
-        frame: Affine3A,
-    ) -> Result<Self, ClothError> {
+        let pin_indices = pins.to_vec();
         params.validate()?;
         check_model_fits(params, grid)?;
-        let pin_indices = pins.resolve(&local, grid.map(|g| g.0))?;
         let springs = Springs::from_pairs(pairs, &local);
         let (triangle_springs, spring_triangles) =
             topology::triangle_edge_springs(&triangles, &springs);
@@ -325,7 +166,11 @@ impl Cloth {
             shape_matching: None,
             patches: None,
             length_scale: 1.0,
-            pieces: vec![(String::from("cloth"), 0..n as u32)],
+            pieces: if pieces.is_empty() {
+                vec![(String::from("cloth"), 0..n as u32)]
+            } else {
+                pieces
+            },
             seam_start: Vec::new(),
             colliders: Vec::new(),
         };

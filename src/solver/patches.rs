@@ -18,10 +18,9 @@
 
 use bevy::math::{Affine3A, Vec3};
 
-use super::{Cloth, topology};
+use super::{Cloth, Layout, topology};
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model, PatchParams, PatchTargets, Substeps};
-use crate::shape::Pins;
 
 /// A pin's hold on its part: the part's centre stays `length` from the pin.
 #[derive(Clone, Copy, Debug)]
@@ -197,12 +196,15 @@ impl Patches {
         pinned_parts.sort_unstable();
         pinned_parts.dedup();
         let pairs = topology::grid_spring_pairs(nx, ny);
-        let mut parts = Cloth::build(
-            centres,
-            pairs,
-            Vec::new(),
-            Some((nx, ny)),
-            &Pins::Indices(pinned_parts),
+        let lattice = Layout {
+            positions: centres,
+            springs: pairs,
+            grid: Some((nx, ny)),
+            ..Layout::default()
+        };
+        let mut parts = Cloth::new(
+            lattice,
+            &pinned_parts,
             &lattice_params(params, patch, 1),
             frame,
         )?;
