@@ -101,14 +101,14 @@ impl Cloth {
     /// the current positions.
     fn goal_forces(&mut self, sm: &ShapeMatchingParams) {
         let force_update = sm.update == GoalUpdate::Force;
-        if force_update && let Some(state) = &mut self.shape_matching {
+        if force_update && let Some(state) = self.model.shape_matching_mut() {
             state.compute_goals(&self.particles.position, &self.particles.mass, sm);
         }
         let p = &mut self.particles;
         for i in 0..p.position.len() {
             p.force[i] -= sm.damping * p.velocity[i];
         }
-        let (Some(state), true) = (&self.shape_matching, force_update) else {
+        let (Some(state), true) = (self.model.shape_matching(), force_update) else {
             return;
         };
         let (l, exponent) = (self.length_scale, sm.exponent);
@@ -141,7 +141,7 @@ impl Cloth {
     /// the target (damping the absolute velocity would be a drag the lattice never
     /// feels). With tiles the particles sit on their targets: no pull at all.
     fn pull_forces(&mut self, env: &Environment, patch: &PatchParams) {
-        let Some(patches) = &mut self.patches else {
+        let Some(patches) = self.model.patches_mut() else {
             return;
         };
         patches.parts.accumulate_forces(env);

@@ -7,7 +7,7 @@ impl Cloth {
     /// Advances every free particle by one substep `h` from its accumulated force.
     pub fn integrate(&mut self) {
         let h = self.h;
-        if let Some(patches) = &mut self.patches {
+        if let Some(patches) = self.model.patches_mut() {
             // The part lattice takes its whole substep first, held by the pins at their
             // place at the end of this substep; particles follow.
             patches.parts.integrate();
@@ -66,7 +66,9 @@ impl Cloth {
     /// positions), and its velocity takes the same change over `h`. Nothing for the other
     /// models.
     pub fn fit_targets(&mut self) {
-        if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
+        if let (Model::Patches(patch), Some(patches)) =
+            (self.params.model, self.model.patches_mut())
+        {
             let p = &mut self.particles;
             let h = self.h;
             if patch.tiles {
@@ -93,7 +95,8 @@ impl Cloth {
             }
             return;
         }
-        let (Model::ShapeMatching(sm), Some(state)) = (self.params.model, &mut self.shape_matching)
+        let (Model::ShapeMatching(sm), Some(state)) =
+            (self.params.model, self.model.shape_matching_mut())
         else {
             return;
         };

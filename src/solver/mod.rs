@@ -95,10 +95,8 @@ pub struct Cloth {
     torn_this_step: Vec<u32>,
     torn_count: usize,
     grab: Option<Grab>,
-    /// Clusters and goals while the model is shape matching.
-    shape_matching: Option<ShapeMatching>,
-    /// The part lattice and targets while the model is the patch model.
-    patches: Option<Patches>,
+    /// The active model's own state (built lazily by the step).
+    model: ModelState,
     /// The cloth's characteristic length L (mean structural rest length), for the
     /// shape-matching force law.
     length_scale: f32,
@@ -108,6 +106,46 @@ pub struct Cloth {
     seam_start: Vec<f32>,
     /// Colliders in world space the particles are kept out of (see `collide.rs`).
     colliders: Vec<Collider>,
+}
+
+/// The active model's own state: none for mass-spring (or before the first step
+/// builds it), the clusters and goals of shape matching, or the part lattice and
+/// targets of the patch model. One at a time, by construction.
+#[derive(Clone, Debug)]
+enum ModelState {
+    None,
+    ShapeMatching(ShapeMatching),
+    Patches(Box<Patches>),
+}
+
+impl ModelState {
+    fn shape_matching(&self) -> Option<&ShapeMatching> {
+        match self {
+            ModelState::ShapeMatching(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    fn shape_matching_mut(&mut self) -> Option<&mut ShapeMatching> {
+        match self {
+            ModelState::ShapeMatching(s) => Some(s),
+            _ => None,
+        }
+    }
+
+    fn patches(&self) -> Option<&Patches> {
+        match self {
+            ModelState::Patches(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    fn patches_mut(&mut self) -> Option<&mut Patches> {
+        match self {
+            ModelState::Patches(p) => Some(p),
+            _ => None,
+        }
+    }
 }
 
 impl Cloth {
@@ -163,8 +201,7 @@ impl Cloth {
             auto_cache: None,
             torn_count: 0,
             grab: None,
-            shape_matching: None,
-            patches: None,
+            model: ModelState::None,
             length_scale: 1.0,
             pieces: if pieces.is_empty() {
                 vec![(String::from("cloth"), 0..n as u32)]
@@ -191,10 +228,12 @@ impl Cloth {
     /// every spring whole and the clock at zero.
     pub fn reset(&mut self) {
         self.grab = None;
-        if let Some(sm) = &mut self.shape_matching {
-            sm.reset();
+        match &mut self.model {
+            ModelState::ShapeMatching(sm) => sm.reset(),
+            // Rebuilt from the rest state by the next step.
+            ModelState::Patches(_) => self.model = ModelState::None,
+            ModelState::None => {}
         }
-        self.patches = None; // rebuilt from the rest state by the next step
         let mass = self.params.node_mass;
         let p = &mut self.particles;
         for (i, local) in self.local_rest.iter().enumerate() {
@@ -290,7 +329,9 @@ impl Cloth {
         let auto = matches!(self.params.substeps, crate::params::Substeps::Auto { .. });
         self.prepare_model(auto && self.state_dependent_stiffness());
         self.sew();
-        if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
+        if let (Model::Patches(patch), Some(patches)) =
+            (self.params.model, self.model.patches_mut())
+        {
             // The lattice gets this step's parameters before its substeps are chosen.
             patches.set_params(&self.params, &patch, 1);
             patches.refresh_lattice_substeps(dt);
@@ -323,7 +364,9 @@ impl Cloth {
             self.rescale_verlet_velocity(self.h / self.last_h);
         }
         self.last_h = self.h;
-        if let (Model::Patches(patch), Some(patches)) = (self.params.model, &mut self.patches) {
+        if let (Model::Patches(patch), Some(patches)) =
+            (self.params.model, self.model.patches_mut())
+        {
             patches.set_params(&self.params, &patch, n);
             patches.parts.set_frame(self.frame);
             // The part centres meet the colliders too: otherwise the targets sink into a
@@ -372,7 +415,7 @@ impl Cloth {
     /// Finishes a step: springs stretched past the tear ratio break and hide the faces
     /// they border (seed 000 §3.2). Returns the springs torn in this step.
     pub fn end_step(&mut self) -> &[u32] {
-        if let Some(patches) = &mut self.patches {
+        if let Some(patches) = self.model.patches_mut() {
             // A torn part spring splits the cloth between its two parts: hide the faces
             // that straddle them (on tear events only).
             patches.parts.end_step();
@@ -443,9 +486,11 @@ impl Cloth {
     /// rate by `γ ≤ max_i (2·Σ_j c_ij + c_drag) / m_i`. A safety factor of 0.8 on the
     /// right-hand side covers the geometric stiffness of stretched springs.
     pub fn stable_substeps(&self, dt: f32) -> u32 {
-        let (omega2, gamma) = match (&self.params.model, &self.shape_matching, &self.patches) {
-            (Model::ShapeMatching(sm), Some(state), _) => self.goal_frequency(sm, state),
-            (Model::Patches(patch), _, Some(patches)) => {
+        let (omega2, gamma) = match (&self.params.model, &self.model) {
+            (Model::ShapeMatching(sm), ModelState::ShapeMatching(state)) => {
+                self.goal_frequency(sm, state)
+            }
+            (Model::Patches(patch), ModelState::Patches(patches)) => {
                 let lattice = patches.lattice_substeps(dt);
                 if patch.tiles {
                     return lattice; // no pull to resolve
@@ -568,45 +613,42 @@ impl Cloth {
     fn prepare_model(&mut self, compute: bool) {
         match self.params.model {
             Model::ShapeMatching(sm) => {
-                self.patches = None;
                 let k = sm.clusters;
-                let built = self
-                    .shape_matching
-                    .as_ref()
-                    .is_none_or(|s| s.built_for != k);
+                let built = self.model.shape_matching().is_none_or(|s| s.built_for != k);
                 if built {
-                    self.shape_matching = Some(ShapeMatching::new(
+                    self.model = ModelState::ShapeMatching(ShapeMatching::new(
                         &self.local_rest,
                         &self.particles.mass,
                         self.grid,
                         k,
                     ));
                 }
-                if let Some(state) = &mut self.shape_matching
+                if let Some(state) = self.model.shape_matching_mut()
                     && (compute || built)
                 {
                     state.compute_goals(&self.particles.position, &self.particles.mass, &sm);
                 }
             }
             Model::Patches(patch) => {
-                self.shape_matching = None;
                 let size = (patch.part_width, patch.part_height, patch.targets);
-                let built = self.patches.as_ref().is_none_or(|p| p.built_for != size);
-                if built && let Some(grid) = self.grid {
-                    self.patches = Patches::new(
-                        &self.local_rest,
-                        grid,
-                        &self.pins,
-                        &self.params,
-                        &patch,
-                        self.frame,
-                    )
-                    .ok();
-                    if let Some(patches) = &mut self.patches {
+                let built = self.model.patches().is_none_or(|p| p.built_for != size);
+                if built {
+                    self.model = ModelState::None;
+                    if let Some(grid) = self.grid
+                        && let Ok(mut patches) = Patches::new(
+                            &self.local_rest,
+                            grid,
+                            &self.pins,
+                            &self.params,
+                            &patch,
+                            self.frame,
+                        )
+                    {
                         patches.adopt_state(&self.particles);
+                        self.model = ModelState::Patches(Box::new(patches));
                     }
                 }
-                if let Some(patches) = &mut self.patches {
+                if let Some(patches) = self.model.patches_mut() {
                     // A grabbed particle drags its part along (particles only follow parts).
                     match self.grab {
                         Some(g) => {
@@ -625,26 +667,23 @@ impl Cloth {
                     }
                 }
             }
-            Model::MassSpring => {
-                self.shape_matching = None;
-                self.patches = None;
-            }
+            Model::MassSpring => self.model = ModelState::None,
         }
     }
 
     /// The patch model's state (part lattice and targets), if that is the model.
     pub fn patches(&self) -> Option<&Patches> {
-        self.patches.as_ref()
+        self.model.patches()
     }
 
     /// The shape-matching goals (after the last goal computation), if that is the model.
     pub fn goals(&self) -> Option<&[Vec3]> {
-        self.shape_matching.as_ref().map(|s| &s.goals[..])
+        self.model.shape_matching().map(|s| &s.goals[..])
     }
 
     /// The shape-matching state, if that is the model.
     pub fn shape_matching(&self) -> Option<&ShapeMatching> {
-        self.shape_matching.as_ref()
+        self.model.shape_matching()
     }
 
     /// Computes the shape-matching goals of the current positions now (outside a step).
@@ -738,7 +777,7 @@ impl Cloth {
 
     /// Number of springs that still act (whole and of an enabled family).
     pub fn spring_count(&self) -> usize {
-        if let Some(patches) = &self.patches {
+        if let Some(patches) = self.model.patches() {
             return patches.spring_count();
         }
         SpringKind::ALL
@@ -755,7 +794,7 @@ impl Cloth {
 
     /// Number of springs torn since the last reset.
     pub fn torn_count(&self) -> usize {
-        self.torn_count + self.patches.as_ref().map_or(0, Patches::torn_count)
+        self.torn_count + self.model.patches().map_or(0, Patches::torn_count)
     }
 
     /// Simulated time since the last reset, in s.
