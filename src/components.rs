@@ -101,9 +101,7 @@ impl Cloth {
                     warn!("{warning}");
                 }
                 if layout.positions.is_empty() || layout.triangles.is_empty() {
-                    return Err(ClothError::BadMesh {
-                        reason: "the garment has no faces".into(),
-                    });
+                    return Err(ClothError::EmptyGarment);
                 }
                 let layout = layout.into_layout();
                 let pins = self.pins.resolve_for(&layout)?;

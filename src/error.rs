@@ -47,6 +47,45 @@ pub enum ClothError {
         /// What is missing.
         reason: String,
     },
+    /// A layout (particles, springs, triangles, pieces) the solver cannot build from.
+    #[error("the layout cannot be a cloth: {reason}")]
+    BadLayout {
+        /// What is wrong.
+        reason: String,
+    },
+    /// A model that needs a grid (the patch model: its parts are blocks of rows and
+    /// columns) was given a cloth without one.
+    #[error("the {model} model needs a grid cloth")]
+    ModelNeedsGrid {
+        /// The model.
+        model: &'static str,
+    },
+    /// A shape that is laid out from data it does not hold itself (a mesh from the
+    /// entity's `Mesh3d`, a garment from its file) was asked for its layout directly.
+    #[error("a {shape} cloth is laid out from its {source_of}")]
+    ShapeNeedsSource {
+        /// The shape.
+        shape: &'static str,
+        /// Where its layout comes from.
+        source_of: &'static str,
+    },
+    /// A garment whose patterns give no faces.
+    #[error("the garment has no faces")]
+    EmptyGarment,
+    /// A model name that is none of the known ones.
+    #[error("no model `{name}`; known: {known}")]
+    UnknownModel {
+        /// The name given.
+        name: String,
+        /// The names that exist.
+        known: &'static str,
+    },
+    /// A measurement asked of a case it cannot measure (the lab's instruments).
+    #[error("cannot measure: {reason}")]
+    NotMeasurable {
+        /// Why.
+        reason: String,
+    },
     /// A pattern file is malformed (names the file, line and column).
     #[error("{0}")]
     Pattern(#[from] crate::pattern::PatternError),

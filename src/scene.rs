@@ -395,7 +395,15 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         InvalidParameter { field, .. } => field,
         GridTooSmall { .. } | GridTooLarge { .. } => "shape",
         PinOutOfRange { .. } => "pins",
-        BadMesh { .. } | Pattern(_) | Garment { .. } => "shape",
+        BadMesh { .. }
+        | BadLayout { .. }
+        | ModelNeedsGrid { .. }
+        | ShapeNeedsSource { .. }
+        | EmptyGarment
+        | Pattern(_)
+        | Garment { .. } => "shape",
+        UnknownModel { .. } => "model",
+        NotMeasurable { .. } => "cloths",
     }
 }
 

@@ -75,12 +75,13 @@ impl ClothShape {
                     pieces: Vec::new(),
                 })
             }
-            ClothShape::Mesh => Err(ClothError::BadMesh {
-                reason: "a mesh-shaped cloth is laid out from its mesh (`Layout::from_mesh`)"
-                    .into(),
+            ClothShape::Mesh => Err(ClothError::ShapeNeedsSource {
+                shape: "mesh-shaped",
+                source_of: "mesh (`Layout::from_mesh`)",
             }),
-            ClothShape::Garment { .. } => Err(ClothError::BadMesh {
-                reason: "a garment is laid out from its file (`GarmentLayout`)".into(),
+            ClothShape::Garment { .. } => Err(ClothError::ShapeNeedsSource {
+                shape: "garment",
+                source_of: "garment file (`GarmentLayout`)",
             }),
         }
     }

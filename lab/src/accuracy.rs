@@ -163,11 +163,14 @@ impl Case {
         index: usize,
         seconds: f32,
     ) -> Result<Self, ClothError> {
-        let cloth = scene.cloths.get(index).ok_or_else(|| ClothError::BadMesh {
-            reason: format!("the scene has no cloth {index}"),
-        })?;
+        let cloth = scene
+            .cloths
+            .get(index)
+            .ok_or_else(|| ClothError::NotMeasurable {
+                reason: format!("the scene has no cloth {index}"),
+            })?;
         if cloth.cloth.params.model != Model::MassSpring {
-            return Err(ClothError::BadMesh {
+            return Err(ClothError::NotMeasurable {
                 reason: format!("cloth {index} is the reference: it must be mass-spring"),
             });
         }

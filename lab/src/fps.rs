@@ -62,8 +62,9 @@ pub fn app_frame(
     warmup: usize,
     frames: usize,
 ) -> Result<AppFrame, ClothError> {
-    let params = seed_model_params(model).ok_or_else(|| ClothError::BadMesh {
-        reason: format!("no model `{model}` (1, 2, 3a, 3b, 3c)"),
+    let params = seed_model_params(model).ok_or_else(|| ClothError::UnknownModel {
+        name: model.to_string(),
+        known: "1, 2, 3a, 3b, 3c",
     })?;
     let (width, height) = grid_for(count);
     let mut app = headless_app();
@@ -94,7 +95,7 @@ pub fn app_frame(
     if app.world().get::<Mesh3d>(entity).is_none()
         || app.world().get::<ClothSimulation>(entity).is_none()
     {
-        return Err(ClothError::BadMesh {
+        return Err(ClothError::NotMeasurable {
             reason: "the plugin made no mesh for the cloth".into(),
         });
     }

@@ -129,8 +129,9 @@ pub const BENCH_PINS: Pins = Pins::TopRow;
 
 /// The timing table's curtain (see [`BENCH_PINS`]).
 pub fn bench_cloth(model: &str, count: usize) -> Result<solver::Cloth, ClothError> {
-    let params = seed_model_params(model).ok_or_else(|| ClothError::BadMesh {
-        reason: format!("no model `{model}` (1, 2, 3a, 3b, 3c)"),
+    let params = seed_model_params(model).ok_or_else(|| ClothError::UnknownModel {
+        name: model.to_string(),
+        known: "1, 2, 3a, 3b, 3c",
     })?;
     let (width, height) = grid_for(count);
     let shape = ClothShape::Grid {

@@ -326,9 +326,11 @@ pub fn cell(
     } else {
         Substeps::Fixed(1)
     };
-    let params = params(model, k, m, integrator, substeps).ok_or_else(|| ClothError::BadMesh {
-        reason: format!("no model `{model}`"),
-    })?;
+    let params =
+        params(model, k, m, integrator, substeps).ok_or_else(|| ClothError::UnknownModel {
+            name: model.to_string(),
+            known: "the stability map's models (stability::MODELS, NONLINEAR_MODELS)",
+        })?;
     let (mut cloth, env) = regime_cloth(regime, &params)?;
     let steps = ((1.0 / dt).ceil() as usize).max(30);
     let (failure, under_resolved) = run_probe(&mut cloth, &env, dt, steps);
@@ -522,7 +524,7 @@ pub fn measured_threshold(
     let fails = |dt: f32, cloth: &mut solver::Cloth| probe(cloth, dt, steps).is_some();
     let (mut lo, mut hi) = (guess * 0.25, guess * 4.0);
     if fails(lo, &mut make()?) || !fails(hi, &mut make()?) {
-        return Err(ClothError::BadMesh {
+        return Err(ClothError::NotMeasurable {
             reason: format!("no threshold between {lo} and {hi} s"),
         });
     }

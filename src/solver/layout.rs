@@ -94,7 +94,7 @@ impl Layout {
     pub fn validate(&self) -> Result<(), ClothError> {
         let n = self.positions.len();
         if n == 0 {
-            return Err(ClothError::BadMesh {
+            return Err(ClothError::BadLayout {
                 reason: "the cloth has no particles".into(),
             });
         }
@@ -105,7 +105,7 @@ impl Layout {
             .iter()
             .find(|&&(_, a, b)| a == b || !exists(a) || !exists(b))
         {
-            return Err(ClothError::BadMesh {
+            return Err(ClothError::BadLayout {
                 reason: format!("{kind:?} spring [{a}, {b}] joins a particle to itself or to none"),
             });
         }
@@ -114,19 +114,19 @@ impl Layout {
             .iter()
             .find(|t| !t.iter().all(|&v| exists(v)) || t[0] == t[1] || t[1] == t[2] || t[0] == t[2])
         {
-            return Err(ClothError::BadMesh {
+            return Err(ClothError::BadLayout {
                 reason: format!("triangle {t:?} is degenerate or indexes past the particles"),
             });
         }
         if let Some((w, h)) = self.grid
             && w as usize * h as usize != n
         {
-            return Err(ClothError::BadMesh {
+            return Err(ClothError::BadLayout {
                 reason: format!("a {w}×{h} grid of {n} particles"),
             });
         }
         if let Some((name, range)) = self.pieces.iter().find(|(_, r)| r.end as usize > n) {
-            return Err(ClothError::BadMesh {
+            return Err(ClothError::BadLayout {
                 reason: format!("piece {name} ends at particle {} of {n}", range.end),
             });
         }

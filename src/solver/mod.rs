@@ -923,9 +923,7 @@ fn family_stiffness(springs: &crate::params::SpringParams, kind: SpringKind) -> 
 /// The patch model needs a grid cloth (its parts are blocks of rows and columns).
 fn check_model_fits(params: &ClothParams, grid: Option<(u32, u32)>) -> Result<(), ClothError> {
     if matches!(params.model, Model::Patches(_)) && grid.is_none() {
-        return Err(ClothError::BadMesh {
-            reason: "the patch model needs a grid cloth".into(),
-        });
+        return Err(ClothError::ModelNeedsGrid { model: "patch" });
     }
     Ok(())
 }
