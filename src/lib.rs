@@ -59,7 +59,7 @@ pub mod prelude {
         ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
         RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
     };
-    pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSystems};
+    pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};
     pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError};
     pub use crate::shape::{ClothShape, Pins};
 }

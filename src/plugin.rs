@@ -4,7 +4,7 @@
 //! ```text
 //! ClothSystems::Prepare      build / rebuild cloths, apply edited parameters, move pins
 //! ClothSystems::Substeps     run the ClothSubstep schedule N times, which holds
-//!     ClothSystems::AccumulateForces → Integrate → FitTargets → Constrain
+//!     ClothSubstepSystems::AccumulateForces → Integrate → FitTargets → Constrain
 //! ClothSystems::Finish       tearing (ClothTorn messages), step timing
 //! ```
 //! and in `PostUpdate`, once per frame after the fixed loop, `ClothSystems::WriteMesh`
@@ -12,7 +12,7 @@
 //!
 //! A substep schedule (as avian's `SubstepSchedule`) makes each phase a real system set
 //! that runs every substep, so a game can add its own forces in a system ordered
-//! `.after(ClothSystems::AccumulateForces).before(ClothSystems::Integrate)` in
+//! `.after(ClothSubstepSystems::AccumulateForces).before(ClothSubstepSystems::Integrate)` in
 //! [`ClothSubstep`]. Each phase runs over all cloths in parallel.
 
 use std::time::{Duration, Instant};
@@ -36,25 +36,33 @@ use crate::params::{
 use crate::shape::{ClothShape, Pins};
 use crate::solver::{self, Layout};
 
-/// The ordered system sets of the cloth simulation.
+/// The ordered system sets of the cloth simulation in the plugin's schedule (and, for
+/// [`ClothSystems::WriteMesh`], `PostUpdate`).
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ClothSystems {
     /// Build new cloths, rebuild changed ones, apply parameter edits, move pins.
     Prepare,
     /// Run the [`ClothSubstep`] schedule as many times as the cloths need.
     Substeps,
-    /// (In [`ClothSubstep`]) forces from the old state: gravity, wind, drag, springs.
-    AccumulateForces,
-    /// (In [`ClothSubstep`]) advance positions by one substep.
-    Integrate,
-    /// (In [`ClothSubstep`]) move particles toward model targets (shape matching, patches).
-    FitTargets,
-    /// (In [`ClothSubstep`]) pins and strain limiting.
-    Constrain,
     /// Tear over-stretched springs and report them; record step time.
     Finish,
     /// (In `PostUpdate`) write positions and normals into the meshes.
     WriteMesh,
+}
+
+/// The ordered system sets of one substep, in the [`ClothSubstep`] schedule only (a
+/// system put in them in another schedule would never run with the cloth's substeps,
+/// so they are a type of their own).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ClothSubstepSystems {
+    /// Forces from the old state: gravity, wind, drag, springs.
+    AccumulateForces,
+    /// Advance positions by one substep.
+    Integrate,
+    /// Move particles toward model targets (shape matching, patches).
+    FitTargets,
+    /// Pins and strain limiting.
+    Constrain,
 }
 
 /// The schedule run once per substep inside [`ClothSystems::Substeps`].
@@ -150,18 +158,18 @@ impl Plugin for ClothPlugin {
         substep.set_executor(SingleThreadedExecutor::new());
         substep.configure_sets(
             (
-                ClothSystems::AccumulateForces,
-                ClothSystems::Integrate,
-                ClothSystems::FitTargets,
-                ClothSystems::Constrain,
+                ClothSubstepSystems::AccumulateForces,
+                ClothSubstepSystems::Integrate,
+                ClothSubstepSystems::FitTargets,
+                ClothSubstepSystems::Constrain,
             )
                 .chain(),
         );
         substep.add_systems((
-            accumulate_forces.in_set(ClothSystems::AccumulateForces),
-            integrate.in_set(ClothSystems::Integrate),
-            fit_targets.in_set(ClothSystems::FitTargets),
-            constrain.in_set(ClothSystems::Constrain),
+            accumulate_forces.in_set(ClothSubstepSystems::AccumulateForces),
+            integrate.in_set(ClothSubstepSystems::Integrate),
+            fit_targets.in_set(ClothSubstepSystems::FitTargets),
+            constrain.in_set(ClothSubstepSystems::Constrain),
         ));
         app.add_schedule(substep);
 

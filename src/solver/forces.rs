@@ -161,7 +161,7 @@ impl Cloth {
 
     /// Adds an external force (N) to particle `i` for the current substep. Call it between
     /// `accumulate_forces` and `integrate` (in the plugin: after
-    /// `ClothSystems::AccumulateForces`, before `ClothSystems::Integrate`).
+    /// `ClothSubstepSystems::AccumulateForces`, before `ClothSubstepSystems::Integrate`).
     pub fn add_force(&mut self, i: usize, force: bevy::math::Vec3) {
         if let Some(f) = self.particles.force.get_mut(i) {
             *f += force;
