@@ -1,25 +1,19 @@
-//! `cloth`: the headless command line.
+//! `cloth`: the headless command line (`cloth --help`, `cloth <verb> --help`).
 //!
-//! ```text
-//! cloth run SCENE [--steps N] [--model mass-spring|shape-matching|patches]
-//!                 [--set key=value]... [--dump FILE.json|.csv|.obj] [--every K]
-//! cloth bench [--max PARTICLES] [--models 1,2,3a,3b,3c] [--repeats N] [--app]
-//!             [--app-models 1,3b] [--json] [--chart FILE.png]
-//! cloth accuracy [--scenes curtain,curtain-wind,card] [--seconds S] [--repeats N] [--json]
-//!                [--chart FILE.png]
-//! cloth stability [--models mass-spring,shape-matching,patches] [--json] [--chart FILE.png]
-//! ```
-//! `run` prints a JSON summary on stdout; `bench` prints seed 000's timing table (Slika
-//! 23) beside ours and, with `--app`, seed 002's frame rates beside the full app's;
-//! `accuracy` and `stability` print their tables. `--chart` draws the chart to a PNG and
-//! an SVG beside it. Bad input exits with code 2 and a one-line message naming the file,
-//! line and field; nothing panics on user input.
+//! `run` prints a JSON summary on stdout and dumps positions on request; `bench` prints
+//! seed 000's timing table (Slika 23) beside ours and, with `--app`, seed 002's frame
+//! rates beside the full app's; `accuracy` and `stability` print their tables. `--chart`
+//! draws the chart to a PNG and an SVG beside it. Bad input exits with code 2 and a
+//! one-line message naming the file, line and field; nothing panics on user input.
 
 mod charts;
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
 
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver;
@@ -30,24 +24,140 @@ use bevy_cloth_lab::stability::{
 };
 use bevy_cloth_lab::{self as measure, BenchCell, SEED_COUNTS, SEED_MODELS, SceneRun};
 
-const USAGE: &str = "usage: cloth run SCENE [--steps N] [--model mass-spring|shape-matching|patches] [--set key=value]... [--dump FILE.json|.csv|.obj] [--every K]
-       cloth bench [--max PARTICLES] [--models 1,2,3a,3b,3c] [--repeats N] [--app] [--app-models 1,3b] [--json] [--chart FILE.png]
-       cloth accuracy [--scenes curtain,curtain-wind,card] [--seconds S] [--json] [--chart FILE.png]
-       cloth stability [--models mass-spring,shape-matching,patches] [--json] [--chart FILE.png]";
+/// Headless runs and measurements of bevy_cloth.
+#[derive(Parser)]
+#[command(
+    name = "cloth",
+    about = "Headless runs and measurements of bevy_cloth (bad input: exit code 2, one line)"
+)]
+struct Cli {
+    #[command(subcommand)]
+    verb: Verb,
+}
+
+#[derive(Subcommand)]
+enum Verb {
+    /// Runs a scene headless: a JSON summary on stdout, positions dumped on request.
+    Run(RunArgs),
+    /// Seed 000's timing table (Slika 23) beside ours; with --app, seed 002's frame rates.
+    Bench(BenchArgs),
+    /// Speed against accuracy, against a converged reference.
+    Accuracy(AccuracyArgs),
+    /// Where each method fails: the linear and the nonlinear stability maps.
+    Stability(StabilityArgs),
+}
+
+#[derive(Args)]
+struct RunArgs {
+    /// The scene file (RON).
+    scene: String,
+    /// Steps to run.
+    #[arg(long, default_value_t = 300)]
+    steps: usize,
+    /// Replaces every cloth's model.
+    #[arg(long, value_enum)]
+    model: Option<ModelArg>,
+    /// Overrides a scene field, e.g. `environment.wind.strength=0` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Writes positions to FILE.json, FILE.csv or FILE_<step>.obj.
+    #[arg(long, value_name = "FILE", value_parser = dump_path)]
+    dump: Option<PathBuf>,
+    /// Dumps every K steps.
+    #[arg(long, value_name = "K", default_value_t = 10, value_parser = at_least_one)]
+    every: usize,
+}
+
+/// A model name on the command line.
+#[derive(Clone, Copy, ValueEnum)]
+enum ModelArg {
+    MassSpring,
+    ShapeMatching,
+    Patches,
+}
+
+/// What every measuring verb can write besides its tables.
+#[derive(Args)]
+struct Output {
+    /// Prints JSON instead of tables.
+    #[arg(long)]
+    json: bool,
+    /// Draws the chart to FILE.png (and an SVG beside it).
+    #[arg(long, value_name = "FILE.png", value_parser = chart_path)]
+    chart: Option<PathBuf>,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// The largest particle count.
+    #[arg(long, default_value_t = 65_536)]
+    max: usize,
+    /// Slika 23's models, comma separated (all when absent).
+    #[arg(long, value_delimiter = ',', value_parser = seed_model)]
+    models: Vec<&'static str>,
+    /// Timed steps per cell (5 from 16,384 particles up).
+    #[arg(long, default_value_t = 15, value_parser = at_least_one)]
+    repeats: usize,
+    /// Also runs seed 002's experiment with the full app.
+    #[arg(long)]
+    app: bool,
+    /// The models of the full-app experiment (implies --app; all when absent).
+    #[arg(long = "app-models", value_delimiter = ',', value_parser = seed_model)]
+    app_models: Vec<&'static str>,
+    #[command(flatten)]
+    output: Output,
+}
+
+#[derive(Args)]
+struct AccuracyArgs {
+    /// The scenes, comma separated: curtain, curtain-wind, card (all when absent).
+    #[arg(long, value_delimiter = ',', value_parser = accuracy_scene)]
+    scenes: Vec<&'static str>,
+    /// Simulated seconds per run.
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true, value_parser = positive)]
+    seconds: f32,
+    /// Timed runs per configuration.
+    #[arg(long, default_value_t = 5, value_parser = at_least_one)]
+    repeats: usize,
+    #[command(flatten)]
+    output: Output,
+}
+
+#[derive(Args)]
+struct StabilityArgs {
+    /// The models, comma separated (all when absent).
+    #[arg(long, value_delimiter = ',', value_parser = stability_model)]
+    models: Vec<&'static str>,
+    #[command(flatten)]
+    output: Output,
+}
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let result = match args.first().map(String::as_str) {
-        Some("run") => run(&args[1..]),
-        Some("bench") => bench(&args[1..]),
-        Some("accuracy") => accuracy(&args[1..]),
-        Some("stability") => stability(&args[1..]),
-        Some("-h" | "--help") => {
-            println!("{USAGE}");
-            Ok(())
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version
+            let _ = e.print();
+            return ExitCode::SUCCESS;
         }
-        Some(other) => Err(format!("unknown command `{other}`\n{USAGE}")),
-        None => Err(USAGE.to_string()),
+        Err(e) => {
+            // One line naming the problem, as for every other bad input.
+            // (clap's message up to its usage block, folded onto one line).
+            let text = e.render().to_string();
+            let line: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.is_empty() && !l.starts_with("Usage:"))
+                .collect();
+            eprintln!("error: {}", line.join(" ").trim_start_matches("error: "));
+            return ExitCode::from(2);
+        }
+    };
+    let result = match cli.verb {
+        Verb::Run(args) => run(args),
+        Verb::Bench(args) => bench(args),
+        Verb::Accuracy(args) => accuracy(args),
+        Verb::Stability(args) => stability(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -58,96 +168,97 @@ fn main() -> ExitCode {
     }
 }
 
-/// Splits `--flag value` options; `positional` collects the rest.
-struct Options {
-    pairs: Vec<(String, String)>,
-    switches: Vec<String>,
-    positional: Vec<String>,
-}
-
-fn options(args: &[String], with_value: &[&str], switches: &[&str]) -> Result<Options, String> {
-    let mut out = Options {
-        pairs: Vec::new(),
-        switches: Vec::new(),
-        positional: Vec::new(),
-    };
-    let mut it = args.iter();
-    while let Some(arg) = it.next() {
-        if with_value.contains(&arg.as_str()) {
-            let value = it.next().ok_or_else(|| format!("{arg} needs a value"))?;
-            out.pairs.push((arg.clone(), value.clone()));
-        } else if switches.contains(&arg.as_str()) {
-            out.switches.push(arg.clone());
-        } else if arg.starts_with("--") {
-            return Err(format!("unknown option `{arg}`\n{USAGE}"));
-        } else {
-            out.positional.push(arg.clone());
-        }
-    }
-    Ok(out)
-}
-
-impl Options {
-    fn switch(&self, flag: &str) -> bool {
-        self.switches.iter().any(|s| s == flag)
-    }
-
-    fn get(&self, flag: &str) -> Option<&str> {
-        self.pairs
-            .iter()
-            .rev()
-            .find(|(f, _)| f == flag)
-            .map(|(_, v)| v.as_str())
-    }
-
-    fn number<T: std::str::FromStr>(&self, flag: &str, default: T) -> Result<T, String> {
-        match self.get(flag) {
-            None => Ok(default),
-            Some(v) => v
-                .parse()
-                .map_err(|_| format!("{flag}: `{v}` is not a whole number")),
-        }
+fn at_least_one(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!("`{text}` is not a whole number of at least 1")),
     }
 }
 
-fn run(args: &[String]) -> Result<(), String> {
-    let opts = options(
-        args,
-        &["--steps", "--model", "--set", "--dump", "--every"],
-        &[],
-    )?;
-    let [scene_path] = &opts.positional[..] else {
-        return Err(format!("run needs one scene file\n{USAGE}"));
-    };
+fn positive(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|x| *x > 0.0 && x.is_finite())
+        .ok_or_else(|| format!("`{text}` is not a positive number"))
+}
+
+/// One of `known`, or an error naming the known ones.
+fn one_of(text: &str, known: &[&'static str], what: &str) -> Result<&'static str, String> {
+    known
+        .iter()
+        .find(|k| **k == text)
+        .copied()
+        .ok_or_else(|| format!("no {what} `{text}` ({})", known.join(", ")))
+}
+
+fn seed_model(text: &str) -> Result<&'static str, String> {
+    one_of(text, &SEED_MODELS, "model")
+}
+
+fn stability_model(text: &str) -> Result<&'static str, String> {
+    one_of(text, &MODELS, "model")
+}
+
+fn accuracy_scene(text: &str) -> Result<&'static str, String> {
+    one_of(text, &ACCURACY_SCENES, "scene")
+}
+
+fn chart_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    charts::check_path(&path)?;
+    Ok(path)
+}
+
+fn dump_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    DumpKind::of(&path)?;
+    Ok(path)
+}
+
+/// The models asked for, or all of `known` when none were.
+fn or_all(asked: Vec<&'static str>, known: &[&'static str]) -> Vec<&'static str> {
+    if asked.is_empty() {
+        known.to_vec()
+    } else {
+        asked
+    }
+}
+
+/// A progress bar on stderr for a long verb, counting `unit`s (drawn only on a terminal;
+/// the verb's own summary lines go through [`ProgressBar::suspend`], so they are printed
+/// either way).
+fn progress(total: usize, unit: &str) -> ProgressBar {
+    let bar = ProgressBar::new(total as u64);
+    let template = format!("[{{bar:30}}] {{pos}}/{{len}} {unit}, {{elapsed}} (about {{eta}} left)");
+    if let Ok(style) = ProgressStyle::with_template(&template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}
+
+/// The accuracy study's scenes.
+const ACCURACY_SCENES: [&str; 3] = ["curtain", "curtain-wind", "card"];
+
+fn run(args: RunArgs) -> Result<(), String> {
+    let scene_path = &args.scene;
     let mut scene = ClothScene::load(scene_path).map_err(|e| e.to_string())?;
-    if let Some(model) = opts.get("--model") {
+    if let Some(model) = args.model {
         let name = match model {
-            "mass-spring" => "MassSpring",
-            "shape-matching" => "ShapeMatching",
-            "patches" => "Patches",
-            other => {
-                return Err(format!(
-                    "--model: `{other}` is not mass-spring, shape-matching or patches"
-                ));
-            }
+            ModelArg::MassSpring => "MassSpring",
+            ModelArg::ShapeMatching => "ShapeMatching",
+            ModelArg::Patches => "Patches",
         };
         scene
             .apply_override(&format!("cloth.params.model={name}"))
             .map_err(|e| e.to_string())?;
     }
-    for (flag, spec) in &opts.pairs {
-        if flag == "--set" {
-            scene.apply_override(spec).map_err(|e| e.to_string())?;
-        }
+    for spec in &args.set {
+        scene.apply_override(spec).map_err(|e| e.to_string())?;
     }
-    let steps: usize = opts.number("--steps", 300)?;
-    let every: usize = opts.number("--every", 10)?;
-    if every == 0 {
-        return Err("--every: must be at least 1".into());
-    }
+    let (steps, every) = (args.steps, args.every);
     let mut run = SceneRun::new(&scene).map_err(|e| format!("{scene_path}: {e}"))?;
-    let mut dump = match opts.get("--dump") {
-        Some(path) => Some(Dump::new(Path::new(path))?),
+    let mut dump = match &args.dump {
+        Some(path) => Some(Dump::new(path)?),
         None => None,
     };
     if let Some(d) = &mut dump {
@@ -190,19 +301,24 @@ enum DumpKind {
     Obj,
 }
 
+impl DumpKind {
+    /// The kind a dump file's extension asks for.
+    fn of(path: &Path) -> Result<Self, String> {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("json") => Ok(DumpKind::Json),
+            Some("csv") => Ok(DumpKind::Csv),
+            Some("obj") => Ok(DumpKind::Obj),
+            _ => Err(format!(
+                "--dump {}: the file must end in .json, .csv or .obj",
+                path.display()
+            )),
+        }
+    }
+}
+
 impl Dump {
     fn new(path: &Path) -> Result<Self, String> {
-        let kind = match path.extension().and_then(|e| e.to_str()) {
-            Some("json") => DumpKind::Json,
-            Some("csv") => DumpKind::Csv,
-            Some("obj") => DumpKind::Obj,
-            _ => {
-                return Err(format!(
-                    "--dump {}: the file must end in .json, .csv or .obj",
-                    path.display()
-                ));
-            }
-        };
+        let kind = DumpKind::of(path)?;
         let mut dump = Dump {
             path: path.to_path_buf(),
             kind,
@@ -299,57 +415,17 @@ impl Dump {
     }
 }
 
-/// The models of `--models` (comma separated), each one of `known`.
-fn model_list<'a>(
-    opts: &'a Options,
-    flag: &str,
-    known: &[&'a str],
-) -> Result<Vec<&'a str>, String> {
-    let models: Vec<&str> = opts
-        .get(flag)
-        .map_or(known.to_vec(), |m| m.split(',').collect());
-    if let Some(bad) = models.iter().find(|m| !known.contains(m)) {
-        return Err(format!("{flag}: no model `{bad}` ({})", known.join(", ")));
-    }
-    Ok(models)
-}
-
-/// The options of a measuring verb (`bench`, `accuracy`, `stability`): no positional
-/// argument, and a `--chart` path that is checked before anything is measured.
-fn verb_options(
-    verb: &str,
-    args: &[String],
-    with_value: &[&str],
-    switches: &[&str],
-) -> Result<Options, String> {
-    let opts = options(args, with_value, switches)?;
-    if let Some(extra) = opts.positional.first() {
-        return Err(format!("{verb} takes no argument `{extra}`\n{USAGE}"));
-    }
-    if let Some(chart) = opts.get("--chart") {
-        charts::check_path(Path::new(chart))?;
-    }
-    Ok(opts)
-}
-
 fn print_json<T: serde::Serialize>(value: &T) -> Result<(), String> {
     let json = serde_json::to_string_pretty(value).map_err(|e| e.to_string())?;
     println!("{json}");
     Ok(())
 }
 
-fn bench(args: &[String]) -> Result<(), String> {
-    let opts = verb_options(
-        "bench",
-        args,
-        &["--max", "--models", "--repeats", "--app-models", "--chart"],
-        &["--json", "--app"],
-    )?;
-    let max: usize = opts.number("--max", 65_536)?;
-    let repeats: usize = opts.number("--repeats", 15)?;
-    let models = model_list(&opts, "--models", &SEED_MODELS)?;
-    let app_models = model_list(&opts, "--app-models", &SEED_MODELS)?;
-    let with_app = opts.switch("--app") || opts.get("--app-models").is_some();
+fn bench(args: BenchArgs) -> Result<(), String> {
+    let (max, repeats) = (args.max, args.repeats);
+    let models = or_all(args.models, &SEED_MODELS);
+    let with_app = args.app || !args.app_models.is_empty();
+    let app_models = or_all(args.app_models, &SEED_MODELS);
     let counts: Vec<usize> = SEED_COUNTS.into_iter().filter(|&c| c <= max).collect();
     let mut cells = Vec::new();
     for &model in &models {
@@ -400,10 +476,10 @@ fn bench(args: &[String]) -> Result<(), String> {
             }
         }
     }
-    if let Some(chart) = opts.get("--chart") {
-        charts::bench(Path::new(chart), &cells, &frames)?;
+    if let Some(chart) = &args.output.chart {
+        charts::bench(chart, &cells, &frames)?;
     }
-    if opts.switch("--json") {
+    if args.output.json {
         return print_json(&serde_json::json!({ "solver": cells, "app": frames }));
     }
     if !cells.is_empty() {
@@ -499,58 +575,47 @@ fn accuracy_cases(names: &[&str], seconds: f32) -> Result<Vec<Case>, String> {
     Ok(cases)
 }
 
-fn number_f32(opts: &Options, flag: &str, default: f32) -> Result<f32, String> {
-    match opts.get(flag) {
-        None => Ok(default),
-        Some(v) => v
-            .parse::<f32>()
-            .ok()
-            .filter(|x| *x > 0.0 && x.is_finite())
-            .ok_or_else(|| format!("{flag}: `{v}` is not a positive number")),
-    }
-}
-
-fn accuracy(args: &[String]) -> Result<(), String> {
-    let opts = verb_options(
-        "accuracy",
-        args,
-        &["--scenes", "--seconds", "--chart", "--repeats"],
-        &["--json"],
-    )?;
-    let seconds = number_f32(&opts, "--seconds", 3.0)?;
-    let repeats: usize = opts.number("--repeats", 5)?;
-    let names: Vec<&str> = opts
-        .get("--scenes")
-        .map_or(vec!["curtain", "curtain-wind", "card"], |s| {
-            s.split(',').collect()
-        });
+fn accuracy(args: AccuracyArgs) -> Result<(), String> {
+    let (seconds, repeats) = (args.seconds, args.repeats);
+    let names = or_all(args.scenes, &ACCURACY_SCENES);
     let cases = accuracy_cases(&names, seconds)?;
     let mut references = Vec::new();
     let mut rows = Vec::new();
+    let total = cases
+        .iter()
+        .map(|c| accuracy::configs(&c.base()).len())
+        .sum();
+    let bar = progress(total, "configurations");
     for case in &cases {
         let configs = accuracy::configs(&case.base());
-        eprintln!(
-            "{}: reference and {} configurations",
-            case.name,
-            configs.len()
-        );
-        let (reference, case_rows) = accuracy::measure(case, &configs, repeats, |r| {
+        bar.suspend(|| {
             eprintln!(
-                "  {:<15} {:<36} {:>10} ms/s  error {}",
-                r.model,
-                r.label,
-                r.ms_per_second.map_or("-".into(), |ms| format!("{ms:.1}")),
-                r.error.map_or("failed".into(), |e| format!("{e:.2e}"))
-            );
+                "{}: reference and {} configurations",
+                case.name,
+                configs.len()
+            )
+        });
+        let (reference, case_rows) = accuracy::measure(case, &configs, repeats, |r| {
+            bar.suspend(|| {
+                eprintln!(
+                    "  {:<15} {:<36} {:>10} ms/s  error {}",
+                    r.model,
+                    r.label,
+                    r.ms_per_second.map_or("-".into(), |ms| format!("{ms:.1}")),
+                    r.error.map_or("failed".into(), |e| format!("{e:.2e}"))
+                )
+            });
+            bar.inc(1);
         })
         .map_err(|e| e.to_string())?;
         references.push(reference);
         rows.extend(case_rows);
     }
-    if let Some(chart) = opts.get("--chart") {
-        charts::accuracy(Path::new(chart), &rows)?;
+    bar.finish_and_clear();
+    if let Some(chart) = &args.output.chart {
+        charts::accuracy(chart, &rows)?;
     }
-    if opts.switch("--json") {
+    if args.output.json {
         return print_json(&serde_json::json!({ "references": references, "rows": rows }));
     }
     println!(
@@ -597,9 +662,17 @@ fn accuracy(args: &[String]) -> Result<(), String> {
     Ok(())
 }
 
-fn stability(args: &[String]) -> Result<(), String> {
-    let opts = verb_options("stability", args, &["--models", "--chart"], &["--json"])?;
-    let models = model_list(&opts, "--models", &MODELS)?;
+fn stability(args: StabilityArgs) -> Result<(), String> {
+    let models = or_all(args.models, &MODELS);
+    let in_list = |model: &str| models.iter().any(|m| model.split(' ').next() == Some(*m));
+    let per_map = STIFFNESS.len() * MASS.len();
+    let nonlinear_models = NONLINEAR_MODELS.iter().filter(|m| in_list(m)).count();
+    let bar = progress(
+        per_map
+            * (models.len() * 4 * TIMESTEP.len()
+                + Regime::NONLINEAR.len() * nonlinear_models * NONLINEAR_TIMESTEP.len()),
+        "cells",
+    );
     let mut cells = Vec::new();
     for &model in &models {
         for integrator in Integrator::ALL {
@@ -614,19 +687,21 @@ fn stability(args: &[String]) -> Result<(), String> {
                             failed += cell.failure.is_some() as usize;
                             total += 1;
                             cells.push(cell);
+                            bar.inc(1);
                         }
                     }
                 }
-                eprintln!(
-                    "{model}, {integrator:?}, auto substeps {}: {failed} of {total} cells fail",
-                    if auto { "on" } else { "off" }
-                );
+                bar.suspend(|| {
+                    eprintln!(
+                        "{model}, {integrator:?}, auto substeps {}: {failed} of {total} cells fail",
+                        if auto { "on" } else { "off" }
+                    )
+                });
             }
         }
     }
     // The nonlinear regimes: Verlet with automatic substeps, the claim under test.
     let mut nonlinear = Vec::new();
-    let in_list = |model: &str| models.iter().any(|m| model.split(' ').next() == Some(*m));
     for regime in Regime::NONLINEAR {
         for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(m)) {
             let mut here = Vec::new();
@@ -637,6 +712,7 @@ fn stability(args: &[String]) -> Result<(), String> {
                             stability::cell(regime, model, Integrator::Verlet, true, k, m, dt)
                                 .map_err(|e| e.to_string())?,
                         );
+                        bar.inc(1);
                     }
                 }
             }
@@ -646,13 +722,16 @@ fn stability(args: &[String]) -> Result<(), String> {
                 .filter(|c| c.persists_at_4x == Some(true))
                 .count();
             let capped = here.iter().filter(|c| c.under_resolved).count();
-            eprintln!(
-                "{regime:?}, {model}: {failed} of {} cells fail ({persists} still at 4× the substeps), {capped} over the substep cap",
-                here.len()
-            );
+            bar.suspend(|| {
+                eprintln!(
+                    "{regime:?}, {model}: {failed} of {} cells fail ({persists} still at 4× the substeps), {capped} over the substep cap",
+                    here.len()
+                )
+            });
             nonlinear.extend(here);
         }
     }
+    bar.finish_and_clear();
     let mut thresholds = Vec::new();
     for integrator in Integrator::ALL {
         for (k, m) in [(100.0, 1e-3), (1_000.0, 1e-4), (25_000.0, 1e-6)] {
@@ -661,8 +740,7 @@ fn stability(args: &[String]) -> Result<(), String> {
         }
     }
     let factors = [stability::lattice_factor(), 1.0, 1.0];
-    if let Some(chart) = opts.get("--chart") {
-        let chart = Path::new(chart);
+    if let Some(chart) = &args.output.chart {
         charts::stability(chart, &cells, &factors)?;
         let stem = chart
             .file_stem()
@@ -673,7 +751,7 @@ fn stability(args: &[String]) -> Result<(), String> {
             &nonlinear,
         )?;
     }
-    if opts.switch("--json") {
+    if args.output.json {
         return print_json(&serde_json::json!({
             "cells": cells,
             "nonlinear": nonlinear,
