@@ -93,7 +93,7 @@ impl Cloth {
     /// Builds the solver for this cloth placed by `frame`: grids directly, garments from
     /// their files (logging pattern warnings). Mesh shapes are built by the plugin from
     /// the entity's mesh.
-    pub fn build(&self, frame: bevy::math::Affine3A) -> Result<solver::Cloth, ClothError> {
+    pub fn build(&self, frame: bevy::math::Affine3A) -> Result<solver::ClothSolver, ClothError> {
         match &self.shape {
             ClothShape::Garment { file, resolution } => {
                 let layout = GarmentLayout::load(&asset_path(file), *resolution)?;
@@ -105,7 +105,7 @@ impl Cloth {
                 }
                 let layout = layout.into_layout();
                 let pins = self.pins.resolve_for(&layout)?;
-                solver::Cloth::new(layout, &pins, &self.params, frame)
+                solver::ClothSolver::new(layout, &pins, &self.params, frame)
             }
             _ => self.shape.build_solver(&self.pins, &self.params, frame),
         }
@@ -274,7 +274,7 @@ impl ClothCollider {
 #[derive(Component, Debug)]
 pub struct ClothSimulation {
     /// The solver state.
-    pub solver: solver::Cloth,
+    pub solver: solver::ClothSolver,
     /// The shape and pins it was built from (a change of either rebuilds).
     pub(crate) built_from: (ClothShape, Pins),
     /// True when the solver moved since the mesh was last written.
@@ -286,7 +286,7 @@ pub struct ClothSimulation {
 }
 
 impl ClothSimulation {
-    pub(crate) fn new(solver: solver::Cloth, cloth: &Cloth) -> Self {
+    pub(crate) fn new(solver: solver::ClothSolver, cloth: &Cloth) -> Self {
         let n = solver.particle_count();
         Self {
             solver,
@@ -380,7 +380,7 @@ impl ClothStats {
     pub const HISTORY_SECONDS: f32 = 10.0;
 
     /// Records a finished step.
-    pub fn record(&mut self, cloth: &solver::Cloth, env: &Environment, step_ms: f32) {
+    pub fn record(&mut self, cloth: &solver::ClothSolver, env: &Environment, step_ms: f32) {
         self.particles = cloth.particle_count();
         self.springs = cloth.spring_count();
         self.torn = cloth.torn_count();

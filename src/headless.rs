@@ -62,7 +62,7 @@ pub struct RunSummary {
 /// A scene's cloths built as solvers, with their colliders, ready to step.
 pub struct SceneRun {
     /// `(name, solver)` per cloth.
-    pub cloths: Vec<(String, solver::Cloth)>,
+    pub cloths: Vec<(String, solver::ClothSolver)>,
     /// Gravity and wind.
     pub environment: Environment,
     /// The step, s.
@@ -95,7 +95,7 @@ impl SceneRun {
     pub fn run(
         &mut self,
         steps: usize,
-        mut each: impl FnMut(usize, &[(String, solver::Cloth)]),
+        mut each: impl FnMut(usize, &[(String, solver::ClothSolver)]),
     ) -> RunSummary {
         let env = self.environment;
         let energy_start: Vec<f32> = self

@@ -27,7 +27,7 @@
 //! ```
 //!
 //! Layers, top to bottom: [`scene`] files and Rust builders → [`components::Cloth`]
-//! (plain data) → [`solver::Cloth`] (pure Rust, no ECS) → [`plugin`] (systems, mesh
+//! (plain data) → [`solver::ClothSolver`] (pure Rust, no ECS) → [`plugin`] (systems, mesh
 //! write-back).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]

@@ -9,7 +9,7 @@ use crate::solver;
 
 /// A mesh with one vertex per particle (positions in the cloth's local frame), smooth
 /// normals, UVs and the visible triangles. `uvs` defaults to the grid's `(i/(w−1), j/(h−1))`.
-pub fn cloth_mesh(cloth: &solver::Cloth, uvs: Option<Vec<[f32; 2]>>) -> Mesh {
+pub fn cloth_mesh(cloth: &solver::ClothSolver, uvs: Option<Vec<[f32; 2]>>) -> Mesh {
     let n = cloth.particle_count();
     let uvs = uvs
         .filter(|u| u.len() == n)
@@ -40,7 +40,7 @@ pub fn cloth_mesh(cloth: &solver::Cloth, uvs: Option<Vec<[f32; 2]>>) -> Mesh {
 /// Positions are written in the cloth's frame, so the entity's transform places them.
 pub fn write_mesh(
     mesh: &mut Mesh,
-    cloth: &solver::Cloth,
+    cloth: &solver::ClothSolver,
     normals: &mut [Vec3],
     faces_changed: bool,
 ) {
@@ -112,7 +112,7 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
         return Err(bad("a vertex position is not finite"));
     }
     // One particle per place: coincident vertices (a non-indexed mesh, a UV seam) are
-    // welded, the way `solver::Cloth::from_mesh` welds them, and keep the first UV.
+    // welded, the way `solver::ClothSolver::from_mesh` welds them, and keep the first UV.
     let welded = solver::topology::weld(&positions);
     let triangles = flat
         .chunks_exact(3)

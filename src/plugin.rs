@@ -207,7 +207,7 @@ fn build_one(
     cloth: &Cloth,
     frame: bevy::math::Affine3A,
     source: Option<&Mesh>,
-) -> Result<Option<(solver::Cloth, Mesh)>, crate::error::ClothError> {
+) -> Result<Option<(solver::ClothSolver, Mesh)>, crate::error::ClothError> {
     cloth.validate()?;
     match cloth.shape {
         ClothShape::Grid { .. } | ClothShape::Garment { .. } => {
@@ -226,7 +226,7 @@ fn build_one(
             } = mesh_triangles(source)?;
             let layout = Layout::from_mesh(&positions, &triangles)?;
             let pins = cloth.pins.resolve_for(&layout)?;
-            let solver = solver::Cloth::new(layout, &pins, &cloth.params, frame)?;
+            let solver = solver::ClothSolver::new(layout, &pins, &cloth.params, frame)?;
             let mesh = cloth_mesh(&solver, uvs);
             Ok(Some((solver, mesh)))
         }
@@ -381,7 +381,7 @@ fn run_substeps(world: &mut World) {
 fn for_each_active(
     plan: &ClothSubstepPlan,
     cloths: &mut Query<(&mut ClothSimulation, &mut StepProgress), Without<ClothInvalid>>,
-    phase: impl Fn(&mut solver::Cloth) + Sync + Send,
+    phase: impl Fn(&mut solver::ClothSolver) + Sync + Send,
 ) {
     cloths.par_iter_mut().for_each(|(mut sim, mut progress)| {
         if plan.index < progress.substeps {
@@ -404,15 +404,15 @@ fn accumulate_forces(
 }
 
 fn integrate(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
-    for_each_active(&plan, &mut cloths, solver::Cloth::integrate);
+    for_each_active(&plan, &mut cloths, solver::ClothSolver::integrate);
 }
 
 fn fit_targets(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
-    for_each_active(&plan, &mut cloths, solver::Cloth::fit_targets);
+    for_each_active(&plan, &mut cloths, solver::ClothSolver::fit_targets);
 }
 
 fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
-    for_each_active(&plan, &mut cloths, solver::Cloth::constrain);
+    for_each_active(&plan, &mut cloths, solver::ClothSolver::constrain);
 }
 
 fn finish_steps(

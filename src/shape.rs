@@ -92,10 +92,10 @@ impl ClothShape {
         pins: &Pins,
         params: &ClothParams,
         frame: Affine3A,
-    ) -> Result<solver::Cloth, ClothError> {
+    ) -> Result<solver::ClothSolver, ClothError> {
         let layout = self.layout()?;
         let pins = pins.resolve_for(&layout)?;
-        solver::Cloth::new(layout, &pins, params, frame)
+        solver::ClothSolver::new(layout, &pins, params, frame)
     }
 
     /// Checks sizes; a grid smaller than 2×2 or with a bad spacing is an error.

@@ -7,7 +7,7 @@ use bevy_cloth::garment::{GarmentLayout, asset_path};
 use bevy_cloth::headless::SceneRun;
 use bevy_cloth::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{Cloth as Solver, Collider, ColliderShape, Layout, SpringKind};
+use bevy_cloth::solver::{ClothSolver, Collider, ColliderShape, Layout, SpringKind};
 
 fn parse_err(text: &[u8]) -> (usize, usize, PatternErrorKind) {
     let e = Pattern::parse(text, "bad.txt").expect_err("must be refused");
@@ -303,12 +303,12 @@ fn broken_garments_name_the_file_and_what_is_wrong() {
 }
 
 /// One free particle (no springs) at `start`, resting on `collider` after `seconds`.
-fn drop_particle(start: Vec3, collider: Collider, seconds: f32) -> Solver {
+fn drop_particle(start: Vec3, collider: Collider, seconds: f32) -> ClothSolver {
     let params = ClothParams {
         drag: 0.0,
         ..ClothParams::default()
     };
-    let mut cloth = Solver::new(
+    let mut cloth = ClothSolver::new(
         Layout::from_springs(&[start], &[]).unwrap(),
         &[],
         &params,
@@ -424,7 +424,7 @@ fn friction_holds_on_a_slope_below_its_angle_and_lets_go_above() {
 
 /// The T-shirt scene's cloth and colliders as a solver, headless (as the `cloth` command
 /// line builds it).
-fn tshirt_scene() -> (Solver, Environment, Vec<Collider>) {
+fn tshirt_scene() -> (ClothSolver, Environment, Vec<Collider>) {
     let scene = ClothScene::load("assets/scenes/tshirt.ron").expect("scene loads");
     let run = SceneRun::new(&scene).expect("builds");
     let (_, cloth) = run.cloths.into_iter().next().expect("one cloth");

@@ -2,11 +2,11 @@
 
 use bevy::math::{Affine3A, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::Cloth as Solver;
+use bevy_cloth::solver::ClothSolver;
 
 const DT: f32 = 0.016;
 
-fn curtain() -> Solver {
+fn curtain() -> ClothSolver {
     ClothShape::Grid {
         width: 10,
         height: 8,

@@ -6,7 +6,7 @@ use std::cell::Cell;
 
 use bevy::math::{Affine3A, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::Cloth as Solver;
+use bevy_cloth::solver::ClothSolver;
 
 struct Counting;
 
@@ -38,7 +38,7 @@ unsafe impl GlobalAlloc for Counting {
 static GLOBAL: Counting = Counting;
 
 /// A 16×16 cloth of 5 cm, pinned at its top corners.
-fn grid_cloth(params: &ClothParams) -> Solver {
+fn grid_cloth(params: &ClothParams) -> ClothSolver {
     let shape = ClothShape::Grid {
         width: 16,
         height: 16,

@@ -3,7 +3,7 @@
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{Cloth as Solver, Layout};
+use bevy_cloth::solver::{ClothSolver, Layout};
 
 const DT: f32 = 0.016;
 
@@ -15,7 +15,7 @@ fn patch(w: u32, h: u32) -> PatchParams {
     }
 }
 
-fn grid(width: u32, height: u32, params: ClothParams, pins: Pins, frame: Affine3A) -> Solver {
+fn grid(width: u32, height: u32, params: ClothParams, pins: Pins, frame: Affine3A) -> ClothSolver {
     ClothShape::Grid {
         width,
         height,
@@ -25,7 +25,7 @@ fn grid(width: u32, height: u32, params: ClothParams, pins: Pins, frame: Affine3
     .unwrap()
 }
 
-fn max_target_error(c: &mut Solver) -> f32 {
+fn max_target_error(c: &mut ClothSolver) -> f32 {
     c.update_goals();
     let targets = &c.patches().unwrap().targets;
     targets
@@ -281,7 +281,7 @@ fn patches_need_a_grid_and_valid_sizes() {
         ..ClothParams::default()
     };
     assert!(
-        Solver::new(
+        ClothSolver::new(
             Layout::from_mesh(&positions, &[[0, 1, 2]]).unwrap(),
             &[],
             &params,
@@ -359,7 +359,7 @@ fn torn_part_springs_split_the_drawn_cloth() {
 }
 
 /// The largest distance between corresponding particles of two cloths.
-fn max_gap(a: &Solver, b: &Solver) -> f32 {
+fn max_gap(a: &ClothSolver, b: &ClothSolver) -> f32 {
     a.positions()
         .iter()
         .zip(b.positions())
@@ -467,7 +467,7 @@ fn a_cloth_one_part_across_resists_stretch_along_that_axis() {
         Pins::None,
         Affine3A::IDENTITY,
     );
-    let height = |c: &Solver| {
+    let height = |c: &ClothSolver| {
         let y: Vec<f32> = c.positions().iter().map(|p| p.y).collect();
         y.iter().copied().fold(f32::MIN, f32::max) - y.iter().copied().fold(f32::MAX, f32::min)
     };
@@ -503,7 +503,7 @@ fn sag(model: Model) -> f32 {
         ..ClothParams::default()
     };
     let mut c = grid(16, 16, params, Pins::TopRow, Affine3A::IDENTITY);
-    let bottom = |c: &Solver| c.positions()[16 * 15..].iter().map(|p| p.y).sum::<f32>() / 16.0;
+    let bottom = |c: &ClothSolver| c.positions()[16 * 15..].iter().map(|p| p.y).sum::<f32>() / 16.0;
     let rest = bottom(&c);
     let env = Environment::default();
     let (steps, last) = (500, 62);

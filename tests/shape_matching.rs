@@ -3,7 +3,7 @@
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{Cloth as Solver, Layout};
+use bevy_cloth::solver::{ClothSolver, Layout};
 
 const DT: f32 = 0.016;
 const POLAR: RotationMethod = RotationMethod::PolarDecomposition;
@@ -38,7 +38,7 @@ fn sm(rotation: RotationMethod) -> ShapeMatchingParams {
 }
 
 /// A playing card, 6.3 × 8.8 cm, as an 8 × 11 grid, pinned nowhere.
-fn card(params: ShapeMatchingParams, pins: Pins) -> Solver {
+fn card(params: ShapeMatchingParams, pins: Pins) -> ClothSolver {
     let cloth = ClothParams {
         model: Model::ShapeMatching(params),
         node_mass: 2e-5,
@@ -57,7 +57,7 @@ fn card(params: ShapeMatchingParams, pins: Pins) -> Solver {
 const CARD_SIZE: f32 = 0.113; // the card's diagonal, m
 
 /// Moves every particle by `motion` and returns the largest |goal − moved position|.
-fn goal_error_after(cloth: &mut Solver, motion: Affine3A) -> f32 {
+fn goal_error_after(cloth: &mut ClothSolver, motion: Affine3A) -> f32 {
     let moved: Vec<Vec3> = cloth
         .positions()
         .iter()
@@ -148,7 +148,7 @@ fn degenerate_shapes_give_finite_goals() {
                 .map(|i| Vec3::new(i as f32 * 0.01, 0.0, 0.0))
                 .collect();
             let springs: Vec<[u32; 2]> = (0..5).map(|i| [i, i + 1]).collect();
-            let mut strip = Solver::new(
+            let mut strip = ClothSolver::new(
                 Layout::from_springs(&positions, &springs).unwrap(),
                 &[],
                 &strip_params,
@@ -184,7 +184,7 @@ fn degenerate_shapes_give_finite_goals() {
 }
 
 /// RMS distance from the goals (the best rigid fit of the rest shape), over the card size.
-fn shape_error(c: &mut Solver) -> f32 {
+fn shape_error(c: &mut ClothSolver) -> f32 {
     c.update_goals();
     let goals = c.goals().unwrap().to_vec();
     let sum: f32 = goals
@@ -438,7 +438,7 @@ fn shape_matching_works_with_pins_gravity_and_wind_and_never_tears() {
     };
     let pin = c.positions()[0];
     let centre_of =
-        |c: &Solver| c.positions().iter().copied().sum::<Vec3>() / c.particle_count() as f32;
+        |c: &ClothSolver| c.positions().iter().copied().sum::<Vec3>() / c.particle_count() as f32;
     let arm = centre_of(&c).distance(pin);
     for _ in 0..500 {
         c.step(DT, &env);

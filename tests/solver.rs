@@ -1,9 +1,9 @@
-//! Solver tests against answers known independently of the code: free fall, a spring's
+//! ClothSolver tests against answers known independently of the code: free fall, a spring's
 //! period, energy conservation, rest, tearing, the explicit stability bound.
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{Cloth as Solver, Layout, SpringKind};
+use bevy_cloth::solver::{ClothSolver, Layout, SpringKind};
 
 const DT: f32 = 0.016;
 
@@ -39,12 +39,12 @@ fn no_wind() -> Environment {
 }
 
 /// Four unpinned particles with no springs: each falls freely, one substep per step.
-fn free_particles(integrator: Integrator) -> Solver {
+fn free_particles(integrator: Integrator) -> ClothSolver {
     free_particles_at(integrator, 1, Affine3A::IDENTITY)
 }
 
 /// Four unconnected particles placed by `frame`, stepped in `substeps` substeps.
-fn free_particles_at(integrator: Integrator, substeps: u32, frame: Affine3A) -> Solver {
+fn free_particles_at(integrator: Integrator, substeps: u32, frame: Affine3A) -> ClothSolver {
     let params = ClothParams {
         springs: no_springs(),
         substeps: Substeps::Fixed(substeps),
@@ -126,7 +126,7 @@ fn spring_period_matches_two_pi_sqrt_m_over_k() {
             ..conservative(integrator)
         };
         let positions = [Vec3::ZERO, Vec3::new(0.0, -1.0, 0.0)];
-        let mut cloth = Solver::new(
+        let mut cloth = ClothSolver::new(
             Layout::from_springs(&positions, &[[0, 1]]).unwrap(),
             &[0],
             &params,
@@ -171,7 +171,7 @@ fn spring_period_matches_two_pi_sqrt_m_over_k() {
 }
 
 /// A cloth held at two corners, released horizontal so it swings.
-fn swinging_cloth(params: &ClothParams) -> Solver {
+fn swinging_cloth(params: &ClothParams) -> ClothSolver {
     let frame = Affine3A::from_rotation_translation(
         Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         Vec3::new(0.0, 1.0, 0.0),
@@ -186,7 +186,7 @@ fn swinging_cloth(params: &ClothParams) -> Solver {
 }
 
 /// Largest |E − E0| over steps `[from, to)` of a swinging cloth with `substeps` fixed.
-fn energy_drift(substeps: u32, steps: usize, from: usize) -> (f32, Solver) {
+fn energy_drift(substeps: u32, steps: usize, from: usize) -> (f32, ClothSolver) {
     let params = ClothParams {
         substeps: Substeps::Fixed(substeps),
         ..conservative(Integrator::Verlet)
@@ -268,7 +268,7 @@ fn damped_cloth_comes_to_rest() {
     assert!(lowest < 1.0 - 0.5, "lowest point {lowest}");
 }
 
-fn tear_test_cloth(tear_ratio: f32, gravity: f32) -> (Solver, Environment) {
+fn tear_test_cloth(tear_ratio: f32, gravity: f32) -> (ClothSolver, Environment) {
     let params = ClothParams {
         tear_ratio: Some(tear_ratio),
         drag: 1e-3,
@@ -319,7 +319,7 @@ fn cloth_tears_past_its_ratio_and_not_below() {
 }
 
 /// Seed 002's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
-fn seed_002_extreme(substeps: Substeps) -> (Solver, Environment) {
+fn seed_002_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
     let params = ClothParams {
         node_mass: 1e-6,
         springs: SpringParams::from_structural(25_000.0),
@@ -428,7 +428,7 @@ fn pins_follow_the_frame() {
     }
     // The rest of the cloth is dragged along over the following steps.
     let centre =
-        |c: &Solver| c.positions().iter().copied().sum::<Vec3>() / c.particle_count() as f32;
+        |c: &ClothSolver| c.positions().iter().copied().sum::<Vec3>() / c.particle_count() as f32;
     let c0 = centre(&cloth);
     for _ in 0..200 {
         cloth.step(DT, &env);
@@ -658,14 +658,14 @@ fn square_mesh(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
 }
 
 /// The mesh hung from its top row for 2 s: the lowest point.
-fn hang_mesh(positions: &[Vec3], triangles: &[[u32; 3]]) -> (Solver, f32) {
+fn hang_mesh(positions: &[Vec3], triangles: &[[u32; 3]]) -> (ClothSolver, f32) {
     let params = ClothParams {
         springs: SpringParams::from_structural(50.0),
         ..ClothParams::default()
     };
     let layout = Layout::from_mesh(positions, triangles).unwrap();
     let pins = Pins::TopRow.resolve_for(&layout).unwrap();
-    let mut c = Solver::new(layout, &pins, &params, Affine3A::IDENTITY).unwrap();
+    let mut c = ClothSolver::new(layout, &pins, &params, Affine3A::IDENTITY).unwrap();
     for _ in 0..125 {
         c.step(DT, &no_wind());
     }

@@ -354,7 +354,7 @@ pub struct Row {
     pub max_strain: f32,
     /// Final total energy minus the reference's, over `M g D` (mass, gravity, diagonal);
     /// the same quantity for every model: the particles' kinetic, gravitational and
-    /// spring energy at the scene's spring parameters ([`bevy_cloth::solver::Cloth::energy`]).
+    /// spring energy at the scene's spring parameters ([`bevy_cloth::solver::ClothSolver::energy`]).
     pub energy_drift: Option<f64>,
     /// When the run failed, s.
     pub failed_at: Option<f32>,

@@ -2,7 +2,7 @@
 //! any game. Seed 000's timing table (Slika 23, here), seed 002's frame rates with the
 //! full app ([`fps`]), speed against accuracy ([`accuracy`]) and where each method fails
 //! ([`stability`]); the `cloth` command line drives them and draws the charts. Every
-//! instrument steps the same [`solver::Cloth`] a game runs.
+//! instrument steps the same [`solver::ClothSolver`] a game runs.
 
 pub mod accuracy;
 pub mod fps;
@@ -128,7 +128,7 @@ impl BenchCell {
 pub const BENCH_PINS: Pins = Pins::TopRow;
 
 /// The timing table's curtain (see [`BENCH_PINS`]).
-pub fn bench_cloth(model: &str, count: usize) -> Result<solver::Cloth, ClothError> {
+pub fn bench_cloth(model: &str, count: usize) -> Result<solver::ClothSolver, ClothError> {
     let params = seed_model_params(model).ok_or_else(|| ClothError::UnknownModel {
         name: model.to_string(),
         known: "1, 2, 3a, 3b, 3c",
@@ -152,7 +152,7 @@ pub const BENCH_CHECK_STEPS: usize = 63;
 /// structural strain, and the first step (1-based) after which it was not stable (the
 /// run stops there).
 fn timed_steps(
-    cloth: &mut solver::Cloth,
+    cloth: &mut solver::ClothSolver,
     env: &Environment,
     warmup: usize,
     repeats: usize,
@@ -177,7 +177,7 @@ fn timed_steps(
 /// Times one 16 ms step of a curtain (a grid of `count` particles, 5 cm apart, hung from
 /// its top row, gravity and the default wind) with `model`: `warmup` steps first, then
 /// the median of `repeats` steps, then untimed steps up to [`BENCH_CHECK_STEPS`]. Every
-/// step is checked ([`solver::Cloth::is_stable`]); a cell that fails anywhere in them is
+/// step is checked ([`solver::ClothSolver::is_stable`]); a cell that fails anywhere in them is
 /// reported as failed, with no time.
 pub fn bench_cell(
     model: &str,

@@ -156,7 +156,7 @@ pub fn quiet() -> Environment {
 
 /// Displaces every free particle by up to `fraction` of `spacing` in each axis
 /// (a fixed hash, the same every run), at rest, and updates the model's goals.
-pub fn perturb(cloth: &mut solver::Cloth, spacing: f32, fraction: f32) {
+pub fn perturb(cloth: &mut solver::ClothSolver, spacing: f32, fraction: f32) {
     let p = cloth.particles_mut();
     for i in 0..p.len() {
         if p.is_pinned(i) {
@@ -180,9 +180,9 @@ fn hash(i: usize, axis: u32) -> f32 {
     (x % 2_000_001) as f32 / 1_000_000.0 - 1.0
 }
 
-/// Kinetic energy of the free particles, J, summed in `f64` (`Cloth::energy` counts the
+/// Kinetic energy of the free particles, J, summed in `f64` (`ClothSolver::energy` counts the
 /// patch model's part lattice instead, whose perturbation averages out).
-pub fn kinetic(cloth: &solver::Cloth) -> f64 {
+pub fn kinetic(cloth: &solver::ClothSolver) -> f64 {
     let p = cloth.particles();
     (0..p.len())
         .filter(|&i| !p.is_pinned(i))
@@ -202,13 +202,13 @@ pub enum Failure {
 }
 
 /// Steps `cloth` `steps` times by `dt` with no input and says whether and how it failed.
-pub fn probe(cloth: &mut solver::Cloth, dt: f32, steps: usize) -> Option<Failure> {
+pub fn probe(cloth: &mut solver::ClothSolver, dt: f32, steps: usize) -> Option<Failure> {
     probe_in(cloth, &quiet(), dt, steps)
 }
 
 /// [`probe`] under `env` (gravity for a hanging cloth).
 pub fn probe_in(
-    cloth: &mut solver::Cloth,
+    cloth: &mut solver::ClothSolver,
     env: &Environment,
     dt: f32,
     steps: usize,
@@ -219,7 +219,7 @@ pub fn probe_in(
 /// Steps `cloth` until it fails or `steps` are done: the failure, and whether any step
 /// hit the automatic substeps' cap.
 fn run_probe(
-    cloth: &mut solver::Cloth,
+    cloth: &mut solver::ClothSolver,
     env: &Environment,
     dt: f32,
     steps: usize,
@@ -242,14 +242,14 @@ fn run_probe(
 
 /// The probe cloth of the grid: [`PROBE_SIZE`]² particles, nothing pinned, perturbed by
 /// 1% of the spacing.
-pub fn probe_cloth(params: &ClothParams) -> Result<solver::Cloth, ClothError> {
+pub fn probe_cloth(params: &ClothParams) -> Result<solver::ClothSolver, ClothError> {
     let mut cloth = rest_lattice(params)?;
     perturb(&mut cloth, SPACING, 0.01);
     Ok(cloth)
 }
 
 /// The probe cloth at rest, unperturbed.
-fn rest_lattice(params: &ClothParams) -> Result<solver::Cloth, ClothError> {
+fn rest_lattice(params: &ClothParams) -> Result<solver::ClothSolver, ClothError> {
     let shape = ClothShape::Grid {
         width: PROBE_SIZE,
         height: PROBE_SIZE,
@@ -264,7 +264,7 @@ fn threshold(
     k: f32,
     m: f32,
     omega: f32,
-    make: impl FnMut() -> Result<solver::Cloth, ClothError>,
+    make: impl FnMut() -> Result<solver::ClothSolver, ClothError>,
     auto_bound: f32,
 ) -> Result<Threshold, ClothError> {
     Ok(Threshold {
@@ -365,7 +365,7 @@ pub fn cell(
 /// energy over ten times `early` (the start's energy, raised to the largest kinetic
 /// energy of the first `quarter` steps).
 fn failure_of(
-    cloth: &solver::Cloth,
+    cloth: &solver::ClothSolver,
     step: usize,
     quarter: usize,
     early: &mut f64,
@@ -392,7 +392,7 @@ fn failure_of(
 pub fn regime_cloth(
     regime: Regime,
     params: &ClothParams,
-) -> Result<(solver::Cloth, Environment), ClothError> {
+) -> Result<(solver::ClothSolver, Environment), ClothError> {
     // The nonlinear regimes run each model as a game would: its default damping (the
     // bound accounts for it) and the strain limiter on.
     let model = match params.model {
@@ -454,7 +454,7 @@ pub fn regime_cloth(
 /// root of the largest eigenvalue of `M⁻¹K`, by power iteration. `K u` sums, over the
 /// acting springs, `k d̂ d̂ᵀ (u_b − u_a)`: at rest length a spring has no geometric
 /// stiffness across itself.
-pub fn lattice_omega_max(cloth: &solver::Cloth) -> f32 {
+pub fn lattice_omega_max(cloth: &solver::ClothSolver) -> f32 {
     let p = cloth.particles();
     let s = cloth.springs();
     let n = p.len();
@@ -500,8 +500,8 @@ pub fn lattice_omega_max(cloth: &solver::Cloth) -> f32 {
 
 /// The largest step the solver's own automatic substeps take as one substep (its
 /// Gershgorin bound with the 0.8 safety factor), by bisection on
-/// [`solver::Cloth::stable_substeps`].
-pub fn auto_bound(cloth: &solver::Cloth) -> f32 {
+/// [`solver::ClothSolver::stable_substeps`].
+pub fn auto_bound(cloth: &solver::ClothSolver) -> f32 {
     let (mut lo, mut hi) = (1e-7f32, 1.0f32);
     for _ in 0..60 {
         let mid = (lo * hi).sqrt();
@@ -517,11 +517,11 @@ pub fn auto_bound(cloth: &solver::Cloth) -> f32 {
 /// The largest stable step found by bisection: `make` builds the perturbed cloth
 /// afresh for each try, and a try runs `steps` single-substep steps.
 pub fn measured_threshold(
-    mut make: impl FnMut() -> Result<solver::Cloth, ClothError>,
+    mut make: impl FnMut() -> Result<solver::ClothSolver, ClothError>,
     guess: f32,
     steps: usize,
 ) -> Result<f32, ClothError> {
-    let fails = |dt: f32, cloth: &mut solver::Cloth| probe(cloth, dt, steps).is_some();
+    let fails = |dt: f32, cloth: &mut solver::ClothSolver| probe(cloth, dt, steps).is_some();
     let (mut lo, mut hi) = (guess * 0.25, guess * 4.0);
     if fails(lo, &mut make()?) || !fails(hi, &mut make()?) {
         return Err(ClothError::NotMeasurable {
@@ -573,7 +573,7 @@ pub fn single_spring(k: f32, m: f32, integrator: Integrator) -> Result<Threshold
     };
     let make = || {
         let layout = solver::Layout::from_springs(&[Vec3::ZERO, Vec3::X * SPACING], &[[0, 1]])?;
-        let mut cloth = solver::Cloth::new(layout, &[0], &params, Affine3A::IDENTITY)?;
+        let mut cloth = solver::ClothSolver::new(layout, &[0], &params, Affine3A::IDENTITY)?;
         // Stretched along the spring by 1%.
         let p = cloth.particles_mut();
         p.position[1].x += SPACING * 0.01;

@@ -4,7 +4,7 @@
 
 use bevy::math::Vec3;
 
-use super::Cloth;
+use super::ClothSolver;
 
 /// The solid a collider fills, in world space.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -74,7 +74,7 @@ impl Collider {
     }
 }
 
-impl Cloth {
+impl ClothSolver {
     /// Pushes every free particle out of every collider to `thickness` outside its surface,
     /// then removes tangential motion of this substep up to `friction × push` (Coulomb).
     /// Velocities follow the corrected positions: `v = (x − x_prev)/h`.

@@ -1,9 +1,9 @@
 //! Phase 1 of a substep: every force from the old state.
 
-use super::{Cloth, SpringKind, pull_scale};
+use super::{ClothSolver, SpringKind, pull_scale};
 use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams};
 
-impl Cloth {
+impl ClothSolver {
     /// Clears and accumulates the forces on every free particle: gravity (seed 002
     /// eq. 1.6), wind, linear drag `−c v` (seed 000 eq. 31) and the springs. Reads only the
     /// old state, so the result does not depend on particle order (seed 000 §3.2).

@@ -1,9 +1,9 @@
 //! Phases 2 and 3 of a substep: integration and constraints.
 
-use super::{Cloth, SpringKind};
+use super::{ClothSolver, SpringKind};
 use crate::params::{GoalUpdate, Integrator, Model};
 
-impl Cloth {
+impl ClothSolver {
     /// Advances every free particle by one substep `h` from its accumulated force.
     pub fn integrate(&mut self) {
         let h = self.h;

@@ -2,7 +2,7 @@
 
 use bevy::math::Vec3;
 
-use super::Cloth;
+use super::ClothSolver;
 
 /// A particle held by a tool: it moves to `target` over the next step, like a pin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -17,7 +17,7 @@ pub struct Grab {
     pub(super) inv_mass: f32,
 }
 
-impl Cloth {
+impl ClothSolver {
     /// The particle nearest to a ray (`origin`, unit `direction`) within `radius` of it,
     /// with its distance along the ray; hidden (torn-off) particles count too.
     pub fn nearest_particle_to_ray(

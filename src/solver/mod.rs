@@ -1,15 +1,15 @@
 //! The physics core: pure Rust, no ECS. The plugin, the tests, the command line and the
-//! benches all call the same [`Cloth::step`], so what is measured is what runs in a game.
+//! benches all call the same [`ClothSolver::step`], so what is measured is what runs in a game.
 //!
 //! One step of `dt` is split into substeps of `h = dt / N`; each substep runs the phases
 //! in a fixed order (seed 000 §3.2: all forces from the old state before any position
 //! changes):
-//! 1. [`Cloth::accumulate_forces`] — gravity, wind, drag, springs;
-//! 2. [`Cloth::integrate`] — Verlet or semi-implicit Euler;
-//! 3. [`Cloth::fit_targets`] — pull toward model goals (shape matching's velocity update);
-//! 4. [`Cloth::constrain`] — pins, Provot strain limiting.
+//! 1. [`ClothSolver::accumulate_forces`] — gravity, wind, drag, springs;
+//! 2. [`ClothSolver::integrate`] — Verlet or semi-implicit Euler;
+//! 3. [`ClothSolver::fit_targets`] — pull toward model goals (shape matching's velocity update);
+//! 4. [`ClothSolver::constrain`] — pins, Provot strain limiting.
 //!
-//! After the substeps, [`Cloth::end_step`] tears over-stretched springs.
+//! After the substeps, [`ClothSolver::end_step`] tears over-stretched springs.
 
 mod collide;
 mod forces;
@@ -36,7 +36,7 @@ use crate::params::{
 use patches::Patches;
 use shape_matching::ShapeMatching;
 
-/// Energies of a cloth in J, for measurement (see [`Cloth::energy`]).
+/// Energies of a cloth in J, for measurement (see [`ClothSolver::energy`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Energy {
     /// `Σ ½ m v²` over free particles.
@@ -65,7 +65,7 @@ pub struct Strain {
 
 /// A simulated cloth: particles, springs, triangles and the step.
 #[derive(Clone, Debug)]
-pub struct Cloth {
+pub struct ClothSolver {
     particles: Particles,
     springs: Springs,
     /// Particle positions in the cloth's own frame before any motion (for reset, pins).
@@ -148,7 +148,7 @@ impl ModelState {
     }
 }
 
-impl Cloth {
+impl ClothSolver {
     /// Builds a cloth of `layout` placed by `frame` (local → world), with the particles
     /// `pins` held where they start (indices into the layout's positions).
     pub fn new(
@@ -176,7 +176,7 @@ impl Cloth {
         let (triangle_springs, spring_triangles) =
             topology::triangle_edge_springs(&triangles, &springs);
         let n = local.len();
-        let mut cloth = Cloth {
+        let mut cloth = ClothSolver {
             particles: Particles::with_len(n),
             torn_this_step: Vec::with_capacity(springs.len()),
             springs,
@@ -929,7 +929,7 @@ fn check_model_fits(params: &ClothParams, grid: Option<(u32, u32)>) -> Result<()
 }
 
 /// Substeps that keep `h = dt/N` inside the explicit bound `h²ω² + 2hγ < 4` with a safety
-/// factor of 0.8 (see [`Cloth::stable_substeps`]).
+/// factor of 0.8 (see [`ClothSolver::stable_substeps`]).
 fn substeps_for(dt: f32, omega2: f32, gamma: f32) -> u32 {
     const SAFETY: f32 = 0.8;
     let h_max = if omega2 > 0.0 {

@@ -1,5 +1,5 @@
 //! The hybrid patch model (seed 000 §3.4): the grid is split into parts of w×h particles;
-//! the parts' centres of mass form a mass-spring lattice (a [`Cloth`] of its own, each
+//! the parts' centres of mass form a mass-spring lattice (a [`ClothSolver`] of its own, each
 //! node a lump of its particles) that feels gravity, wind, drag and the part springs; the
 //! particles follow targets interpolated between neighbouring part centres.
 //!
@@ -18,7 +18,7 @@
 
 use bevy::math::{Affine3A, Vec3};
 
-use super::{Cloth, Layout, topology};
+use super::{ClothSolver, Layout, topology};
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model, PatchParams, PatchTargets, Substeps};
 
@@ -46,7 +46,7 @@ struct Part {
 #[derive(Clone, Debug)]
 pub struct Patches {
     /// The part centres as a mass-spring cloth.
-    pub parts: Box<Cloth>,
+    pub parts: Box<ClothSolver>,
     part_grid: (u32, u32),
     layout: Vec<Part>,
     grid: (u32, u32),
@@ -202,7 +202,7 @@ impl Patches {
             grid: Some((nx, ny)),
             ..Layout::default()
         };
-        let mut parts = Cloth::new(
+        let mut parts = ClothSolver::new(
             lattice,
             &pinned_parts,
             &lattice_params(params, patch, 1),

@@ -355,7 +355,7 @@ impl Dump {
         &mut self,
         step: usize,
         time: f32,
-        cloths: &[(String, solver::Cloth)],
+        cloths: &[(String, solver::ClothSolver)],
     ) -> Result<(), String> {
         let mut text = String::new();
         match self.kind {
