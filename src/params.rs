@@ -286,8 +286,9 @@ impl ShapeMatchingParams {
 pub enum PatchTargets {
     /// Seed 000 §3.4's pseudocode: an affine map per part from its four neighbours.
     /// Neighbouring parts disagree along their border when the lattice bends (the
-    /// thesis's visible borders, Slika 22).
-    Seed,
+    /// thesis's visible borders, Slika 22). (`Seed` in older scene files.)
+    #[serde(alias = "Seed")]
+    PerPart,
     /// Bilinear interpolation between the four part centres around each particle
     /// (extrapolated past the outer centres, like the seed's ghosts): continuous across
     /// part borders; the same as the seed's for a flat, rigidly moved cloth. Not in the
@@ -315,7 +316,7 @@ pub struct PatchParams {
     pub part_damping: f32,
     /// The thesis's proposed correction: shift each part's targets by the offset from
     /// their centre of mass to the part's centre, less with distance. Acts only with
-    /// [`PatchTargets::Seed`]: the bilinear targets ignore it (a per-part shift would
+    /// [`PatchTargets::PerPart`]: the bilinear targets ignore it (a per-part shift would
     /// break their continuity across part borders).
     pub center_correction: bool,
     /// "Tiles" (Slika 12): particles sit exactly on their targets, no oscillation. The

@@ -94,8 +94,8 @@ fn undeformed_targets_are_the_rest_positions() {
     // The centre correction acts on the seed's targets only: it is tried there.
     let variants = [
         (PatchTargets::Bilinear, false),
-        (PatchTargets::Seed, false),
-        (PatchTargets::Seed, true),
+        (PatchTargets::PerPart, false),
+        (PatchTargets::PerPart, true),
     ];
     for (w, h) in [(2, 2), (3, 3), (4, 4), (8, 8), (4, 3), (5, 2)] {
         for (targets, correction) in variants {
@@ -244,7 +244,7 @@ fn a_curtain_of_four_by_four_parts_hangs() {
     );
     // The seed's per-part targets: neighbouring parts disagree on their common border when
     // the lattice bends (Slika 22's visible borders), so the largest strain sits there.
-    let (_, sag, p95, max) = hang_curtain(patches(PatchTargets::Seed));
+    let (_, sag, p95, max) = hang_curtain(patches(PatchTargets::PerPart));
     assert!(
         (sag / sag_ms - 1.0).abs() < 0.25,
         "seed targets: sag {sag} against mass-spring {sag_ms}"

@@ -156,3 +156,11 @@ fn scenes_name_a_missing_garment_and_a_bad_collider() {
     let scene = ClothScene::load("assets/scenes/tshirt.ron").unwrap();
     assert_eq!(scene.colliders.len(), 12);
 }
+
+#[test]
+fn the_per_part_targets_still_read_under_their_old_name() {
+    let old: PatchTargets = ron::from_str("Seed").unwrap();
+    let new: PatchTargets = ron::from_str("PerPart").unwrap();
+    assert_eq!(old, PatchTargets::PerPart);
+    assert_eq!(new, PatchTargets::PerPart);
+}

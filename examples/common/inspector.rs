@@ -391,12 +391,12 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                     );
                     ui.selectable_value(
                         &mut patch.targets,
-                        PatchTargets::Seed,
+                        PatchTargets::PerPart,
                         "Seed (per part, §3.4)",
                     );
                 });
             ui.add_enabled(
-                patch.targets == PatchTargets::Seed,
+                patch.targets == PatchTargets::PerPart,
                 egui::Checkbox::new(
                     &mut patch.center_correction,
                     "centre correction (seed targets only)",
