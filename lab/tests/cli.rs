@@ -192,12 +192,24 @@ fn bad_input_exits_2_with_one_line_naming_the_problem() {
 /// rewrites them; the commit then says why.
 #[test]
 fn golden_dumps_of_the_scenes_are_unchanged() {
-    let cases: [(&str, &str, &[&str]); 4] = [
+    let cases: [(&str, &str, &[&str]); 5] = [
         ("curtain", "assets/scenes/curtain.ron", &[]),
         (
             "curtain_patches",
             "assets/scenes/curtain.ron",
             &["--model", "patches"],
+        ),
+        (
+            "curtain_patches_per_part",
+            "assets/scenes/curtain.ron",
+            &[
+                "--model",
+                "patches",
+                "--set",
+                "cloth.params.model.0.targets=PerPart",
+                "--set",
+                "cloth.params.model.0.center_correction=true",
+            ],
         ),
         ("card", "assets/scenes/card.ron", &[]),
         ("tshirt", "assets/scenes/tshirt.ron", &[]),

@@ -80,6 +80,132 @@ pub struct Patches {
 
 /// The part lattice's own parameters: the cloth's springs, integrator, strain limit and
 /// tearing, with the part damping added to the drag.
+
+/// A grid cut into parts of `part_size` particles (smaller at a non-dividing edge), row
+/// by row: each part's rest centre, mass in particles, and its particles' centre
+/// correction weights.
+struct PartSplit {
+    parts: Vec<Part>,
+    centres: Vec<Vec3>,
+    lumps: Vec<f32>,
+    correction_weight: Vec<f32>,
+    single: Vec<bool>,
+}
+
+impl PartSplit {
+    fn new(local_rest: &[Vec3], (w, h): (u32, u32), (pw, ph): (u32, u32)) -> Self {
+        let (nx, ny) = (w.div_ceil(pw), h.div_ceil(ph));
+        let count = (nx * ny) as usize;
+        let mut split = PartSplit {
+            parts: Vec::with_capacity(count),
+            centres: Vec::with_capacity(count),
+            lumps: Vec::with_capacity(count),
+            correction_weight: vec![1.0; local_rest.len()],
+            single: vec![false; local_rest.len()],
+        };
+        let spacing = local_rest[0].distance(local_rest[1]);
+        for py in 0..ny {
+            for px in 0..nx {
+                let part = Part {
+                    i0: px * pw,
+                    j0: py * ph,
+                    width: pw.min(w - px * pw),
+                    height: ph.min(h - py * ph),
+                };
+                let members: Vec<usize> = part_particles(&part, w).collect();
+                let centre =
+                    members.iter().map(|&k| local_rest[k]).sum::<Vec3>() / members.len() as f32;
+                let reach = members
+                    .iter()
+                    .map(|&k| local_rest[k].distance(centre))
+                    .fold(0.0, f32::max);
+                for &k in &members {
+                    split.correction_weight[k] =
+                        1.0 - local_rest[k].distance(centre) / (reach + spacing);
+                    split.single[k] = members.len() == 1;
+                }
+                split.centres.push(centre);
+                split.lumps.push(members.len() as f32);
+                split.parts.push(part);
+            }
+        }
+        split
+    }
+
+    /// How each pin holds its part: the parts fixed outright (sorted, once each) and the
+    /// rods from pins to part centres (see [`Patches::new`]).
+    fn hold_pins(
+        &self,
+        pins: &[u32],
+        local_rest: &[Vec3],
+        (w, _): (u32, u32),
+        (pw, ph): (u32, u32),
+        bilinear: bool,
+    ) -> (Vec<u32>, Vec<Anchor>) {
+        let nx = w.div_ceil(pw);
+        let mut pinned_parts = Vec::new();
+        let mut anchors = Vec::new();
+        for (slot, &k) in pins.iter().enumerate() {
+            let (i, j) = (k % w, k / w);
+            let part = (j / ph) * nx + i / pw;
+            if self.lumps[part as usize] == 1.0 || !bilinear {
+                pinned_parts.push(part);
+            } else {
+                anchors.push(Anchor {
+                    part,
+                    pin: slot as u32,
+                    length: local_rest[k as usize].distance(self.centres[part as usize]),
+                });
+            }
+        }
+        pinned_parts.sort_unstable();
+        pinned_parts.dedup();
+        (pinned_parts, anchors)
+    }
+}
+
+/// Per particle of a `w×h` grid cut into parts of `part_size`: the four part centres
+/// around it (in lattice indices) and its bilinear coordinates `(s, t)` between them,
+/// from the centres' rest coordinates along each axis (extrapolated past the outer ones).
+fn bilinear_stencil((w, h): (u32, u32), (pw, ph): (u32, u32)) -> Vec<([u32; 4], f32, f32)> {
+    let (nx, ny) = (w.div_ceil(pw), h.div_ceil(ph));
+    // Rest coordinates of the centres along each axis, in particle indices.
+    let column_centre: Vec<f32> = (0..nx)
+        .map(|px| (px * pw) as f32 + (pw.min(w - px * pw) - 1) as f32 * 0.5)
+        .collect();
+    let row_centre: Vec<f32> = (0..ny)
+        .map(|py| (py * ph) as f32 + (ph.min(h - py * ph) - 1) as f32 * 0.5)
+        .collect();
+    let bracket = |centres: &[f32], u: f32| -> (u32, u32, f32) {
+        if centres.len() == 1 {
+            return (0, 0, 0.0);
+        }
+        let last = centres.len() - 1;
+        let a = centres
+            .iter()
+            .rposition(|&c| c <= u)
+            .unwrap_or(0)
+            .min(last - 1);
+        (
+            a as u32,
+            a as u32 + 1,
+            (u - centres[a]) / (centres[a + 1] - centres[a]),
+        )
+    };
+    (0..h)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| {
+            let (x0, x1, s) = bracket(&column_centre, i as f32);
+            let (y0, y1, t) = bracket(&row_centre, j as f32);
+            (
+                [y0 * nx + x0, y0 * nx + x1, y1 * nx + x0, y1 * nx + x1],
+                s,
+                t,
+            )
+        })
+        .collect()
+}
+
 fn lattice_params(params: &ClothParams, patch: &PatchParams, substeps: u32) -> ClothParams {
     ClothParams {
         model: Model::MassSpring,
@@ -101,77 +227,10 @@ impl Patches {
         frame: Affine3A,
     ) -> Result<Self, ClothError> {
         let (w, h) = grid;
-        let (pw, ph) = (patch.part_width.min(w), patch.part_height.min(h));
-        let (nx, ny) = (w.div_ceil(pw), h.div_ceil(ph));
-        let mut layout = Vec::with_capacity((nx * ny) as usize);
-        let mut centres = Vec::with_capacity(layout.capacity());
-        let mut lumps = Vec::with_capacity(layout.capacity());
-        let mut correction_weight = vec![1.0; local_rest.len()];
-        let mut single = vec![false; local_rest.len()];
-        for py in 0..ny {
-            for px in 0..nx {
-                let part = Part {
-                    i0: px * pw,
-                    j0: py * ph,
-                    width: pw.min(w - px * pw),
-                    height: ph.min(h - py * ph),
-                };
-                let members: Vec<usize> = part_particles(&part, w).collect();
-                let centre =
-                    members.iter().map(|&k| local_rest[k]).sum::<Vec3>() / members.len() as f32;
-                let reach = members
-                    .iter()
-                    .map(|&k| local_rest[k].distance(centre))
-                    .fold(0.0, f32::max);
-                let spacing = local_rest[0].distance(local_rest[1]);
-                for &k in &members {
-                    correction_weight[k] = 1.0 - local_rest[k].distance(centre) / (reach + spacing);
-                    single[k] = members.len() == 1;
-                }
-                centres.push(centre);
-                lumps.push(members.len() as f32);
-                layout.push(part);
-            }
-        }
-        // Rest coordinates of the centres along each axis, in particle indices.
-        let column_centre: Vec<f32> = (0..nx)
-            .map(|px| (px * pw) as f32 + (pw.min(w - px * pw) - 1) as f32 * 0.5)
-            .collect();
-        let row_centre: Vec<f32> = (0..ny)
-            .map(|py| (py * ph) as f32 + (ph.min(h - py * ph) - 1) as f32 * 0.5)
-            .collect();
-        let bracket = |centres: &[f32], u: f32| -> (u32, u32, f32) {
-            if centres.len() == 1 {
-                return (0, 0, 0.0);
-            }
-            let last = centres.len() - 1;
-            let a = centres
-                .iter()
-                .rposition(|&c| c <= u)
-                .unwrap_or(0)
-                .min(last - 1);
-            (
-                a as u32,
-                a as u32 + 1,
-                (u - centres[a]) / (centres[a + 1] - centres[a]),
-            )
-        };
-        let stencil = (0..h)
-            .flat_map(|j| (0..w).map(move |i| (i, j)))
-            .map(|(i, j)| {
-                let (x0, x1, s) = bracket(&column_centre, i as f32);
-                let (y0, y1, t) = bracket(&row_centre, j as f32);
-                (
-                    [y0 * nx + x0, y0 * nx + x1, y1 * nx + x0, y1 * nx + x1],
-                    s,
-                    t,
-                )
-            })
-            .collect();
-        let part_of = |k: u32| {
-            let (i, j) = (k % w, k / w);
-            (j / ph) * nx + i / pw
-        };
+        let part_size = (patch.part_width.min(w), patch.part_height.min(h));
+        let (nx, ny) = (w.div_ceil(part_size.0), h.div_ceil(part_size.1));
+        let split = PartSplit::new(local_rest, grid, part_size);
+        let stencil = bilinear_stencil(grid, part_size);
         // A part of one particle is that particle: pinned outright. With the bilinear
         // targets a larger part is held at its rest distance from each of its pins (see
         // the module doc). The seed's targets, and a cloth one part across, take the
@@ -179,26 +238,10 @@ impl Patches {
         // carry its pinned particle's target off the pin (a 16×8 curtain of 8×8 parts
         // passed 100% strain at its pins): there a pin fixes its part, as in the thesis.
         let bilinear = patch.targets == PatchTargets::Bilinear && nx > 1 && ny > 1;
-        let mut pinned_parts = Vec::new();
-        let mut anchors = Vec::new();
-        for (slot, &k) in pins.iter().enumerate() {
-            let part = part_of(k);
-            if lumps[part as usize] == 1.0 || !bilinear {
-                pinned_parts.push(part);
-            } else {
-                anchors.push(Anchor {
-                    part,
-                    pin: slot as u32,
-                    length: local_rest[k as usize].distance(centres[part as usize]),
-                });
-            }
-        }
-        pinned_parts.sort_unstable();
-        pinned_parts.dedup();
-        let pairs = topology::grid_spring_pairs(nx, ny);
+        let (pinned_parts, anchors) = split.hold_pins(pins, local_rest, grid, part_size, bilinear);
         let lattice = Layout {
-            positions: centres,
-            springs: pairs,
+            positions: split.centres,
+            springs: topology::grid_spring_pairs(nx, ny),
             grid: Some((nx, ny)),
             ..Layout::default()
         };
@@ -208,8 +251,8 @@ impl Patches {
             &lattice_params(params, patch, 1),
             frame,
         )?;
-        parts.particles.lump = lumps;
-        scale_for_aspect(&mut parts.springs, nx, (pw, ph));
+        parts.particles.lump = split.lumps;
+        scale_for_aspect(&mut parts.springs, nx, part_size);
         parts.reset();
         let step =
             |a: usize, b: usize| local_rest.get(b).map_or(0.0, |x| x.distance(local_rest[a]));
@@ -221,13 +264,13 @@ impl Patches {
         Ok(Patches {
             parts: Box::new(parts),
             part_grid: (nx, ny),
-            layout,
+            layout: split.parts,
             grid,
             target_velocity: vec![Vec3::ZERO; targets.len()],
             previous_targets: targets.clone(),
             targets,
-            correction_weight,
-            single,
+            correction_weight: split.correction_weight,
+            single: split.single,
             stencil,
             anchors,
             rest_step,
@@ -370,7 +413,6 @@ impl Patches {
     /// the particles' current positions `x` (used only when the cloth is one part wide or
     /// high). Allocates nothing.
     pub fn compute_targets(&mut self, x: &[Vec3], patch: &PatchParams) {
-        let (nx, ny) = self.part_grid;
         if self.bilinear(patch) {
             let c = &self.parts.particles.position;
             for (target, &([a, b, d, e], s, t)) in self.targets.iter_mut().zip(&self.stencil) {
@@ -379,84 +421,95 @@ impl Patches {
             }
             return;
         }
-        let w = self.grid.0;
-        let centres = &self.parts.particles.position;
+        let (nx, ny) = self.part_grid;
         for py in 0..ny {
             for px in 0..nx {
-                let k = (py * nx + px) as usize;
-                let part = self.layout[k];
-                let c = centres[k];
-                if part.width == 1 && part.height == 1 {
-                    // A part of one particle is that particle: the model is mass-spring.
-                    self.targets[(part.j0 * w + part.i0) as usize] = c;
-                    continue;
-                }
-                let size =
-                    |p: Part, horizontal: bool| if horizontal { p.width } else { p.height } as f32;
-                // Neighbour centres and their rest distances in particle spacings; a missing
-                // neighbour is a "ghost" mirrored through this centre (Slika 9).
-                let neighbour = |dx: i32, dy: i32| -> Option<(Vec3, f32)> {
-                    let (qx, qy) = (px as i32 + dx, py as i32 + dy);
-                    if qx < 0 || qy < 0 || qx >= nx as i32 || qy >= ny as i32 {
-                        return None;
-                    }
-                    let q = (qy as u32 * nx + qx as u32) as usize;
-                    let horizontal = dx != 0;
-                    Some((
-                        centres[q],
-                        0.5 * (size(part, horizontal) + size(self.layout[q], horizontal)),
-                    ))
-                };
-                let axis = |minus: Option<(Vec3, f32)>,
-                            plus: Option<(Vec3, f32)>,
-                            horizontal: bool| match (minus, plus) {
-                    (Some(m), Some(p)) => (m, p),
-                    (Some((m, d)), None) => ((m, d), (2.0 * c - m, d)),
-                    (None, Some((p, d))) => ((2.0 * c - p, d), (p, d)),
-                    // One part across: measure the direction from the part's own particles.
-                    // Its length is the rest spacing, so the pull restores the cloth's
-                    // extent along that axis (a measured length would give no stiffness).
-                    (None, None) => {
-                        let rest = if horizontal {
-                            self.rest_step.0
-                        } else {
-                            self.rest_step.1
-                        };
-                        let step = own_step(&part, x, w, horizontal).normalize_or_zero() * rest;
-                        let n = size(part, horizontal);
-                        ((c - step * n, n), (c + step * n, n))
-                    }
-                };
-                let ((l, dl), (r, dr)) = axis(neighbour(-1, 0), neighbour(1, 0), true);
-                let ((t, dt), (b, db)) = axis(neighbour(0, -1), neighbour(0, 1), false);
-                // Seed 000's pseudocode, generalised to unequal neighbours (edge parts):
-                // horizontal = (right − left) / (2w), vertical = (bottom − top) / (2h),
-                // start = (top + left)/2 shifted by half a step; target = start + j·v + i·h.
-                let horizontal = (r - l) / (dl + dr);
-                let vertical = (b - t) / (dt + db);
-                let start = 0.5 * (t + l)
-                    + horizontal * (0.5 * (dl - part.width as f32 + 1.0))
-                    + vertical * (0.5 * (dt - part.height as f32 + 1.0));
-                for j in 0..part.height {
-                    for i in 0..part.width {
-                        let index = ((part.j0 + j) * w + part.i0 + i) as usize;
-                        self.targets[index] = start + horizontal * i as f32 + vertical * j as f32;
-                    }
-                }
-                if patch.center_correction {
-                    // The thesis's proposed correction: move the targets' centre of mass
-                    // onto the part's centre, fully at the centre, less toward the edges.
-                    let count = (part.width * part.height) as f32;
-                    let mean = part_particles(&part, w)
-                        .map(|q| self.targets[q])
-                        .sum::<Vec3>()
-                        / count;
-                    let offset = c - mean;
-                    for q in part_particles(&part, w) {
-                        self.targets[q] += offset * self.correction_weight[q];
-                    }
-                }
+                self.place_part_targets(px, py, x, patch);
             }
+        }
+    }
+
+    /// The seed's targets (§3.4 pseudocode) of the particles of part `(px, py)`.
+    fn place_part_targets(&mut self, px: u32, py: u32, x: &[Vec3], patch: &PatchParams) {
+        let (nx, ny) = self.part_grid;
+        let w = self.grid.0;
+        let centres = &self.parts.particles.position;
+        let k = (py * nx + px) as usize;
+        let part = self.layout[k];
+        let c = centres[k];
+        if part.width == 1 && part.height == 1 {
+            // A part of one particle is that particle: the model is mass-spring.
+            self.targets[(part.j0 * w + part.i0) as usize] = c;
+            return;
+        }
+        let size = |p: Part, horizontal: bool| if horizontal { p.width } else { p.height } as f32;
+        // Neighbour centres and their rest distances in particle spacings; a missing
+        // neighbour is a "ghost" mirrored through this centre (Slika 9).
+        let neighbour = |dx: i32, dy: i32| -> Option<(Vec3, f32)> {
+            let (qx, qy) = (px as i32 + dx, py as i32 + dy);
+            if qx < 0 || qy < 0 || qx >= nx as i32 || qy >= ny as i32 {
+                return None;
+            }
+            let q = (qy as u32 * nx + qx as u32) as usize;
+            let horizontal = dx != 0;
+            Some((
+                centres[q],
+                0.5 * (size(part, horizontal) + size(self.layout[q], horizontal)),
+            ))
+        };
+        let axis = |minus: Option<(Vec3, f32)>, plus: Option<(Vec3, f32)>, horizontal: bool| match (
+            minus, plus,
+        ) {
+            (Some(m), Some(p)) => (m, p),
+            (Some((m, d)), None) => ((m, d), (2.0 * c - m, d)),
+            (None, Some((p, d))) => ((2.0 * c - p, d), (p, d)),
+            // One part across: measure the direction from the part's own particles.
+            // Its length is the rest spacing, so the pull restores the cloth's
+            // extent along that axis (a measured length would give no stiffness).
+            (None, None) => {
+                let rest = if horizontal {
+                    self.rest_step.0
+                } else {
+                    self.rest_step.1
+                };
+                let step = own_step(&part, x, w, horizontal).normalize_or_zero() * rest;
+                let n = size(part, horizontal);
+                ((c - step * n, n), (c + step * n, n))
+            }
+        };
+        let ((l, dl), (r, dr)) = axis(neighbour(-1, 0), neighbour(1, 0), true);
+        let ((t, dt), (b, db)) = axis(neighbour(0, -1), neighbour(0, 1), false);
+        // Seed 000's pseudocode, generalised to unequal neighbours (edge parts):
+        // horizontal = (right − left) / (2w), vertical = (bottom − top) / (2h),
+        // start = (top + left)/2 shifted by half a step; target = start + j·v + i·h.
+        let horizontal = (r - l) / (dl + dr);
+        let vertical = (b - t) / (dt + db);
+        let start = 0.5 * (t + l)
+            + horizontal * (0.5 * (dl - part.width as f32 + 1.0))
+            + vertical * (0.5 * (dt - part.height as f32 + 1.0));
+        for j in 0..part.height {
+            for i in 0..part.width {
+                let index = ((part.j0 + j) * w + part.i0 + i) as usize;
+                self.targets[index] = start + horizontal * i as f32 + vertical * j as f32;
+            }
+        }
+        if patch.center_correction {
+            self.correct_centre(part, c);
+        }
+    }
+
+    /// The thesis's proposed correction: move the targets' centre of mass onto the part's
+    /// centre `c`, fully at the centre, less toward the edges.
+    fn correct_centre(&mut self, part: Part, c: Vec3) {
+        let w = self.grid.0;
+        let count = (part.width * part.height) as f32;
+        let mean = part_particles(&part, w)
+            .map(|q| self.targets[q])
+            .sum::<Vec3>()
+            / count;
+        let offset = c - mean;
+        for q in part_particles(&part, w) {
+            self.targets[q] += offset * self.correction_weight[q];
         }
     }
 
