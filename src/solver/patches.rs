@@ -78,9 +78,6 @@ pub struct Patches {
     lattice_substeps: Option<(ClothParams, f32, u32)>,
 }
 
-/// The part lattice's own parameters: the cloth's springs, integrator, strain limit and
-/// tearing, with the part damping added to the drag.
-
 /// A grid cut into parts of `part_size` particles (smaller at a non-dividing edge), row
 /// by row: each part's rest centre, mass in particles, and its particles' centre
 /// correction weights.
@@ -206,6 +203,8 @@ fn bilinear_stencil((w, h): (u32, u32), (pw, ph): (u32, u32)) -> Vec<([u32; 4], 
         .collect()
 }
 
+/// The part lattice's own parameters: the cloth's springs, integrator, strain limit and
+/// tearing, with the part damping added to the drag.
 fn lattice_params(params: &ClothParams, patch: &PatchParams, substeps: u32) -> ClothParams {
     ClothParams {
         model: Model::MassSpring,
