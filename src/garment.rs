@@ -181,24 +181,7 @@ impl GarmentLayout {
             column: e.span.start.col,
             message: e.code.to_string(),
         })?;
-        if !(desc.spacing > 0.0 && desc.spacing.is_finite()) {
-            return Err(error(
-                "spacing",
-                format!(
-                    "`spacing` must be a positive distance in m, got {}",
-                    desc.spacing
-                ),
-            ));
-        }
-        if !(1..=MAX_RESOLUTION).contains(&resolution) {
-            return Err(error(
-                "spacing",
-                format!("resolution {resolution} is outside 1–{MAX_RESOLUTION}"),
-            ));
-        }
-        if desc.pieces.is_empty() {
-            return Err(error("pieces", "a garment needs at least one piece".into()));
-        }
+        check_header(&desc, resolution, &error)?;
         let spacing = desc.spacing / resolution as f32;
         let mut layout = GarmentLayout::default();
         // Per piece: its pattern and the particle index of each grid node.
@@ -221,65 +204,7 @@ impl GarmentLayout {
             grids.push((pattern, index));
         }
         for seam in &desc.seams {
-            let label = if seam.name.is_empty() {
-                "a seam".to_string()
-            } else {
-                format!("seam `{}`", seam.name)
-            };
-            let needle = if seam.name.is_empty() {
-                "seams".to_string()
-            } else {
-                format!("\"{}\"", seam.name)
-            };
-            let mut sides = Vec::new();
-            for edge in [&seam.a, &seam.b] {
-                let Some(p) = desc.pieces.iter().position(|p| p.name == edge.piece) else {
-                    return Err(error(
-                        &needle,
-                        format!("{label}: no piece is named `{}`", edge.piece),
-                    ));
-                };
-                let (pattern, index) = &grids[p];
-                let nodes = edge_nodes(edge, resolution)
-                    .map_err(|m| error(&needle, format!("{label}: {m}")))?;
-                let mut particles = Vec::with_capacity(nodes.len());
-                for (c, r) in nodes {
-                    if !pattern.has(c as i64, r as i64) {
-                        return Err(error(
-                            &needle,
-                            format!(
-                                "{label}: node ({}, {}) of `{}` is not in the pattern",
-                                c as f32 / resolution as f32,
-                                r as f32 / resolution as f32,
-                                edge.piece
-                            ),
-                        ));
-                    }
-                    particles.push(index[(r * pattern.width + c) as usize]);
-                }
-                sides.push(particles);
-            }
-            if sides[0].len() != sides[1].len() {
-                return Err(error(
-                    &needle,
-                    format!(
-                        "{label}: edge a has {} nodes but edge b has {}",
-                        sides[0].len(),
-                        sides[1].len()
-                    ),
-                ));
-            }
-            let pairs: Vec<[u32; 2]> = sides[0]
-                .iter()
-                .zip(&sides[1])
-                .map(|(&a, &b)| [a, b])
-                .collect();
-            if let Some(p) = pairs.iter().find(|p| p[0] == p[1]) {
-                return Err(error(
-                    &needle,
-                    format!("{label} joins particle {} to itself", p[0]),
-                ));
-            }
+            let pairs = seam_pairs(seam, &desc.pieces, &grids, resolution, &error)?;
             layout
                 .springs
                 .extend(pairs.iter().map(|p| (SpringKind::Seam, p[0], p[1])));
@@ -296,6 +221,104 @@ impl GarmentLayout {
         }
         Ok(layout)
     }
+}
+
+/// The garment file's own numbers: a positive spacing, a resolution in range, a piece.
+fn check_header(
+    desc: &GarmentFile,
+    resolution: u32,
+    error: &dyn Fn(&str, String) -> ClothError,
+) -> Result<(), ClothError> {
+    if !(desc.spacing > 0.0 && desc.spacing.is_finite()) {
+        return Err(error(
+            "spacing",
+            format!(
+                "`spacing` must be a positive distance in m, got {}",
+                desc.spacing
+            ),
+        ));
+    }
+    if !(1..=MAX_RESOLUTION).contains(&resolution) {
+        return Err(error(
+            "spacing",
+            format!("resolution {resolution} is outside 1–{MAX_RESOLUTION}"),
+        ));
+    }
+    if desc.pieces.is_empty() {
+        return Err(error("pieces", "a garment needs at least one piece".into()));
+    }
+    Ok(())
+}
+
+/// The particle pairs a seam joins: its two edges' nodes, in order, in their pieces'
+/// particle indices (`grids`: each piece's pattern and node → particle map).
+fn seam_pairs(
+    seam: &SeamDesc,
+    pieces: &[PieceDesc],
+    grids: &[(Pattern, Vec<u32>)],
+    resolution: u32,
+    error: &dyn Fn(&str, String) -> ClothError,
+) -> Result<Vec<[u32; 2]>, ClothError> {
+    let label = if seam.name.is_empty() {
+        "a seam".to_string()
+    } else {
+        format!("seam `{}`", seam.name)
+    };
+    let needle = if seam.name.is_empty() {
+        "seams".to_string()
+    } else {
+        format!("\"{}\"", seam.name)
+    };
+    let mut sides = Vec::new();
+    for edge in [&seam.a, &seam.b] {
+        let Some(p) = pieces.iter().position(|p| p.name == edge.piece) else {
+            return Err(error(
+                &needle,
+                format!("{label}: no piece is named `{}`", edge.piece),
+            ));
+        };
+        let (pattern, index) = &grids[p];
+        let nodes =
+            edge_nodes(edge, resolution).map_err(|m| error(&needle, format!("{label}: {m}")))?;
+        let mut particles = Vec::with_capacity(nodes.len());
+        for (c, r) in nodes {
+            if !pattern.has(c as i64, r as i64) {
+                return Err(error(
+                    &needle,
+                    format!(
+                        "{label}: node ({}, {}) of `{}` is not in the pattern",
+                        c as f32 / resolution as f32,
+                        r as f32 / resolution as f32,
+                        edge.piece
+                    ),
+                ));
+            }
+            particles.push(index[(r * pattern.width + c) as usize]);
+        }
+        sides.push(particles);
+    }
+    if sides[0].len() != sides[1].len() {
+        return Err(error(
+            &needle,
+            format!(
+                "{label}: edge a has {} nodes but edge b has {}",
+                sides[0].len(),
+                sides[1].len()
+            ),
+        ));
+    }
+    let pairs: Vec<[u32; 2]> = sides[0]
+        .iter()
+        .zip(&sides[1])
+        .map(|(&a, &b)| [a, b])
+        .collect();
+    if let Some(p) = pairs.iter().find(|p| p[0] == p[1]) {
+        return Err(error(
+            &needle,
+            format!("{label} joins particle {} to itself", p[0]),
+        ));
+    }
+    Ok(pairs)
 }
 
 /// Adds one piece's particles, springs and triangles; returns the particle index of each

@@ -124,19 +124,7 @@ impl Pattern {
             column,
             kind,
         };
-        let text = std::str::from_utf8(bytes).map_err(|e| {
-            let before = &bytes[..e.valid_up_to()];
-            let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
-            let line_start = before
-                .iter()
-                .rposition(|&b| b == b'\n')
-                .map_or(0, |p| p + 1);
-            let column = String::from_utf8_lossy(&before[line_start..])
-                .chars()
-                .count()
-                + 1;
-            error(line, column, PatternErrorKind::NotUtf8)
-        })?;
+        let text = utf8(bytes, file)?;
         let mut width = 0usize;
         let mut nodes = Vec::new();
         // (line, column) of every node, for warnings.
@@ -194,23 +182,7 @@ impl Pattern {
             height: (nodes.len() / width) as u32,
             nodes,
         };
-        let warnings = pattern
-            .islands()
-            .iter()
-            .skip(1)
-            .map(|island| {
-                let (line, column) = places[island[0] as usize];
-                PatternWarning {
-                    file: file.to_string(),
-                    line: line as usize,
-                    column: column as usize,
-                    message: format!(
-                        "{} node(s) here are not joined to the rest of the piece: they will fall on their own",
-                        island.len()
-                    ),
-                }
-            })
-            .collect();
+        let warnings = island_warnings(&pattern, &places, file);
         Ok((pattern, warnings))
     }
 
@@ -324,4 +296,48 @@ impl Pattern {
             nodes,
         }
     }
+}
+
+/// The file's text, or where its first byte that is not UTF-8 is.
+fn utf8<'a>(bytes: &'a [u8], file: &str) -> Result<&'a str, PatternError> {
+    std::str::from_utf8(bytes).map_err(|e| {
+        let before = &bytes[..e.valid_up_to()];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |p| p + 1);
+        let column = String::from_utf8_lossy(&before[line_start..])
+            .chars()
+            .count()
+            + 1;
+        PatternError {
+            file: file.to_string(),
+            line,
+            column,
+            kind: PatternErrorKind::NotUtf8,
+        }
+    })
+}
+
+/// A warning for every island of nodes but the largest, at its first node's place
+/// (`places`: the line and column of each node).
+fn island_warnings(pattern: &Pattern, places: &[(u32, u32)], file: &str) -> Vec<PatternWarning> {
+    pattern
+        .islands()
+        .iter()
+        .skip(1)
+        .map(|island| {
+            let (line, column) = places[island[0] as usize];
+            PatternWarning {
+                file: file.to_string(),
+                line: line as usize,
+                column: column as usize,
+                message: format!(
+                    "{} node(s) here are not joined to the rest of the piece: they will fall on their own",
+                    island.len()
+                ),
+            }
+        })
+        .collect()
 }
