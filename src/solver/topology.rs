@@ -111,25 +111,22 @@ pub fn grid_spring_pairs(width: u32, height: u32) -> Vec<(SpringKind, u32, u32)>
     for j in 0..height {
         for i in 0..width {
             let p = idx(i, j);
-            if i + 1 < width {
-                pairs.push((SpringKind::Structural, p, idx(i + 1, j)));
-            }
-            if j + 1 < height {
-                pairs.push((SpringKind::Structural, p, idx(i, j + 1)));
-            }
-            if i + 1 < width && j + 1 < height {
-                pairs.push((SpringKind::Shear, p, idx(i + 1, j + 1)));
-                pairs.push((SpringKind::Shear, idx(i + 1, j), idx(i, j + 1)));
-            }
-            if i + 2 < width {
-                pairs.push((SpringKind::Bend, p, idx(i + 2, j)));
-            }
-            if j + 2 < height {
-                pairs.push((SpringKind::Bend, p, idx(i, j + 2)));
-            }
-            if i + 2 < width && j + 2 < height {
-                pairs.push((SpringKind::BendDiagonal, p, idx(i + 2, j + 2)));
-                pairs.push((SpringKind::BendDiagonal, idx(i + 2, j), idx(i, j + 2)));
+            // Neighbours one apart: structural along the rows and columns, shear across;
+            // two apart: bend, and the optional diagonal bend.
+            for (along, across, d) in [
+                (SpringKind::Structural, SpringKind::Shear, 1),
+                (SpringKind::Bend, SpringKind::BendDiagonal, 2),
+            ] {
+                if i + d < width {
+                    pairs.push((along, p, idx(i + d, j)));
+                }
+                if j + d < height {
+                    pairs.push((along, p, idx(i, j + d)));
+                }
+                if i + d < width && j + d < height {
+                    pairs.push((across, p, idx(i + d, j + d)));
+                    pairs.push((across, idx(i + d, j), idx(i, j + d)));
+                }
             }
         }
     }
