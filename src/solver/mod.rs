@@ -12,6 +12,7 @@
 //! After the substeps, [`ClothSolver::end_step`] tears over-stretched springs.
 
 mod collide;
+mod diagnostics;
 mod forces;
 mod integrate;
 mod interact;
@@ -22,6 +23,7 @@ mod state;
 pub mod topology;
 
 pub use collide::{Collider, ColliderShape};
+pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
 pub use state::Particles;
@@ -35,33 +37,6 @@ use crate::params::{
 };
 use patches::Patches;
 use shape_matching::ShapeMatching;
-
-/// Energies of a cloth in J, for measurement (see [`ClothSolver::energy`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Energy {
-    /// `Σ ½ m v²` over free particles.
-    pub kinetic: f32,
-    /// `Σ −m g·x` over free particles (zero at the world origin).
-    pub gravitational: f32,
-    /// `Σ ½ k (l − l0)²` over acting springs.
-    pub spring: f32,
-}
-
-impl Energy {
-    /// Kinetic + gravitational + spring energy.
-    pub fn total(&self) -> f32 {
-        self.kinetic + self.gravitational + self.spring
-    }
-}
-
-/// Stretch of the structural springs, `(l − l0)/l0`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct Strain {
-    /// The largest stretch (negative when every spring is compressed).
-    pub max: f32,
-    /// The mean of `|l − l0|/l0`.
-    pub mean: f32,
-}
 
 /// A simulated cloth: particles, springs, triangles and the step.
 #[derive(Clone, Debug)]
@@ -274,6 +249,13 @@ impl ClothSolver {
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
         check_model_fits(params, self.grid)?;
+        self.apply_params(params);
+        Ok(())
+    }
+
+    /// [`ClothSolver::set_params`] for parameters known to be valid for this cloth (the
+    /// patch lattice's, derived from the cloth's validated ones).
+    pub(crate) fn apply_params(&mut self, params: &ClothParams) {
         if params.node_mass != self.params.node_mass {
             for i in 0..self.particles.len() {
                 self.particles.mass[i] = params.node_mass * self.particles.lump[i];
@@ -283,7 +265,6 @@ impl ClothSolver {
             }
         }
         self.params = *params;
-        Ok(())
     }
 
     /// The frame (local → world) the pins follow.
@@ -810,102 +791,6 @@ impl ClothSolver {
     /// True when automatic substeps hit their maximum: the step may be unstable.
     pub fn under_resolved(&self) -> bool {
         self.under_resolved
-    }
-
-    /// The failure test of the measurements (DESIGN.md): every position and velocity is
-    /// finite and no structural spring is stretched past 100%.
-    pub fn is_stable(&self) -> bool {
-        self.is_finite() && self.strain().max <= 1.0
-    }
-
-    /// True when every position and velocity is finite.
-    pub fn is_finite(&self) -> bool {
-        self.particles.position.iter().all(|p| p.is_finite())
-            && self.particles.velocity.iter().all(|v| v.is_finite())
-    }
-
-    /// Kinetic, gravitational and spring energy of the particles under `env`, the same
-    /// quantity for every model: the springs count at the cloth's spring parameters
-    /// (`params.springs`) whichever model moves the particles, so a shape-matched or
-    /// patch cloth is measured as the same cloth a mass-spring run would be (its goal
-    /// pull or part lattice is not counted).
-    pub fn energy(&self, env: &Environment) -> Energy {
-        let g = env.effective_gravity();
-        let p = &self.particles;
-        let mut e = Energy::default();
-        for i in 0..p.len() {
-            if p.inv_mass[i] > 0.0 {
-                e.kinetic += 0.5 * p.mass[i] * p.velocity[i].length_squared();
-                e.gravitational -= p.mass[i] * g.dot(p.position[i]);
-            }
-        }
-        e.spring = self.spring_energy(&self.params.springs);
-        e
-    }
-
-    /// `Σ ½ k (l − l0)²` over the whole springs, with each family's stiffness from
-    /// `springs`.
-    fn spring_energy(&self, springs: &crate::params::SpringParams) -> f32 {
-        let x = &self.particles.position;
-        let s = &self.springs;
-        let mut energy = 0.0;
-        for kind in SpringKind::ALL {
-            let k = family_stiffness(springs, kind);
-            if k == 0.0 {
-                continue;
-            }
-            for i in s.ranges[kind as usize].clone() {
-                if s.alive[i] {
-                    let l = x[s.a[i] as usize].distance(x[s.b[i] as usize]);
-                    energy += 0.5 * k * s.scale(i) * (l - s.rest_length[i]).powi(2);
-                }
-            }
-        }
-        energy
-    }
-
-    /// Stretch of the whole structural springs.
-    pub fn strain(&self) -> Strain {
-        let x = &self.particles.position;
-        let s = &self.springs;
-        let mut max = f32::NEG_INFINITY;
-        let (mut sum, mut count) = (0.0f32, 0usize);
-        for k in s.ranges[SpringKind::Structural as usize].clone() {
-            if s.alive[k] {
-                let l = x[s.a[k] as usize].distance(x[s.b[k] as usize]);
-                let e = (l - s.rest_length[k]) / s.rest_length[k];
-                max = max.max(e);
-                sum += e.abs();
-                count += 1;
-            }
-        }
-        if count == 0 {
-            return Strain::default();
-        }
-        Strain {
-            max,
-            mean: sum / count as f32,
-        }
-    }
-
-    /// Smooth vertex normals (area-weighted over the visible triangles) into `out`, which
-    /// must hold one entry per particle. Allocates nothing.
-    pub fn normals_into(&self, out: &mut [Vec3]) {
-        out.fill(Vec3::ZERO);
-        let x = &self.particles.position;
-        for (t, tri) in self.triangles.iter().enumerate() {
-            if !self.triangle_visible[t] {
-                continue;
-            }
-            let [a, b, c] = tri.map(|v| v as usize);
-            let n = (x[b] - x[a]).cross(x[c] - x[a]);
-            out[a] += n;
-            out[b] += n;
-            out[c] += n;
-        }
-        for n in out.iter_mut() {
-            *n = n.normalize_or(Vec3::Z);
-        }
     }
 }
 

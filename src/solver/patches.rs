@@ -367,9 +367,8 @@ impl Patches {
     pub fn set_params(&mut self, params: &ClothParams, patch: &PatchParams, substeps: u32) {
         // Validated with the cloth's parameters already; the lattice's differ only in
         // model, drag (+ a validated damping) and substeps.
-        let _ = self
-            .parts
-            .set_params(&lattice_params(params, patch, substeps));
+        self.parts
+            .apply_params(&lattice_params(params, patch, substeps));
     }
 
     /// True when particle `i` is a part of its own (its position is its part's centre).

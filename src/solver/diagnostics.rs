@@ -1,0 +1,132 @@
+//! What the solver reports about a cloth and does not need to step it: energies, strain,
+//! stability, normals for drawing.
+
+use bevy::math::Vec3;
+
+use super::{ClothSolver, SpringKind, family_stiffness};
+use crate::params::{Environment, SpringParams};
+
+/// Energies of a cloth in J, for measurement (see [`ClothSolver::energy`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energy {
+    /// `Σ ½ m v²` over free particles.
+    pub kinetic: f32,
+    /// `Σ −m g·x` over free particles (zero at the world origin).
+    pub gravitational: f32,
+    /// `Σ ½ k (l − l0)²` over acting springs.
+    pub spring: f32,
+}
+
+impl Energy {
+    /// Kinetic + gravitational + spring energy.
+    pub fn total(&self) -> f32 {
+        self.kinetic + self.gravitational + self.spring
+    }
+}
+
+/// Stretch of the structural springs, `(l − l0)/l0`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Strain {
+    /// The largest stretch (negative when every spring is compressed).
+    pub max: f32,
+    /// The mean of `|l − l0|/l0`.
+    pub mean: f32,
+}
+
+impl ClothSolver {
+    /// The failure test of the measurements (DESIGN.md): every position and velocity is
+    /// finite and no structural spring is stretched past 100%.
+    pub fn is_stable(&self) -> bool {
+        self.is_finite() && self.strain().max <= 1.0
+    }
+
+    /// True when every position and velocity is finite.
+    pub fn is_finite(&self) -> bool {
+        self.particles.position.iter().all(|p| p.is_finite())
+            && self.particles.velocity.iter().all(|v| v.is_finite())
+    }
+
+    /// Kinetic, gravitational and spring energy of the particles under `env`, the same
+    /// quantity for every model: the springs count at the cloth's spring parameters
+    /// (`params.springs`) whichever model moves the particles, so a shape-matched or
+    /// patch cloth is measured as the same cloth a mass-spring run would be (its goal
+    /// pull or part lattice is not counted).
+    pub fn energy(&self, env: &Environment) -> Energy {
+        let g = env.effective_gravity();
+        let p = &self.particles;
+        let mut e = Energy::default();
+        for i in 0..p.len() {
+            if p.inv_mass[i] > 0.0 {
+                e.kinetic += 0.5 * p.mass[i] * p.velocity[i].length_squared();
+                e.gravitational -= p.mass[i] * g.dot(p.position[i]);
+            }
+        }
+        e.spring = self.spring_energy(&self.params.springs);
+        e
+    }
+
+    /// `Σ ½ k (l − l0)²` over the whole springs, with each family's stiffness from
+    /// `springs`.
+    fn spring_energy(&self, springs: &SpringParams) -> f32 {
+        let x = &self.particles.position;
+        let s = &self.springs;
+        let mut energy = 0.0;
+        for kind in SpringKind::ALL {
+            let k = family_stiffness(springs, kind);
+            if k == 0.0 {
+                continue;
+            }
+            for i in s.ranges[kind as usize].clone() {
+                if s.alive[i] {
+                    let l = x[s.a[i] as usize].distance(x[s.b[i] as usize]);
+                    energy += 0.5 * k * s.scale(i) * (l - s.rest_length[i]).powi(2);
+                }
+            }
+        }
+        energy
+    }
+
+    /// Stretch of the whole structural springs.
+    pub fn strain(&self) -> Strain {
+        let x = &self.particles.position;
+        let s = &self.springs;
+        let mut max = f32::NEG_INFINITY;
+        let (mut sum, mut count) = (0.0f32, 0usize);
+        for k in s.ranges[SpringKind::Structural as usize].clone() {
+            if s.alive[k] {
+                let l = x[s.a[k] as usize].distance(x[s.b[k] as usize]);
+                let e = (l - s.rest_length[k]) / s.rest_length[k];
+                max = max.max(e);
+                sum += e.abs();
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return Strain::default();
+        }
+        Strain {
+            max,
+            mean: sum / count as f32,
+        }
+    }
+
+    /// Smooth vertex normals (area-weighted over the visible triangles) into `out`, which
+    /// must hold one entry per particle. Allocates nothing.
+    pub fn normals_into(&self, out: &mut [Vec3]) {
+        out.fill(Vec3::ZERO);
+        let x = &self.particles.position;
+        for (t, tri) in self.triangles.iter().enumerate() {
+            if !self.triangle_visible[t] {
+                continue;
+            }
+            let [a, b, c] = tri.map(|v| v as usize);
+            let n = (x[b] - x[a]).cross(x[c] - x[a]);
+            out[a] += n;
+            out[b] += n;
+            out[c] += n;
+        }
+        for n in out.iter_mut() {
+            *n = n.normalize_or(Vec3::Z);
+        }
+    }
+}
