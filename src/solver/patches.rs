@@ -73,9 +73,6 @@ pub struct Patches {
     /// `(part_width, part_height, targets)` these were built for (the targets decide how
     /// pins hold the lattice).
     pub(super) built_for: (u32, u32, PatchTargets),
-    /// The lattice's stable substeps for (its parameters, dt): they do not depend on the
-    /// state, so a state-dependent pull (p ≠ 1) does not recompute (and allocate) them.
-    lattice_substeps: Option<(ClothParams, f32, u32)>,
 }
 
 /// A grid cut into parts of `part_size` particles (smaller at a non-dividing edge), row
@@ -273,7 +270,6 @@ impl Patches {
             stencil,
             anchors,
             rest_step,
-            lattice_substeps: None,
             built_for: (patch.part_width, patch.part_height, patch.targets),
         })
     }
@@ -376,30 +372,16 @@ impl Patches {
         self.single[i]
     }
 
-    /// The lattice's parameters without the substep count it is handed each step.
-    fn lattice_key(&self) -> ClothParams {
-        ClothParams {
-            substeps: Substeps::Fixed(1),
-            ..*self.parts.params()
-        }
-    }
-
     /// Computes and caches the lattice's stable substeps for `dt` if its parameters or
     /// `dt` changed since the last time.
     pub fn refresh_lattice_substeps(&mut self, dt: f32) {
-        let key = self.lattice_key();
-        if !matches!(self.lattice_substeps, Some((p, d, _)) if p == key && d == dt) {
-            self.lattice_substeps = Some((key, dt, self.parts.stable_substeps(dt)));
-        }
+        self.parts.refresh_substep_cache(dt);
     }
 
     /// Stable substeps of the part lattice for a step of `dt`: the cached value when it
     /// is current, otherwise computed now.
     pub fn lattice_substeps(&self, dt: f32) -> u32 {
-        match self.lattice_substeps {
-            Some((p, d, n)) if p == self.lattice_key() && d == dt => n,
-            _ => self.parts.stable_substeps(dt),
-        }
+        self.parts.cached_substeps(dt)
     }
 
     /// Number of parts.

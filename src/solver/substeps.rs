@@ -1,0 +1,293 @@
+//! The substep rule: how many substeps keep an explicit step stable for a cloth (the
+//! bound of each model: springs, shape-matching goals, the patch pull and its lattice),
+//! and the one cache that spares recomputing it while nothing it depends on changes.
+
+use bevy::math::Vec3;
+
+use super::patches::Patches;
+use super::shape_matching::ShapeMatching;
+use super::{ClothSolver, ModelState, SpringKind, pull_scale};
+use crate::params::{ClothParams, GoalUpdate, Model, PatchParams, ShapeMatchingParams, Substeps};
+
+/// Automatic substeps remembered for (the parameters but their substep setting, dt).
+/// Tearing only removes stiffness, so a cached count stays stable after a tear and the
+/// step never recomputes (or allocates) for it. The part lattice of the patch model, a
+/// cloth itself, uses its own.
+#[derive(Clone, Debug, Default)]
+pub(super) struct SubstepCache(Option<(ClothParams, f32, u32)>);
+
+impl SubstepCache {
+    /// The parameters as the bound sees them: the substep setting is what the bound
+    /// decides, not what it depends on.
+    fn key(params: &ClothParams) -> ClothParams {
+        ClothParams {
+            substeps: Substeps::Fixed(1),
+            ..*params
+        }
+    }
+
+    fn get(&self, params: &ClothParams, dt: f32) -> Option<u32> {
+        match self.0 {
+            Some((p, d, n)) if p == Self::key(params) && d == dt => Some(n),
+            _ => None,
+        }
+    }
+}
+
+impl ClothSolver {
+    /// The stable substeps for `dt` from the cache, computed and remembered when the
+    /// parameters or `dt` changed.
+    pub(super) fn refresh_substep_cache(&mut self, dt: f32) -> u32 {
+        if let Some(n) = self.substep_cache.get(&self.params, dt) {
+            return n;
+        }
+        let n = self.stable_substeps(dt);
+        self.substep_cache = SubstepCache(Some((SubstepCache::key(&self.params), dt, n)));
+        n
+    }
+
+    /// The stable substeps for `dt`: the cached value when it is current, otherwise
+    /// computed now.
+    pub(super) fn cached_substeps(&self, dt: f32) -> u32 {
+        self.substep_cache
+            .get(&self.params, dt)
+            .unwrap_or_else(|| self.stable_substeps(dt))
+    }
+
+    /// The number of substeps that keeps an explicit step of `dt` stable for this cloth.
+    ///
+    /// Symplectic Euler (and Verlet, the same recurrence) on `x'' = −ω² x − γ x'` is stable
+    /// while `h²ω² + 2hγ < 4` (Jury's test on its 2×2 update matrix); with no damping this
+    /// is the lattice bound `ω_max·h < 2`. Gershgorin's theorem bounds the lattice's
+    /// largest frequency by `ω_max² ≤ max_i 2·Σ_j k_ij / m_i` and its largest damping
+    /// rate by `γ ≤ max_i (2·Σ_j c_ij + c_drag) / m_i`. A safety factor of 0.8 on the
+    /// right-hand side covers the geometric stiffness of stretched springs.
+    pub fn stable_substeps(&self, dt: f32) -> u32 {
+        let (omega2, gamma) = match (&self.params.model, &self.model) {
+            (Model::ShapeMatching(sm), ModelState::ShapeMatching(state)) => {
+                self.goal_frequency(sm, state)
+            }
+            (Model::Patches(patch), ModelState::Patches(patches)) => {
+                let lattice = patches.lattice_substeps(dt);
+                if patch.tiles {
+                    return lattice; // no pull to resolve
+                }
+                let pull = self.pull_frequency(patch, patches);
+                return substeps_for(dt, pull.0, pull.1).max(lattice);
+            }
+            _ => self.spring_frequency(),
+        };
+        substeps_for(dt, omega2, gamma)
+    }
+
+    /// True when the explicit bound depends on the current deformation.
+    pub(super) fn state_dependent_stiffness(&self) -> bool {
+        match self.params.model {
+            Model::ShapeMatching(_) => true,
+            Model::Patches(p) => p.exponent != 1.0 && !p.tiles,
+            Model::MassSpring => false,
+        }
+    }
+
+    /// `(ω², γ)` of the patch model's pull toward the targets, damped at
+    /// `ratio · 2√(α m)`.
+    fn pull_frequency(&self, patch: &PatchParams, patches: &Patches) -> (f32, f32) {
+        let omega2 = self.pull_omega2(&patches.targets, patch.stiffness, patch.exponent);
+        let gamma = patch.particle_damping_ratio
+            * 2.0
+            * (patch.stiffness * self.max_free_inv_mass()).sqrt();
+        (omega2, gamma)
+    }
+
+    /// ω² bound of a pull `α (d/L)^(p−1) d` toward `targets` over a step: its stiffness
+    /// along `d` is `p α (d/L)^(p−1)` and across `d` it is `α (d/L)^(p−1)`, so the larger
+    /// of the two is `max(p, 1) α (d/L)^(p−1)` ([`pull_stiffness`]). The bound must hold
+    /// wherever the particle goes within the step, not only where it is now: for p < 1
+    /// the stiffness peaks at the goal (inside the clamp), which a particle far from it
+    /// now may pass, so that peak is used; for p > 1 it grows with `d`, so `d` is taken
+    /// as far as the particle's kinetic energy could carry it against the pull
+    /// ([`pull_reach`]). The target moves with the particle (centre of mass, rotation,
+    /// interpolation), bounded by a factor 2. Over the free particles. (The cloth
+    /// stability map's nonlinear regimes found the bound from the current `d` too loose:
+    /// most failures of a crumpled cloth at p = 0.5 and 3 went away at 4× the substeps.)
+    fn pull_omega2(&self, targets: &[Vec3], stiffness: f32, exponent: f32) -> f32 {
+        let p = &self.particles;
+        let l = self.length_scale;
+        (0..p.len())
+            .filter(|&i| p.inv_mass[i] > 0.0)
+            .map(|i| {
+                let d = if exponent < 1.0 {
+                    0.0
+                } else if exponent > 1.0 {
+                    let energy = 0.5 * p.mass[i] * p.velocity[i].length_squared();
+                    pull_reach(
+                        targets[i].distance(p.position[i]),
+                        energy,
+                        stiffness,
+                        l,
+                        exponent,
+                    )
+                } else {
+                    0.0 // linear: the same stiffness everywhere
+                };
+                2.0 * stiffness * pull_stiffness(d, l, exponent) * p.inv_mass[i]
+            })
+            .fold(0.0, f32::max)
+    }
+
+    /// The largest inverse mass of a free particle.
+    fn max_free_inv_mass(&self) -> f32 {
+        self.particles.inv_mass.iter().copied().fold(0.0, f32::max)
+    }
+
+    /// Gershgorin bounds `(ω_max², γ_max)` of the spring lattice.
+    fn spring_frequency(&self) -> (f32, f32) {
+        let n = self.particles.len();
+        let mut k_sum = vec![0.0f32; n];
+        let mut c_sum = vec![0.0f32; n];
+        let damping = self.params.springs.damping;
+        for kind in SpringKind::ALL {
+            let k = self.stiffness(kind);
+            let c = if k > 0.0 { damping } else { 0.0 };
+            if k == 0.0 && c == 0.0 {
+                continue;
+            }
+            for s in self.springs.ranges[kind as usize].clone() {
+                if self.springs.alive[s] {
+                    for p in [self.springs.a[s], self.springs.b[s]] {
+                        k_sum[p as usize] += k * self.springs.scale(s);
+                        c_sum[p as usize] += c;
+                    }
+                }
+            }
+        }
+        let (mut omega2, mut gamma) = (0.0f32, 0.0f32);
+        for i in 0..n {
+            let w = self.particles.inv_mass[i];
+            omega2 = omega2.max(2.0 * k_sum[i] * w);
+            gamma = gamma.max((2.0 * c_sum[i] + self.params.drag * self.particles.lump[i]) * w);
+        }
+        (omega2, gamma)
+    }
+
+    /// `(ω_max², γ_max)` of shape matching's goal force at the current deformation (see
+    /// `pull_omega2`). Müller's velocity update cannot overshoot: only drag and damping
+    /// bound its step.
+    fn goal_frequency(&self, sm: &ShapeMatchingParams, state: &ShapeMatching) -> (f32, f32) {
+        let omega2 = match sm.update {
+            GoalUpdate::Force => self.pull_omega2(&state.goals, sm.stiffness, sm.exponent),
+            GoalUpdate::Velocity => 0.0,
+        };
+        (
+            omega2,
+            (sm.damping + self.params.drag) * self.max_free_inv_mass(),
+        )
+    }
+}
+
+/// Substeps that keep `h = dt/N` inside the explicit bound `h²ω² + 2hγ < 4` with a safety
+/// factor of 0.8 (see [`ClothSolver::stable_substeps`]).
+fn substeps_for(dt: f32, omega2: f32, gamma: f32) -> u32 {
+    const SAFETY: f32 = 0.8;
+    let h_max = if omega2 > 0.0 {
+        (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
+    } else if gamma > 0.0 {
+        2.0 * SAFETY / gamma
+    } else {
+        f32::INFINITY
+    };
+    let n = (dt / h_max).ceil();
+    if n.is_finite() && n >= 1.0 {
+        n.min(u32::MAX as f32) as u32
+    } else {
+        1
+    }
+}
+
+/// The largest stiffness of the pull `(d/L)^(p−1) d` per unit α at distance `d`: along
+/// `d` it is `p (d/L)^(p−1)`, across `d` it is `(d/L)^(p−1)`, so `max(p, 1) (d/L)^(p−1)`
+/// (inside the clamp at `d/L = 0.05` the pull is linear: both are the clamped scale).
+#[inline]
+fn pull_stiffness(d: f32, length_scale: f32, exponent: f32) -> f32 {
+    let clamped = d / length_scale < 0.05;
+    let factor = if clamped { 1.0 } else { exponent.max(1.0) };
+    factor * pull_scale(d, length_scale, exponent)
+}
+
+/// How far from its goal a particle at distance `d` with kinetic energy `energy` can get
+/// against the pull `α (d/L)^(p−1) d` if the goal stood still: its potential is
+/// `α L² (d/L)^(p+1) / (p+1)`, so `d_max/L = ((d/L)^(p+1) + (p+1) E / (α L²))^(1/(p+1))`.
+#[inline]
+fn pull_reach(d: f32, energy: f32, stiffness: f32, length_scale: f32, exponent: f32) -> f32 {
+    let l = length_scale;
+    let potential = (d / l).powf(exponent + 1.0);
+    let kinetic = (exponent + 1.0) * energy / (stiffness * l * l).max(f32::MIN_POSITIVE);
+    l * (potential + kinetic).powf(1.0 / (exponent + 1.0))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The largest singular value of the Jacobian of `f(d) = (|d|/L)^(p−1) d` at `d`, by
+    /// central differences.
+    fn jacobian_norm(d: Vec3, l: f32, p: f32) -> f32 {
+        let f = |d: Vec3| d.as_dvec3() * pull_scale(d.length(), l, p) as f64;
+        let eps = d.length() * 1e-3;
+        let columns: Vec<bevy::math::DVec3> = [Vec3::X, Vec3::Y, Vec3::Z]
+            .iter()
+            .map(|&e| (f(d + e * eps) - f(d - e * eps)) / (2.0 * eps as f64))
+            .collect();
+        let j = bevy::math::DMat3::from_cols(columns[0], columns[1], columns[2]);
+        // Power iteration on JᵀJ.
+        let mut v = bevy::math::DVec3::new(0.3, 0.5, 0.8).normalize();
+        for _ in 0..200 {
+            v = (j.transpose() * (j * v)).normalize();
+        }
+        (j * v).length() as f32
+    }
+
+    #[test]
+    fn the_reach_of_a_pull_is_where_its_kinetic_energy_runs_out() {
+        // A particle on a fixed goal's pull, released at d0 with speed v toward nothing:
+        // integrate the 1-D motion finely and compare its farthest point with the reach.
+        let (alpha, l, m) = (50.0f32, 0.02f32, 1e-4f32);
+        for p in [1.5f32, 2.0, 3.0] {
+            let (mut x, mut v) = (0.01f64, 0.3f64);
+            let reach = pull_reach(x as f32, 0.5 * m * (v * v) as f32, alpha, l, p) as f64;
+            let mut farthest = x;
+            let h = 1e-7;
+            for _ in 0..2_000_000 {
+                let a = -(alpha as f64) * (x / l as f64).powf(p as f64 - 1.0) * x / m as f64;
+                v += a * h;
+                x += v * h;
+                farthest = farthest.max(x);
+                if v < 0.0 {
+                    break;
+                }
+            }
+            assert!(
+                (farthest - reach).abs() < 1e-3 * reach,
+                "p {p}: {farthest} vs {reach}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_pull_bound_covers_its_stiffness_along_and_across_the_pull() {
+        // For p < 1 the pull is stiffer across d than along it; a bound from the axial
+        // stiffness p·(d/L)^(p−1) alone is too small by 1/p.
+        let l = 0.05;
+        for p in [0.5, 0.75, 1.0, 2.0, 3.0] {
+            for ratio in [0.01, 0.1, 0.3, 1.0, 2.5] {
+                let d = Vec3::new(0.6, -0.3, 0.74).normalize() * (ratio * l);
+                let exact = jacobian_norm(d, l, p);
+                let bound = pull_stiffness(d.length(), l, p);
+                assert!(
+                    bound >= exact * 0.999 && bound <= exact * 1.01,
+                    "p {p}, d/L {ratio}: bound {bound}, largest stiffness {exact}"
+                );
+            }
+        }
+    }
+}
