@@ -122,21 +122,7 @@ impl ClothSolver {
         self.substep_index += 1;
         let t = self.substep_index as f32 / self.substeps.max(1) as f32;
         let h = self.h;
-        let p = &mut self.particles;
-        for (k, &i) in self.pins.iter().enumerate() {
-            let i = i as usize;
-            let target = self.pin_from[k].lerp(self.pin_to[k], t);
-            p.previous[i] = p.position[i];
-            p.velocity[i] = (target - p.position[i]) / h;
-            p.position[i] = target;
-        }
-        if let Some(g) = self.grab {
-            let i = g.particle as usize;
-            let target = g.from.lerp(g.target, t);
-            p.previous[i] = p.position[i];
-            p.velocity[i] = (target - p.position[i]) / h;
-            p.position[i] = target;
-        }
+        self.drive(t);
         // Strain limiting corrects springs; a model without acting springs has none.
         if let (Some(limit), Model::MassSpring) = (self.params.strain_limit, self.params.model) {
             self.limit_strain(limit, h);

@@ -13,6 +13,7 @@
 
 mod collide;
 mod diagnostics;
+mod drivers;
 mod forces;
 mod integrate;
 mod interact;
@@ -361,31 +362,6 @@ impl ClothSolver {
         }
         self.torn_this_step.clear();
         n
-    }
-
-    /// Seam springs shrink from their starting gap to `seam_rest_length` over `sew_time`
-    /// seconds of simulated time (a tailor sewing the pieces together).
-    fn sew(&mut self) {
-        let s = &self.params.springs;
-        let progress = if s.sew_time > 0.0 {
-            (self.time / s.sew_time).min(1.0)
-        } else {
-            1.0
-        };
-        let seams = self.springs.ranges[SpringKind::Seam as usize].clone();
-        for (rest, &start) in self.springs.rest_length[seams]
-            .iter_mut()
-            .zip(&self.seam_start)
-        {
-            *rest = start + (s.seam_rest_length - start) * progress;
-        }
-    }
-
-    /// True while the seams of a garment are still being sewn (see `sew_time`).
-    pub fn sewing(&self) -> bool {
-        !self.seam_start.is_empty()
-            && self.time < self.params.springs.sew_time
-            && self.params.springs.seam.effective() > 0.0
     }
 
     /// Finishes a step: springs stretched past the tear ratio break and hide the faces
