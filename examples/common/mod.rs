@@ -8,6 +8,7 @@ use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_dis
 use bevy_cloth::prelude::*;
 use bevy_egui::EguiPlugin;
 use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
+use clap::Parser;
 
 pub mod inspector;
 pub mod tools;
@@ -56,9 +57,10 @@ pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
         .run();
 }
 
-/// Options every example accepts: `--scene FILE`, `--set key=value` (repeatable, see
-/// `ClothScene::apply_override`), and `--screenshot PATH --frames N` (repeatable: one PNG
-/// per pair, then exit; also `CLOTH_SCREENSHOT` / `CLOTH_FRAMES` for one).
+/// Options every example accepts (`cargo run --example curtain -- --help`): `--scene FILE`,
+/// `--set key=value` (repeatable, see `ClothScene::apply_override`), `--screenshot PATH
+/// --frames N` (repeatable: one PNG per pair, then exit; also `CLOTH_SCREENSHOT` /
+/// `CLOTH_FRAMES` for one) and `--yaw DEGREES`.
 #[derive(Resource, Clone, Debug)]
 pub struct ExampleArgs {
     /// The scene file to load.
@@ -72,65 +74,72 @@ pub struct ExampleArgs {
     pub yaw_degrees: f32,
 }
 
+/// The options every bevy_cloth example takes.
+#[derive(Parser)]
+struct Cli {
+    /// The scene file (RON); each example has its own default.
+    #[arg(long, value_name = "FILE")]
+    scene: Option<PathBuf>,
+    /// Overrides a scene field, e.g. `environment.wind.strength=0` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    /// Saves a PNG of the window at the matching `--frames` (repeatable, in pairs).
+    #[arg(long, value_name = "PATH")]
+    screenshot: Vec<PathBuf>,
+    /// The frame of the matching `--screenshot` (120 when missing).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+    frames: Vec<u32>,
+    /// The camera's starting angle about the vertical, degrees.
+    #[arg(long, default_value_t = 20.0, allow_negative_numbers = true, value_parser = finite)]
+    yaw: f32,
+}
+
+fn finite(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|y| y.is_finite())
+        .ok_or_else(|| format!("`{text}` is not an angle in degrees"))
+}
+
 impl ExampleArgs {
     /// Reads the options from the command line and environment; `default_scene` is the
     /// scene file used without `--scene`. Exits with code 2 on a malformed option.
     pub fn parse(default_scene: &str) -> Self {
+        let cli = Cli::try_parse().unwrap_or_else(|e| {
+            if !e.use_stderr() {
+                let _ = e.print();
+                std::process::exit(0);
+            }
+            let text = e.render().to_string();
+            let line: Vec<&str> = text
+                .lines()
+                .map(str::trim)
+                .take_while(|l| !l.is_empty() && !l.starts_with("Usage:"))
+                .collect();
+            fail(line.join(" ").trim_start_matches("error: "))
+        });
         let env_frames = std::env::var("CLOTH_FRAMES")
             .ok()
             .and_then(|f| f.parse().ok());
-        let mut args = ExampleArgs {
-            scene: PathBuf::from(default_scene),
-            overrides: Vec::new(),
-            screenshots: std::env::var_os("CLOTH_SCREENSHOT")
-                .map(|p| vec![(env_frames.unwrap_or(120), PathBuf::from(p))])
-                .unwrap_or_default(),
-            yaw_degrees: 20.0,
-        };
-        let mut pending_path: Option<PathBuf> = None;
-        let mut pending_frames: Option<u32> = None;
-        let mut it = std::env::args().skip(1);
-        while let Some(flag) = it.next() {
-            let mut value = || {
-                it.next()
-                    .unwrap_or_else(|| fail(&format!("{flag} needs a value")))
-            };
-            match flag.as_str() {
-                "--scene" => args.scene = PathBuf::from(value()),
-                "--set" => args.overrides.push(value()),
-                "--screenshot" => pending_path = Some(PathBuf::from(value())),
-                "--yaw" => {
-                    let v = value();
-                    args.yaw_degrees = v
-                        .parse()
-                        .ok()
-                        .filter(|y: &f32| y.is_finite())
-                        .unwrap_or_else(|| {
-                            fail(&format!("--yaw: `{v}` is not an angle in degrees"))
-                        });
-                }
-                "--frames" => {
-                    let v = value();
-                    let frames = v.parse().ok().filter(|f| *f > 0);
-                    pending_frames = Some(frames.unwrap_or_else(|| {
-                        fail(&format!("--frames: `{v}` is not a whole number > 0"))
-                    }));
-                }
-                other => fail(&format!(
-                    "unknown option `{other}` (try --scene, --set, --screenshot, --frames, --yaw)"
-                )),
-            }
-            if pending_path.is_some() && pending_frames.is_some() {
-                let (frames, path) = (pending_frames.take(), pending_path.take());
-                args.screenshots.extend(frames.zip(path));
-            }
+        let default_frames = env_frames.unwrap_or(120);
+        let mut screenshots: Vec<(u32, PathBuf)> = cli
+            .screenshot
+            .into_iter()
+            .enumerate()
+            .map(|(k, path)| (cli.frames.get(k).copied().unwrap_or(default_frames), path))
+            .collect();
+        if screenshots.is_empty()
+            && let Some(path) = std::env::var_os("CLOTH_SCREENSHOT")
+        {
+            screenshots.push((default_frames, PathBuf::from(path)));
         }
-        if let Some(path) = pending_path {
-            args.screenshots
-                .push((pending_frames.or(env_frames).unwrap_or(120), path));
+        screenshots.sort_by_key(|(frame, _)| *frame);
+        ExampleArgs {
+            scene: cli.scene.unwrap_or_else(|| PathBuf::from(default_scene)),
+            overrides: cli.set,
+            screenshots,
+            yaw_degrees: cli.yaw,
         }
-        args.screenshots.sort_by_key(|(frame, _)| *frame);
-        args
     }
 
     /// Loads the scene and applies the overrides, or exits with code 2 and the error
