@@ -56,8 +56,9 @@ pub mod prelude {
     pub use crate::error::ClothError;
     pub use crate::headless::{SceneRun, headless_app};
     pub use crate::params::{
-        ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
-        RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
+        ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
+        PatchTargets, RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps,
+        Wind, WindField,
     };
     pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};
     pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError};

@@ -394,6 +394,77 @@ pub enum Model {
     Patches(PatchParams),
 }
 
+impl Model {
+    /// Which model this is, without its parameters.
+    pub fn kind(&self) -> ModelKind {
+        match self {
+            Model::MassSpring => ModelKind::MassSpring,
+            Model::ShapeMatching(_) => ModelKind::ShapeMatching,
+            Model::Patches(_) => ModelKind::Patches,
+        }
+    }
+}
+
+/// Which model, without its parameters: the one identifier every front end uses (the
+/// command line's `--model`, the lab's tables and charts, the inspector's list), written
+/// `mass-spring`, `shape-matching`, `patches`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Reflect, Serialize, Deserialize)]
+pub enum ModelKind {
+    /// [`Model::MassSpring`].
+    MassSpring,
+    /// [`Model::ShapeMatching`].
+    ShapeMatching,
+    /// [`Model::Patches`].
+    Patches,
+}
+
+impl ModelKind {
+    /// Every model, in the seeds' order.
+    pub const ALL: [ModelKind; 3] = [
+        ModelKind::MassSpring,
+        ModelKind::ShapeMatching,
+        ModelKind::Patches,
+    ];
+
+    /// The model's name: `mass-spring`, `shape-matching` or `patches`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            ModelKind::MassSpring => "mass-spring",
+            ModelKind::ShapeMatching => "shape-matching",
+            ModelKind::Patches => "patches",
+        }
+    }
+
+    /// The model with its default parameters.
+    pub fn default_model(self) -> Model {
+        match self {
+            ModelKind::MassSpring => Model::MassSpring,
+            ModelKind::ShapeMatching => Model::ShapeMatching(ShapeMatchingParams::default()),
+            ModelKind::Patches => Model::Patches(PatchParams::default()),
+        }
+    }
+}
+
+impl std::fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for ModelKind {
+    type Err = ClothError;
+
+    fn from_str(name: &str) -> Result<Self, ClothError> {
+        ModelKind::ALL
+            .into_iter()
+            .find(|k| k.name() == name)
+            .ok_or_else(|| ClothError::UnknownModel {
+                name: name.to_string(),
+                known: "mass-spring, shape-matching, patches",
+            })
+    }
+}
+
 /// Parameters of the model of one cloth. Edits take effect on the next step.
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

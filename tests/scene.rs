@@ -164,3 +164,16 @@ fn the_per_part_targets_still_read_under_their_old_name() {
     assert_eq!(old, PatchTargets::PerPart);
     assert_eq!(new, PatchTargets::PerPart);
 }
+
+#[test]
+fn one_model_identifier_reads_back_what_it_writes() {
+    for kind in ModelKind::ALL {
+        assert_eq!(kind.name().parse::<ModelKind>(), Ok(kind));
+        assert_eq!(kind.to_string(), kind.name());
+        assert_eq!(kind.default_model().kind(), kind);
+    }
+    assert!(matches!(
+        "springs".parse::<ModelKind>(),
+        Err(ClothError::UnknownModel { .. })
+    ));
+}

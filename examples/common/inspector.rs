@@ -332,22 +332,13 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             .text("node mass, g"),
     );
     p.node_mass = grams * 1e-3;
-    let names = ["mass-spring", "shape matching", "patches"];
-    let current = match p.model {
-        Model::MassSpring => 0,
-        Model::ShapeMatching(_) => 1,
-        Model::Patches(_) => 2,
-    };
+    let current = p.model.kind();
     egui::ComboBox::from_label("model")
-        .selected_text(names[current])
+        .selected_text(current.name())
         .show_ui(ui, |ui| {
-            for (k, name) in names.iter().enumerate() {
-                if ui.selectable_label(k == current, *name).clicked() && k != current {
-                    p.model = match k {
-                        0 => Model::MassSpring,
-                        1 => Model::ShapeMatching(ShapeMatchingParams::default()),
-                        _ => Model::Patches(PatchParams::default()),
-                    };
+            for kind in ModelKind::ALL {
+                if ui.selectable_label(kind == current, kind.name()).clicked() && kind != current {
+                    p.model = kind.default_model();
                 }
             }
         });

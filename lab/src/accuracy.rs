@@ -22,7 +22,7 @@ use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
 use bevy_cloth::params::{
-    ClothParams, Integrator, Model, PatchParams, ShapeMatchingParams, Substeps,
+    ClothParams, Integrator, Model, ModelKind, PatchParams, ShapeMatchingParams, Substeps,
 };
 use bevy_cloth::scene::ClothScene;
 
@@ -77,7 +77,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
                 Substeps::Auto { .. } => "auto substeps".into(),
             };
             out.push(Config {
-                model: "mass-spring",
+                model: ModelKind::MassSpring.name(),
                 label: format!("{name}, {steps}"),
                 params: ClothParams {
                     model: Model::MassSpring,
@@ -92,7 +92,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
         // The same step with the limiter run to the reference's tolerance: how much of a
         // configuration's error is its limiter's (4 sweeps make a softer material).
         out.push(Config {
-            model: "mass-spring",
+            model: ModelKind::MassSpring.name(),
             label: "Verlet, auto substeps, limiter converged".into(),
             params: ClothParams {
                 model: Model::MassSpring,
@@ -109,7 +109,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
         for factor in [1.0, 4.0, 16.0, 64.0] {
             let stiffness = k * factor;
             out.push(Config {
-                model: "shape-matching",
+                model: ModelKind::ShapeMatching.name(),
                 label: format!("{clusters}×{clusters} clusters, α = {stiffness} N/m"),
                 params: ClothParams {
                     model: Model::ShapeMatching(ShapeMatchingParams {
@@ -127,7 +127,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
     }
     for size in [1, 2, 4, 8] {
         out.push(Config {
-            model: "patches",
+            model: ModelKind::Patches.name(),
             label: format!("{size}×{size} parts"),
             params: ClothParams {
                 model: Model::Patches(PatchParams {

@@ -29,8 +29,8 @@ use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
 use bevy_cloth::params::{
-    ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, ShapeMatchingParams,
-    SpringFamily, SpringParams, Substeps, Wind,
+    ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
+    ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind,
 };
 use bevy_cloth::shape::{ClothShape, Pins};
 use bevy_cloth::solver::{self, SpringKind};
@@ -43,7 +43,11 @@ pub const MASS: [f32; 4] = [1e-6, 1e-5, 1e-4, 1e-3];
 pub const TIMESTEP: [f32; 6] = [0.001, 0.002, 0.004, 0.008, 0.016, 0.033];
 
 /// The models of the grid.
-pub const MODELS: [&str; 3] = ["mass-spring", "shape-matching", "patches"];
+pub const MODELS: [&str; 3] = [
+    ModelKind::MassSpring.name(),
+    ModelKind::ShapeMatching.name(),
+    ModelKind::Patches.name(),
+];
 
 /// The models of the nonlinear regimes: the grid's three, and the pulls at exponents 0.5
 /// and 3 and shape matching's velocity update (α = 0.5 of the way per substep).
@@ -105,21 +109,21 @@ pub fn params(
         "p=3" => 3.0,
         _ => return None,
     };
-    let model = match (name, variant) {
-        ("mass-spring", "") => Model::MassSpring,
-        ("shape-matching", "velocity") => Model::ShapeMatching(ShapeMatchingParams {
+    let model = match (name.parse::<ModelKind>().ok()?, variant) {
+        (ModelKind::MassSpring, "") => Model::MassSpring,
+        (ModelKind::ShapeMatching, "velocity") => Model::ShapeMatching(ShapeMatchingParams {
             update: GoalUpdate::Velocity,
             stiffness: 0.5,
             damping: 0.0,
             ..ShapeMatchingParams::default()
         }),
-        ("shape-matching", _) => Model::ShapeMatching(ShapeMatchingParams {
+        (ModelKind::ShapeMatching, _) => Model::ShapeMatching(ShapeMatchingParams {
             stiffness: k,
             exponent,
             damping: 0.0,
             ..ShapeMatchingParams::default()
         }),
-        ("patches", v) if v != "velocity" => Model::Patches(PatchParams {
+        (ModelKind::Patches, v) if v != "velocity" => Model::Patches(PatchParams {
             stiffness: k,
             exponent,
             particle_damping_ratio: 0.0,

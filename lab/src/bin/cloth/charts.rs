@@ -234,7 +234,7 @@ impl Chart for Bench<'_> {
 
 // ----- accuracy -----------------------------------------------------------------------
 
-const ACCURACY_MODELS: [&str; 3] = ["mass-spring", "shape-matching", "patches"];
+const ACCURACY_MODELS: [&str; 3] = bevy_cloth_lab::stability::MODELS;
 
 /// `docs/accuracy.png`: one panel per scene, cost (ms per simulated second) against
 /// error, log-log; circles mass-spring, triangles shape matching, squares patches; the

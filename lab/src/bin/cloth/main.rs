@@ -12,7 +12,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use bevy_cloth::prelude::*;
@@ -54,9 +54,9 @@ struct RunArgs {
     /// Steps to run.
     #[arg(long, default_value_t = 300)]
     steps: usize,
-    /// Replaces every cloth's model.
-    #[arg(long, value_enum)]
-    model: Option<ModelArg>,
+    /// Replaces every cloth's model: mass-spring, shape-matching or patches.
+    #[arg(long, value_parser = model_kind)]
+    model: Option<ModelKind>,
     /// Overrides a scene field, e.g. `environment.wind.strength=0` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
@@ -66,14 +66,6 @@ struct RunArgs {
     /// Dumps every K steps.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = at_least_one)]
     every: usize,
-}
-
-/// A model name on the command line.
-#[derive(Clone, Copy, ValueEnum)]
-enum ModelArg {
-    MassSpring,
-    ShapeMatching,
-    Patches,
 }
 
 /// What every measuring verb can write besides its tables.
@@ -168,6 +160,10 @@ fn main() -> ExitCode {
     }
 }
 
+fn model_kind(text: &str) -> Result<ModelKind, String> {
+    text.parse().map_err(|e: ClothError| e.to_string())
+}
+
 fn at_least_one(text: &str) -> Result<usize, String> {
     match text.parse::<usize>() {
         Ok(n) if n >= 1 => Ok(n),
@@ -243,13 +239,9 @@ fn run(args: RunArgs) -> Result<(), String> {
     let scene_path = &args.scene;
     let mut scene = ClothScene::load(scene_path).map_err(|e| e.to_string())?;
     if let Some(model) = args.model {
-        let name = match model {
-            ModelArg::MassSpring => "MassSpring",
-            ModelArg::ShapeMatching => "ShapeMatching",
-            ModelArg::Patches => "Patches",
-        };
+        // `{model:?}` is the variant's name in a scene file (`MassSpring`, …).
         scene
-            .apply_override(&format!("cloth.params.model={name}"))
+            .apply_override(&format!("cloth.params.model={model:?}"))
             .map_err(|e| e.to_string())?;
     }
     for spec in &args.set {
