@@ -61,6 +61,6 @@ pub mod prelude {
         Wind, WindField,
     };
     pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};
-    pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError};
+    pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError, SpawnedScene};
     pub use crate::shape::{ClothShape, Pins};
 }

@@ -18,7 +18,12 @@ use bevy::reflect::{GetPath, Reflect};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-use crate::components::{Cloth, ClothCollider};
+use bevy::ecs::entity::Entity;
+use bevy::ecs::name::Name;
+use bevy::ecs::system::Commands;
+use bevy::time::{Fixed, Time};
+
+use crate::components::{Cloth, ClothCollider, ClothEnvironment, ClothStats};
 use crate::params::Environment;
 
 /// A scene: the cloths, their world and the timestep.
@@ -152,6 +157,54 @@ pub enum SceneError {
         /// What is wrong.
         message: String,
     },
+}
+
+/// The entities [`ClothScene::spawn`] made, in the scene's order.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SpawnedScene {
+    /// One per entry of `cloths`.
+    pub cloths: Vec<Entity>,
+    /// One per entry of `colliders`.
+    pub colliders: Vec<Entity>,
+}
+
+impl ClothScene {
+    /// Spawns the scene: each cloth (its [`Cloth`], `Name`, `Transform` and
+    /// [`ClothStats`]) and each collider (its [`ClothCollider`], `Name`, `Transform`), and
+    /// sets the environment and the fixed timestep. How they look (materials, collider
+    /// meshes) is the app's to add to the returned entities.
+    pub fn spawn(&self, commands: &mut Commands) -> SpawnedScene {
+        let colliders = self
+            .colliders
+            .iter()
+            .map(|entry| {
+                commands
+                    .spawn((
+                        entry.collider,
+                        entry.transform(),
+                        Name::new(entry.name.clone()),
+                    ))
+                    .id()
+            })
+            .collect();
+        commands.insert_resource(ClothEnvironment(self.environment));
+        commands.insert_resource(Time::<Fixed>::from_seconds(self.timestep as f64));
+        let cloths = self
+            .cloths
+            .iter()
+            .map(|entry| {
+                commands
+                    .spawn((
+                        entry.cloth.clone(),
+                        ClothStats::default(),
+                        Name::new(entry.name.clone()),
+                        entry.transform(),
+                    ))
+                    .id()
+            })
+            .collect();
+        SpawnedScene { cloths, colliders }
+    }
 }
 
 impl ClothScene {

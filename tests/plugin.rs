@@ -540,3 +540,33 @@ fn collider_entities_keep_cloth_out_and_follow_their_transform() {
             if center.distance(Vec3::new(1.0, 0.5, 0.0)) < 1e-6
     )));
 }
+
+#[test]
+fn a_scene_spawns_its_cloths_colliders_and_world() {
+    let scene = ClothScene::load("assets/scenes/tshirt.ron").unwrap();
+    let mut app = app();
+    let spawned = scene.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    assert_eq!(spawned.cloths.len(), scene.cloths.len());
+    assert_eq!(spawned.colliders.len(), scene.colliders.len());
+    for _ in 0..3 {
+        app.update();
+    }
+    for (entry, &entity) in scene.cloths.iter().zip(&spawned.cloths) {
+        let sim = app.world().get::<ClothSimulation>(entity).expect("built");
+        assert!(sim.solver.particle_count() > 0);
+        assert_eq!(
+            app.world().get::<Name>(entity).map(|n| n.as_str()),
+            Some(entry.name.as_str())
+        );
+    }
+    for (entry, &entity) in scene.colliders.iter().zip(&spawned.colliders) {
+        assert_eq!(app.world().get::<ClothCollider>(entity), Some(&entry.collider));
+    }
+    assert_eq!(
+        app.world().resource::<ClothEnvironment>().0,
+        scene.environment
+    );
+    let fixed = app.world().resource::<Time<Fixed>>().timestep();
+    assert!((fixed.as_secs_f32() - scene.timestep).abs() < 1e-6);
+}

@@ -181,12 +181,8 @@ pub fn spawn_scene(
     meshes: &mut Assets<Mesh>,
     materials: &mut Assets<StandardMaterial>,
 ) {
-    for entry in &scene.colliders {
-        let mut entity = commands.spawn((
-            entry.collider,
-            entry.transform(),
-            Name::new(entry.name.clone()),
-        ));
+    let spawned = scene.spawn(commands);
+    for (entry, entity) in scene.colliders.iter().zip(spawned.colliders) {
         if let Some([r, g, b]) = entry.color {
             let mesh = match entry.collider.shape {
                 ColliderKind::Sphere { radius } => Sphere::new(radius).mesh().build(),
@@ -196,7 +192,7 @@ pub fn spawn_scene(
                 } => Capsule3d::new(radius, 2.0 * half_length).mesh().build(),
                 ColliderKind::Plane => Plane3d::default().mesh().size(4.0, 4.0).build(),
             };
-            entity.insert((
+            commands.entity(entity).insert((
                 Mesh3d(meshes.add(mesh)),
                 MeshMaterial3d(materials.add(StandardMaterial {
                     base_color: Color::linear_rgb(r, g, b),
@@ -206,21 +202,14 @@ pub fn spawn_scene(
             ));
         }
     }
-    commands.insert_resource(ClothEnvironment(scene.environment));
-    commands.insert_resource(Time::<Fixed>::from_seconds(scene.timestep as f64));
-    for entry in &scene.cloths {
+    for (entry, entity) in scene.cloths.iter().zip(spawned.cloths) {
         let look = inspector::ClothLook {
             piece_colors: entry.piece_colors.clone(),
             ..inspector::ClothLook::from_color(entry.color)
         };
-        commands.spawn((
-            entry.cloth.clone(),
-            ClothStats::default(),
-            Name::new(entry.name.clone()),
-            entry.transform(),
-            MeshMaterial3d(materials.add(look.material())),
-            look,
-        ));
+        commands
+            .entity(entity)
+            .insert((MeshMaterial3d(materials.add(look.material())), look));
     }
 }
 
