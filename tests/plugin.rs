@@ -561,7 +561,10 @@ fn a_scene_spawns_its_cloths_colliders_and_world() {
         );
     }
     for (entry, &entity) in scene.colliders.iter().zip(&spawned.colliders) {
-        assert_eq!(app.world().get::<ClothCollider>(entity), Some(&entry.collider));
+        assert_eq!(
+            app.world().get::<ClothCollider>(entity),
+            Some(&entry.collider)
+        );
     }
     assert_eq!(
         app.world().resource::<ClothEnvironment>().0,

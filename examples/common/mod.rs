@@ -110,13 +110,7 @@ impl ExampleArgs {
                 let _ = e.print();
                 std::process::exit(0);
             }
-            let text = e.render().to_string();
-            let line: Vec<&str> = text
-                .lines()
-                .map(str::trim)
-                .take_while(|l| !l.is_empty() && !l.starts_with("Usage:"))
-                .collect();
-            fail(line.join(" ").trim_start_matches("error: "))
+            fail(&bevy_cloth::error::one_line(&e.render().to_string()))
         });
         let env_frames = std::env::var("CLOTH_FRAMES")
             .ok()

@@ -134,14 +134,8 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             // One line naming the problem, as for every other bad input.
-            // (clap's message up to its usage block, folded onto one line).
-            let text = e.render().to_string();
-            let line: Vec<&str> = text
-                .lines()
-                .map(str::trim)
-                .take_while(|l| !l.is_empty() && !l.starts_with("Usage:"))
-                .collect();
-            eprintln!("error: {}", line.join(" ").trim_start_matches("error: "));
+            let line = bevy_cloth::error::one_line(&e.render().to_string());
+            eprintln!("error: {line}");
             return ExitCode::from(2);
         }
     };
