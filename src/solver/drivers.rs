@@ -10,17 +10,13 @@ impl ClothSolver {
     /// `t` through the step, with the velocity that takes them there this substep.
     pub(super) fn drive(&mut self, t: f32) {
         let h = self.h;
-        let p = &mut self.particles;
-        let mut place = |i: usize, target: bevy::math::Vec3| {
-            p.previous[i] = p.position[i];
-            p.velocity[i] = (target - p.position[i]) / h;
-            p.position[i] = target;
-        };
         for (k, &i) in self.pins.iter().enumerate() {
-            place(i as usize, self.pin_from[k].lerp(self.pin_to[k], t));
+            let target = self.pin_from[k].lerp(self.pin_to[k], t);
+            self.particles.move_to(i as usize, target, h);
         }
         if let Some(g) = self.grab {
-            place(g.particle as usize, g.from.lerp(g.target, t));
+            self.particles
+                .move_to(g.particle as usize, g.from.lerp(g.target, t), h);
         }
     }
 

@@ -1,6 +1,6 @@
 //! Phase 1 of a substep: every force from the old state.
 
-use super::{ClothSolver, SpringKind, pull_scale};
+use super::{ClothSolver, Particles, SpringKind, Springs, pull_scale};
 use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams};
 
 impl ClothSolver {
@@ -45,54 +45,15 @@ impl ClothSolver {
             if k == 0.0 {
                 continue;
             }
-            self.spring_forces(self.springs.ranges[kind as usize].clone(), k, damping);
-        }
-    }
-
-    /// Hooke springs `F = k (|l| − l0) l/|l|` (seed 002 eq. 1.4) plus damping along the
-    /// spring. Each spring pushes its ends with equal and opposite forces; dividing by each
-    /// end's mass in `integrate` shares the motion by inverse mass, as seed 000 eq. 2 asks.
-    fn spring_forces(&mut self, range: std::ops::Range<usize>, k: f32, damping: f32) {
-        // A particle cloth's springs all take their family's constant; only the patch
-        // model's part lattice scales them one by one. Two instances of one loop, so the
-        // common case reads no per-spring factor.
-        match self.springs.stiffness_scale.take() {
-            None => self.spring_forces_scaled(range, k, damping, |_| 1.0),
-            Some(scale) => {
-                self.spring_forces_scaled(range, k, damping, |i| scale[i]);
-                self.springs.stiffness_scale = Some(scale);
+            let range = self.springs.ranges[kind as usize].clone();
+            // A particle cloth's springs all take their family's constant; only the patch
+            // model's part lattice scales them one by one. Two instances of one loop, so
+            // the common case reads no per-spring factor.
+            let (s, p) = (&self.springs, &mut self.particles);
+            match s.stiffness_scale.as_deref() {
+                None => spring_forces(s, p, range, k, damping, |_| 1.0),
+                Some(scale) => spring_forces(s, p, range, k, damping, |i| scale[i]),
             }
-        }
-    }
-
-    #[inline(always)]
-    fn spring_forces_scaled(
-        &mut self,
-        range: std::ops::Range<usize>,
-        k: f32,
-        damping: f32,
-        scale: impl Fn(usize) -> f32,
-    ) {
-        let s = &self.springs;
-        let p = &mut self.particles;
-        for idx in range {
-            if !s.alive[idx] {
-                continue;
-            }
-            let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
-            let d = p.position[b] - p.position[a];
-            let len = d.length();
-            if len <= f32::EPSILON {
-                continue;
-            }
-            let dir = d / len;
-            let mut magnitude = k * scale(idx) * (len - s.rest_length[idx]);
-            if damping > 0.0 {
-                magnitude += damping * (p.velocity[b] - p.velocity[a]).dot(dir);
-            }
-            let f = dir * magnitude;
-            p.force[a] += f;
-            p.force[b] -= f;
         }
     }
 
@@ -166,5 +127,39 @@ impl ClothSolver {
         if let Some(f) = self.particles.force.get_mut(i) {
             *f += force;
         }
+    }
+}
+
+/// Hooke springs `F = k (|l| − l0) l/|l|` (seed 002 eq. 1.4) plus damping along the
+/// spring, over the springs `range` of `s`, each scaled by `scale(spring)`. Each spring
+/// pushes its ends with equal and opposite forces; dividing by each end's mass in
+/// `integrate` shares the motion by inverse mass, as seed 000 eq. 2 asks.
+#[inline(always)]
+fn spring_forces(
+    s: &Springs,
+    p: &mut Particles,
+    range: std::ops::Range<usize>,
+    k: f32,
+    damping: f32,
+    scale: impl Fn(usize) -> f32,
+) {
+    for idx in range {
+        if !s.alive[idx] {
+            continue;
+        }
+        let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
+        let d = p.position[b] - p.position[a];
+        let len = d.length();
+        if len <= f32::EPSILON {
+            continue;
+        }
+        let dir = d / len;
+        let mut magnitude = k * scale(idx) * (len - s.rest_length[idx]);
+        if damping > 0.0 {
+            magnitude += damping * (p.velocity[b] - p.velocity[a]).dot(dir);
+        }
+        let f = dir * magnitude;
+        p.force[a] += f;
+        p.force[b] -= f;
     }
 }

@@ -76,10 +76,7 @@ impl ClothSolver {
                 patches.compute_targets(&p.position, &patch);
                 for i in 0..p.position.len() {
                     if p.inv_mass[i] != 0.0 {
-                        let target = patches.targets[i];
-                        p.previous[i] = p.position[i];
-                        p.velocity[i] = (target - p.position[i]) / h;
-                        p.position[i] = target;
+                        p.move_to(i, patches.targets[i], h);
                     }
                 }
                 return;

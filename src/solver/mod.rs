@@ -346,9 +346,6 @@ impl ClothSolver {
         {
             patches.set_params(&self.params, &patch, n);
             patches.parts.set_frame(self.frame);
-            // The part centres meet the colliders too: otherwise the targets sink into a
-            // collider and pull the particles in after it.
-            patches.parts.set_colliders(self.colliders.iter().copied());
             patches.parts.begin_step(dt);
         }
         // Pins move from where they are to where the frame puts them, over the substeps.
@@ -467,6 +464,7 @@ impl ClothSolver {
                         )
                     {
                         patches.adopt_state(&self.particles);
+                        patches.parts.set_colliders(self.colliders.iter().copied());
                         self.model = ModelState::Patches(Box::new(patches));
                     }
                 }
@@ -580,6 +578,11 @@ impl ClothSolver {
     pub fn set_colliders(&mut self, colliders: impl IntoIterator<Item = Collider>) {
         self.colliders.clear();
         self.colliders.extend(colliders);
+        // The part centres meet the colliders too: otherwise the targets sink into a
+        // collider and pull the particles in after it.
+        if let Some(patches) = self.model.patches_mut() {
+            patches.parts.set_colliders(self.colliders.iter().copied());
+        }
     }
 
     /// The colliders in use.

@@ -136,12 +136,10 @@ impl PartSplit {
         (pw, ph): (u32, u32),
         bilinear: bool,
     ) -> (Vec<u32>, Vec<Anchor>) {
-        let nx = w.div_ceil(pw);
         let mut pinned_parts = Vec::new();
         let mut anchors = Vec::new();
         for (slot, &k) in pins.iter().enumerate() {
-            let (i, j) = (k % w, k / w);
-            let part = (j / ph) * nx + i / pw;
+            let part = part_index(k, w, (pw, ph));
             if self.lumps[part as usize] == 1.0 || !bilinear {
                 pinned_parts.push(part);
             } else {
@@ -156,6 +154,13 @@ impl PartSplit {
         pinned_parts.dedup();
         (pinned_parts, anchors)
     }
+}
+
+/// The point of the centres `c` at a particle's bilinear stencil (see [`bilinear_stencil`]).
+#[inline]
+fn bilinear_at(c: &[Vec3], &([a, b, d, e], s, t): &([u32; 4], f32, f32)) -> Vec3 {
+    let [a, b, d, e] = [a, b, d, e].map(|k| c[k as usize]);
+    (a * (1.0 - s) + b * s) * (1.0 - t) + (d * (1.0 - s) + e * s) * t
 }
 
 /// Per particle of a `w×h` grid cut into parts of `part_size`: the four part centres
@@ -301,14 +306,13 @@ impl Patches {
         if self.bilinear(patch) {
             // One pass: each new target and its velocity together.
             let c = &self.parts.particles.position;
-            for ((target, v), &([a, b, d, e], s, t)) in self
+            for ((target, v), stencil) in self
                 .targets
                 .iter_mut()
                 .zip(&mut self.target_velocity)
                 .zip(&self.stencil)
             {
-                let [a, b, d, e] = [a, b, d, e].map(|k| c[k as usize]);
-                let new = (a * (1.0 - s) + b * s) * (1.0 - t) + (d * (1.0 - s) + e * s) * t;
+                let new = bilinear_at(c, stencil);
                 *v = (new - *target) * inv_h;
                 *target = new;
             }
@@ -353,10 +357,8 @@ impl Patches {
 
     /// The part holding particle `i`.
     pub fn part_of(&self, i: u32) -> usize {
-        let (w, nx) = (self.grid.0, self.part_grid.0);
         let first = self.layout[0];
-        let (pw, ph) = (first.width, first.height);
-        (((i / w) / ph) * nx + (i % w) / pw) as usize
+        part_index(i, self.grid.0, (first.width, first.height)) as usize
     }
 
     /// Updates the lattice's parameters (springs, drag, integrator, tearing) and substeps.
@@ -395,9 +397,8 @@ impl Patches {
     pub fn compute_targets(&mut self, x: &[Vec3], patch: &PatchParams) {
         if self.bilinear(patch) {
             let c = &self.parts.particles.position;
-            for (target, &([a, b, d, e], s, t)) in self.targets.iter_mut().zip(&self.stencil) {
-                let [a, b, d, e] = [a, b, d, e].map(|k| c[k as usize]);
-                *target = (a * (1.0 - s) + b * s) * (1.0 - t) + (d * (1.0 - s) + e * s) * t;
+            for (target, stencil) in self.targets.iter_mut().zip(&self.stencil) {
+                *target = bilinear_at(c, stencil);
             }
             return;
         }
@@ -536,6 +537,12 @@ fn scale_for_aspect(springs: &mut topology::Springs, nx: u32, (pw, ph): (u32, u3
         })
         .collect();
     springs.stiffness_scale = Some(scale);
+}
+
+/// The part (lattice index) holding particle `k` of a grid `w` wide cut into parts of
+/// `pw × ph` (row by row, smaller parts at a non-dividing edge).
+fn part_index(k: u32, w: u32, (pw, ph): (u32, u32)) -> u32 {
+    (k / w / ph) * w.div_ceil(pw) + (k % w) / pw
 }
 
 fn part_particles(part: &Part, w: u32) -> impl Iterator<Item = usize> + '_ {

@@ -50,6 +50,15 @@ impl Particles {
         self.position.is_empty()
     }
 
+    /// Moves particle `i` to `target` kinematically over a substep of `h`: the velocity
+    /// that takes it there, and the previous position where it was.
+    #[inline]
+    pub fn move_to(&mut self, i: usize, target: Vec3, h: f32) {
+        self.previous[i] = self.position[i];
+        self.velocity[i] = (target - self.position[i]) / h;
+        self.position[i] = target;
+    }
+
     /// True when particle `i` is pinned.
     pub fn is_pinned(&self, i: usize) -> bool {
         self.inv_mass[i] == 0.0

@@ -116,19 +116,13 @@ impl ClothSolver {
         (0..p.len())
             .filter(|&i| p.inv_mass[i] > 0.0)
             .map(|i| {
-                let d = if exponent < 1.0 {
-                    0.0
-                } else if exponent > 1.0 {
+                // p ≤ 1: the peak at the goal (p = 1: the same stiffness everywhere).
+                let d = if exponent > 1.0 {
                     let energy = 0.5 * p.mass[i] * p.velocity[i].length_squared();
-                    pull_reach(
-                        targets[i].distance(p.position[i]),
-                        energy,
-                        stiffness,
-                        l,
-                        exponent,
-                    )
+                    let now = targets[i].distance(p.position[i]);
+                    pull_reach(now, energy, stiffness, l, exponent)
                 } else {
-                    0.0 // linear: the same stiffness everywhere
+                    0.0
                 };
                 2.0 * stiffness * pull_stiffness(d, l, exponent) * p.inv_mass[i]
             })
