@@ -25,14 +25,17 @@ fn grid(width: u32, height: u32, params: ClothParams, pins: Pins, frame: Affine3
     .unwrap()
 }
 
+/// The largest distance between corresponding points of `a` and `b`.
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f32 {
+    a.iter()
+        .zip(b)
+        .map(|(p, q)| p.distance(*q))
+        .fold(0.0, f32::max)
+}
+
 fn max_target_error(c: &mut ClothSolver) -> f32 {
     c.update_goals();
-    let targets = &c.patches().unwrap().targets;
-    targets
-        .iter()
-        .zip(c.positions())
-        .map(|(t, x)| t.distance(*x))
-        .fold(0.0, f32::max)
+    max_distance(&c.patches().unwrap().targets, c.positions())
 }
 
 /// A wiring check more than a validation: a part of one particle is that particle, so
@@ -72,12 +75,7 @@ fn one_by_one_parts_reduce_to_the_mass_spring_model() {
     for _ in 0..200 {
         springs.step(DT, &env);
         parts.step(DT, &env);
-        let gap = springs
-            .positions()
-            .iter()
-            .zip(parts.positions())
-            .map(|(a, b)| a.distance(*b))
-            .fold(0.0, f32::max);
+        let gap = max_distance(springs.positions(), parts.positions());
         worst = worst.max(gap);
     }
     assert!(worst < 1e-4, "1×1 parts drift {worst} m from mass-spring");
@@ -309,11 +307,7 @@ fn switching_to_patches_mid_motion_keeps_the_cloth_in_place_and_grabs_pull_parts
     params.model = Model::Patches(patch(4, 4));
     c.set_params(&params).unwrap();
     c.step(DT, &env);
-    let jump = before
-        .iter()
-        .zip(c.positions())
-        .map(|(a, b)| a.distance(*b))
-        .fold(0.0, f32::max);
+    let jump = max_distance(&before, c.positions());
     assert!(
         jump < 0.05,
         "switching models moved a particle by {jump} m in one step"
@@ -358,15 +352,6 @@ fn torn_part_springs_split_the_drawn_cloth() {
     assert!(c.is_finite());
 }
 
-/// The largest distance between corresponding particles of two cloths.
-fn max_gap(a: &ClothSolver, b: &ClothSolver) -> f32 {
-    a.positions()
-        .iter()
-        .zip(b.positions())
-        .map(|(p, q)| p.distance(*q))
-        .fold(0.0, f32::max)
-}
-
 #[test]
 fn a_free_falling_patch_cloth_falls_like_the_mass_spring_cloth() {
     // No drag, no pins: every model must fall as g t²/2. Particle damping on the absolute
@@ -400,7 +385,7 @@ fn a_free_falling_patch_cloth_falls_like_the_mass_spring_cloth() {
             reference.step(DT, &env);
             parts.step(DT, &env);
         }
-        let gap = max_gap(&reference, &parts);
+        let gap = max_distance(reference.positions(), parts.positions());
         assert!(
             gap < 1e-3,
             "{size}×{size} parts: {gap} m from mass-spring after 1 s"
@@ -623,12 +608,7 @@ fn part_centres_meet_the_colliders() {
         lowest_centre > 0.0,
         "a part centre is at y = {lowest_centre}"
     );
-    let worst = patches
-        .targets
-        .iter()
-        .zip(c.positions())
-        .map(|(t, x)| t.distance(*x))
-        .fold(0.0, f32::max);
+    let worst = max_distance(&patches.targets, c.positions());
     assert!(worst < 0.01, "a particle is {worst} m from its target");
     assert!(c.positions().iter().all(|p| p.y >= 0.0));
 }

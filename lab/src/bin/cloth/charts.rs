@@ -100,6 +100,23 @@ fn tick_label(v: &f64) -> String {
     format!("{v:.decimals$}")
 }
 
+/// The legend of a chart's labelled series at `position`, in `size`-point text on a
+/// translucent white box.
+fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    size: u32,
+) -> Result<()> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FONT, size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(err)
+}
+
 fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
@@ -220,14 +237,7 @@ impl Chart for Bench<'_> {
             .legend(|(x, y)| {
                 Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], BLACK.stroke_width(2))
             });
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .label_font((FONT, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(err)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft, 15)?;
         Ok(())
     }
 }
@@ -351,14 +361,7 @@ impl Chart for Accuracy<'_> {
                     _ => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
                 });
             }
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerLeft)
-                .label_font((FONT, 14))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(err)?;
+            legend(&mut chart, SeriesLabelPosition::LowerLeft, 14)?;
         }
         Ok(())
     }
