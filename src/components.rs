@@ -91,24 +91,33 @@ impl Cloth {
     }
 
     /// Builds the solver for this cloth placed by `frame`: grids directly, garments from
-    /// their files (logging pattern warnings). Mesh shapes are built by the plugin from
-    /// the entity's mesh.
+    /// their files read from disk (the plugin loads them as assets instead). Mesh shapes
+    /// are built by the plugin from the entity's mesh.
     pub fn build(&self, frame: bevy::math::Affine3A) -> Result<solver::ClothSolver, ClothError> {
         match &self.shape {
             ClothShape::Garment { file, resolution } => {
-                let layout = GarmentLayout::load(&asset_path(file), *resolution)?;
-                for warning in &layout.warnings {
-                    warn!("{warning}");
-                }
-                if layout.positions.is_empty() || layout.triangles.is_empty() {
-                    return Err(ClothError::EmptyGarment);
-                }
-                let layout = layout.into_layout();
-                let pins = self.pins.resolve_for(&layout)?;
-                solver::ClothSolver::new(layout, &pins, &self.params, frame)
+                self.build_garment(GarmentLayout::load(&asset_path(file), *resolution)?, frame)
             }
             _ => self.shape.build_solver(&self.pins, &self.params, frame),
         }
+    }
+
+    /// Builds the solver of a garment cloth from its laid-out garment, logging the
+    /// patterns' warnings.
+    pub fn build_garment(
+        &self,
+        layout: GarmentLayout,
+        frame: bevy::math::Affine3A,
+    ) -> Result<solver::ClothSolver, ClothError> {
+        for warning in &layout.warnings {
+            warn!("{warning}");
+        }
+        if layout.positions.is_empty() || layout.triangles.is_empty() {
+            return Err(ClothError::EmptyGarment);
+        }
+        let layout = layout.into_layout();
+        let pins = self.pins.resolve_for(&layout)?;
+        solver::ClothSolver::new(layout, &pins, &self.params, frame)
     }
 }
 

@@ -142,13 +142,24 @@ impl SceneRun {
     }
 }
 
-/// The app without a window: `MinimalPlugins`, assets, meshes and `ClothPlugin`, with
-/// time advanced by exactly one 16 ms fixed step per `update`.
+/// The app without a window: `MinimalPlugins`, assets (from
+/// [`crate::garment::asset_root`]), meshes and `ClothPlugin`, with time advanced by
+/// exactly one 16 ms fixed step per `update`.
 pub fn headless_app() -> App {
+    headless_app_in(crate::garment::asset_root().to_string_lossy())
+}
+
+/// [`headless_app`] with its assets in the folder `assets` (absolute, or relative to
+/// where Bevy looks: see [`AssetPlugin::file_path`]). Bevy's `file_watcher` feature
+/// makes it hot-reload them.
+pub fn headless_app_in(assets: impl Into<String>) -> App {
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
-        AssetPlugin::default(),
+        AssetPlugin {
+            file_path: assets.into(),
+            ..default()
+        },
         ClothPlugin::default(),
     ))
     .init_asset::<Mesh>()

@@ -18,7 +18,7 @@
 use std::time::{Duration, Instant};
 
 use bevy::app::FixedUpdate;
-use bevy::asset::AssetEventSystems;
+use bevy::asset::{AssetEventSystems, AssetLoadError, LoadState};
 use bevy::ecs::intern::Interned;
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
@@ -28,6 +28,8 @@ use crate::components::{
     Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats,
     ClothTorn,
 };
+use crate::error::ClothError;
+use crate::garment::{Garment, GarmentLoader};
 use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::params::{
     ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, RotationMethod,
@@ -152,7 +154,10 @@ impl Plugin for ClothPlugin {
             .init_resource::<ClothEnvironment>()
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
-            .add_message::<ClothTorn>();
+            .add_message::<ClothTorn>()
+            .init_asset::<Garment>()
+            .register_asset_loader(GarmentLoader)
+            .add_systems(Update, watch_garments);
 
         let mut substep = Schedule::new(ClothSubstep);
         substep.set_executor(SingleThreadedExecutor::new());
@@ -201,36 +206,54 @@ impl Plugin for ClothPlugin {
     }
 }
 
-/// Builds a cloth's solver and mesh: a grid or garment from its description, a mesh shape
-/// from the entity's (or the remembered source) mesh. `Ok(None)`: the source mesh is not loaded yet.
+/// Where a cloth's layout comes from when its description is not enough: the entity's
+/// (or the remembered source) mesh, or the loaded garment; `None` while not loaded yet.
+enum LayoutSource<'a> {
+    Description,
+    Mesh(Option<&'a Mesh>),
+    Garment(Option<&'a Garment>),
+}
+
+/// Builds a cloth's solver and mesh. `Ok(None)`: its mesh or garment is not loaded yet.
 fn build_one(
     cloth: &Cloth,
     frame: bevy::math::Affine3A,
-    source: Option<&Mesh>,
-) -> Result<Option<(solver::ClothSolver, Mesh)>, crate::error::ClothError> {
+    source: LayoutSource,
+) -> Result<Option<(solver::ClothSolver, Mesh)>, ClothError> {
     cloth.validate()?;
-    match cloth.shape {
-        ClothShape::Grid { .. } | ClothShape::Garment { .. } => {
-            let solver = cloth.build(frame)?;
-            let mesh = cloth_mesh(&solver, None);
-            Ok(Some((solver, mesh)))
+    let (solver, uvs) = match (&cloth.shape, source) {
+        (ClothShape::Garment { resolution, .. }, LayoutSource::Garment(garment)) => {
+            let Some(garment) = garment else {
+                return Ok(None);
+            };
+            (
+                cloth.build_garment(garment.layout(*resolution)?, frame)?,
+                None,
+            )
         }
-        ClothShape::Mesh => {
-            let Some(source) = source else {
+        (ClothShape::Mesh, LayoutSource::Mesh(mesh)) => {
+            let Some(mesh) = mesh else {
                 return Ok(None);
             };
             let MeshSource {
                 positions,
                 triangles,
                 uvs,
-            } = mesh_triangles(source)?;
+            } = mesh_triangles(mesh)?;
             let layout = Layout::from_mesh(&positions, &triangles)?;
             let pins = cloth.pins.resolve_for(&layout)?;
             let solver = solver::ClothSolver::new(layout, &pins, &cloth.params, frame)?;
-            let mesh = cloth_mesh(&solver, uvs);
-            Ok(Some((solver, mesh)))
+            (solver, uvs)
         }
-    }
+        _ => (
+            cloth
+                .shape
+                .build_solver(&cloth.pins, &cloth.params, frame)?,
+            None,
+        ),
+    };
+    let mesh = cloth_mesh(&solver, uvs);
+    Ok(Some((solver, mesh)))
 }
 
 /// Remembers the mesh a mesh-shaped cloth was made from (its `Mesh3d` is replaced by the
@@ -238,10 +261,87 @@ fn build_one(
 #[derive(Component, Clone, Debug)]
 struct ClothSourceMesh(Handle<Mesh>);
 
-#[allow(clippy::type_complexity)]
+/// The garment asset a garment cloth is built from, and whether it changed on disk
+/// since (hot reload).
+#[derive(Component, Clone, Debug)]
+struct ClothGarment {
+    file: String,
+    handle: Handle<Garment>,
+    changed: bool,
+}
+
+/// Marks the cloths whose garment was reloaded (an edited garment or pattern file, or a
+/// broken one fixed). Runs every frame, so no asset event is missed between fixed steps.
+fn watch_garments(
+    mut events: MessageReader<AssetEvent<Garment>>,
+    mut cloths: Query<(&mut ClothGarment, Has<ClothSimulation>)>,
+) {
+    for event in events.read() {
+        for (mut garment, built) in &mut cloths {
+            let reloaded = match *event {
+                // A built cloth's garment changed; an unbuilt one's arrived.
+                AssetEvent::Modified { id } => id == garment.handle.id(),
+                AssetEvent::LoadedWithDependencies { id } => !built && id == garment.handle.id(),
+                _ => false,
+            };
+            garment.changed |= reloaded;
+        }
+    }
+}
+
+/// The garment of a garment cloth: its asset (loading it on first sight or when the file
+/// changes), `Ok(None)` while loading, the loader's error when it failed.
+fn garment_source<'a>(
+    commands: &mut Commands,
+    entity: Entity,
+    file: &str,
+    current: Option<&ClothGarment>,
+    asset_server: &AssetServer,
+    garments: &'a Assets<Garment>,
+) -> Result<Option<&'a Garment>, ClothError> {
+    let handle = match current {
+        Some(current) if current.file == file => current.handle.clone(),
+        _ => {
+            let handle = asset_server.load::<Garment>(file.to_string());
+            commands.entity(entity).insert(ClothGarment {
+                file: file.to_string(),
+                handle: handle.clone(),
+                changed: false,
+            });
+            handle
+        }
+    };
+    if let Some(garment) = garments.get(&handle) {
+        return Ok(Some(garment));
+    }
+    match asset_server.load_state(&handle) {
+        LoadState::Failed(e) => Err(load_error(file, &e)),
+        _ => Ok(None),
+    }
+}
+
+/// The cloth error behind a failed garment load (the loader's own, with file, line and
+/// column), or the asset server's message (a missing file).
+fn load_error(file: &str, error: &AssetLoadError) -> ClothError {
+    if let AssetLoadError::AssetLoaderError(e) = error
+        && let Some(e) = e.error().downcast_ref::<ClothError>()
+    {
+        return e.clone();
+    }
+    ClothError::Garment {
+        file: file.to_string(),
+        line: 1,
+        column: 1,
+        message: error.to_string(),
+    }
+}
+
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 fn build_cloths(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
+    asset_server: Res<AssetServer>,
+    garments: Res<Assets<Garment>>,
     transforms: TransformHelper,
     mut cloths: Query<(
         Entity,
@@ -249,20 +349,29 @@ fn build_cloths(
         Option<&mut ClothSimulation>,
         Option<&Mesh3d>,
         Option<&ClothSourceMesh>,
+        Option<&mut ClothGarment>,
         Has<ClothInvalid>,
     )>,
 ) {
-    for (entity, cloth, sim, mesh3d, source, invalid) in &mut cloths {
+    for (entity, cloth, sim, mesh3d, source, garment, invalid) in &mut cloths {
         let frame = transforms
             .compute_global_transform(entity)
             .map(|g| g.affine())
             .unwrap_or_default();
+        let mut garment = garment;
+        let reload = garment.as_mut().is_some_and(|g| {
+            let changed = g.changed;
+            if changed {
+                g.changed = false;
+            }
+            changed
+        });
         if let Some(mut sim) = sim {
             sim.solver.set_frame(frame);
-            if !cloth.is_changed() {
+            if !cloth.is_changed() && !reload {
                 continue;
             }
-            if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) {
+            if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !reload {
                 match sim.solver.set_params(&cloth.params) {
                     Ok(()) if invalid => {
                         commands.entity(entity).remove::<ClothInvalid>();
@@ -275,15 +384,35 @@ fn build_cloths(
                 }
                 continue;
             }
-        } else if invalid && !cloth.is_changed() {
+        } else if invalid && !cloth.is_changed() && !reload {
             continue;
         }
-        let source_handle = match cloth.shape {
-            ClothShape::Mesh => source.map(|s| s.0.clone()).or(mesh3d.map(|m| m.0.clone())),
-            ClothShape::Grid { .. } | ClothShape::Garment { .. } => None,
+        let mut source_handle = None;
+        let layout_source = match &cloth.shape {
+            ClothShape::Mesh => {
+                source_handle = source.map(|s| s.0.clone()).or(mesh3d.map(|m| m.0.clone()));
+                LayoutSource::Mesh(source_handle.as_ref().and_then(|h| meshes.get(h)))
+            }
+            ClothShape::Garment { file, .. } => {
+                let current = garment.as_deref();
+                match garment_source(
+                    &mut commands,
+                    entity,
+                    file,
+                    current,
+                    &asset_server,
+                    &garments,
+                ) {
+                    Ok(garment) => LayoutSource::Garment(garment),
+                    Err(e) => {
+                        invalidate(&mut commands, entity, e);
+                        continue;
+                    }
+                }
+            }
+            ClothShape::Grid { .. } => LayoutSource::Description,
         };
-        let source_mesh = source_handle.as_ref().and_then(|h| meshes.get(h));
-        match build_one(&cloth, frame, source_mesh) {
+        match build_one(&cloth, frame, layout_source) {
             Ok(Some((solver, mesh))) => {
                 let sim = ClothSimulation::new(solver, &cloth);
                 let handle = meshes.add(mesh);
@@ -296,15 +425,18 @@ fn build_cloths(
                 }
             }
             Ok(None) => {}
-            Err(e) => {
-                error!("cloth {entity} is not simulated: {e}");
-                commands
-                    .entity(entity)
-                    .insert(ClothInvalid(e))
-                    .remove::<ClothSimulation>();
-            }
+            Err(e) => invalidate(&mut commands, entity, e),
         }
     }
+}
+
+/// A cloth that cannot be built is not simulated, and says why.
+fn invalidate(commands: &mut Commands, entity: Entity, error: ClothError) {
+    error!("cloth {entity} is not simulated: {error}");
+    commands
+        .entity(entity)
+        .insert(ClothInvalid(error))
+        .remove::<ClothSimulation>();
 }
 
 /// Gives every cloth the colliders where their entities are now: each collider's world

@@ -549,8 +549,16 @@ fn a_scene_spawns_its_cloths_colliders_and_world() {
     app.world_mut().flush();
     assert_eq!(spawned.cloths.len(), scene.cloths.len());
     assert_eq!(spawned.colliders.len(), scene.colliders.len());
-    for _ in 0..3 {
+    // The garment loads through the asset server, in the background.
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs() < 10
+        && !spawned
+            .cloths
+            .iter()
+            .all(|&e| app.world().get::<ClothSimulation>(e).is_some())
+    {
         app.update();
+        std::thread::sleep(std::time::Duration::from_millis(5));
     }
     for (entry, &entity) in scene.cloths.iter().zip(&spawned.cloths) {
         let sim = app.world().get::<ClothSimulation>(entity).expect("built");

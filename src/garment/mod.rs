@@ -29,9 +29,13 @@ use bevy::math::{Quat, Vec3};
 use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
+
 use crate::pattern::{Pattern, PatternWarning};
 use crate::solver::topology::{grid_spring_pairs, grid_triangles};
 use crate::solver::{Layout, SpringKind};
+
+mod asset;
+pub use asset::{Garment, GarmentLoader};
 
 /// The finest resolution a garment may be rescaled to.
 pub const MAX_RESOLUTION: u32 = 64;
@@ -121,20 +125,22 @@ impl GarmentLayout {
     }
 }
 
-/// The path of an asset file: under the `assets` folder where Bevy's asset server looks
-/// (`BEVY_ASSET_ROOT`, the crate under cargo, else beside the executable), or else under
-/// `assets` in the working directory (a binary run by hand from the project); absolute
-/// paths stay as they are.
-pub fn asset_path(file: &str) -> PathBuf {
-    let bevy_path = bevy::asset::io::file::FileAssetReader::get_base_path()
-        .join("assets")
-        .join(file);
-    let local = Path::new("assets").join(file);
-    if bevy_path.exists() || !local.exists() {
-        bevy_path
+/// The `assets` folder: where Bevy's asset server looks (`BEVY_ASSET_ROOT`, the crate
+/// under cargo, else beside the executable), or else `assets` in the working directory (a
+/// binary run by hand from the project).
+pub fn asset_root() -> PathBuf {
+    let bevy_root = bevy::asset::io::file::FileAssetReader::get_base_path().join("assets");
+    let local = PathBuf::from("assets");
+    if bevy_root.exists() || !local.exists() {
+        bevy_root
     } else {
         local
     }
+}
+
+/// The path of an asset file under [`asset_root`]; absolute paths stay as they are.
+pub fn asset_path(file: &str) -> PathBuf {
+    asset_root().join(file)
 }
 
 impl GarmentLayout {
