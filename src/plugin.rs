@@ -359,29 +359,16 @@ fn build_cloths(
             .map(|g| g.affine())
             .unwrap_or_default();
         let mut garment = garment;
-        let reload = garment.as_mut().is_some_and(|g| {
-            let changed = g.changed;
-            if changed {
-                g.changed = false;
-            }
-            changed
-        });
+        let reload = garment
+            .as_mut()
+            .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed));
         if let Some(mut sim) = sim {
             sim.solver.set_frame(frame);
             if !cloth.is_changed() && !reload {
                 continue;
             }
             if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !reload {
-                match sim.solver.set_params(&cloth.params) {
-                    Ok(()) if invalid => {
-                        commands.entity(entity).remove::<ClothInvalid>();
-                    }
-                    Ok(()) => {}
-                    Err(e) => {
-                        error!("cloth {entity}: {e}; the cloth is paused until this is fixed");
-                        commands.entity(entity).insert(ClothInvalid(e));
-                    }
-                }
+                apply_params(&mut commands, entity, &mut sim, &cloth.params, invalid);
                 continue;
             }
         } else if invalid && !cloth.is_changed() && !reload {
@@ -426,6 +413,26 @@ fn build_cloths(
             }
             Ok(None) => {}
             Err(e) => invalidate(&mut commands, entity, e),
+        }
+    }
+}
+
+/// Applies edited parameters to a built cloth; bad ones pause it until they are fixed.
+fn apply_params(
+    commands: &mut Commands,
+    entity: Entity,
+    sim: &mut ClothSimulation,
+    params: &ClothParams,
+    invalid: bool,
+) {
+    match sim.solver.set_params(params) {
+        Ok(()) if invalid => {
+            commands.entity(entity).remove::<ClothInvalid>();
+        }
+        Ok(()) => {}
+        Err(e) => {
+            error!("cloth {entity}: {e}; the cloth is paused until this is fixed");
+            commands.entity(entity).insert(ClothInvalid(e));
         }
     }
 }
