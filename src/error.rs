@@ -88,7 +88,7 @@ pub enum ClothError {
     },
     /// A pattern file is malformed (names the file, line and column).
     #[error("{0}")]
-    Pattern(#[from] crate::pattern::PatternError),
+    Pattern(#[from] crate::layout::pattern::PatternError),
     /// A garment file is malformed, or its pieces and seams do not fit together.
     #[error("{file}:{line}:{column}: {message}")]
     Garment {

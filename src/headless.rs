@@ -11,9 +11,9 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
 
+use crate::ecs::plugin::ClothPlugin;
 use crate::error::ClothError;
 use crate::params::Environment;
-use crate::plugin::ClothPlugin;
 use crate::scene::ClothScene;
 use crate::solver::{self, Collider};
 use crate::stats::median;
@@ -143,10 +143,10 @@ impl SceneRun {
 }
 
 /// The app without a window: `MinimalPlugins`, assets (from
-/// [`crate::garment::asset_root`]), meshes and `ClothPlugin`, with time advanced by
+/// [`crate::layout::garment::asset_root`]), meshes and `ClothPlugin`, with time advanced by
 /// exactly one 16 ms fixed step per `update`.
 pub fn headless_app() -> App {
-    headless_app_in(crate::garment::asset_root().to_string_lossy())
+    headless_app_in(crate::layout::garment::asset_root().to_string_lossy())
 }
 
 /// [`headless_app`] with its assets in the folder `assets` (absolute, or relative to

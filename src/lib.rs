@@ -4,7 +4,7 @@
 //! "Model elastične tkanine" (seed 000) and the BMSTU T-shirt course work (seed 002),
 //! with a measured solver that runs the same way in a game, a test and a benchmark.
 //!
-//! Add [`ClothPlugin`](plugin::ClothPlugin) and spawn a [`Cloth`](components::Cloth):
+//! Add [`ClothPlugin`](ecs::plugin::ClothPlugin) and spawn a [`Cloth`](ecs::components::Cloth):
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -26,41 +26,37 @@
 //! }
 //! ```
 //!
-//! Layers, top to bottom: [`scene`] files and Rust builders → [`components::Cloth`]
-//! (plain data) → [`solver::ClothSolver`] (pure Rust, no ECS) → [`plugin`] (systems, mesh
-//! write-back).
+//! Layers, top to bottom: [`scene`] files and Rust builders → [`ecs`] (the
+//! [`Cloth`](ecs::components::Cloth) component, the plugin's systems, mesh write-back) →
+//! [`layout`] (grids, pattern and garment files → a layout) → [`solver`] (pure Rust, no
+//! ECS: [`solver::ClothSolver`] steps a [`solver::Layout`]).
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod components;
-pub mod controls;
+pub mod ecs;
 pub mod error;
-pub mod garment;
 pub mod headless;
-pub mod mesh;
+pub mod layout;
 pub mod params;
-pub mod pattern;
-pub mod plugin;
 pub mod scene;
-pub mod shape;
 pub mod solver;
 pub mod stats;
 
 /// The types a user needs to add cloth to an app.
 pub mod prelude {
-    pub use crate::components::{
+    pub use crate::ecs::components::{
         Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation,
         ClothStats, ClothTorn, ColliderKind, StatSample,
     };
-    pub use crate::controls::{ClothControls, ClothControlsPlugin};
+    pub use crate::ecs::controls::{ClothControls, ClothControlsPlugin};
+    pub use crate::ecs::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};
     pub use crate::error::ClothError;
     pub use crate::headless::{SceneRun, headless_app};
+    pub use crate::layout::shape::{ClothShape, Pins};
     pub use crate::params::{
         ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
         PatchTargets, RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps,
         Wind, WindField,
     };
-    pub use crate::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};
     pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError, SpawnedScene};
-    pub use crate::shape::{ClothShape, Pins};
 }

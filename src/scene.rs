@@ -23,7 +23,7 @@ use bevy::ecs::name::Name;
 use bevy::ecs::system::Commands;
 use bevy::time::{Fixed, Time};
 
-use crate::components::{Cloth, ClothCollider, ClothEnvironment, ClothStats};
+use crate::ecs::components::{Cloth, ClothCollider, ClothEnvironment, ClothStats};
 use crate::params::Environment;
 
 /// A scene: the cloths, their world and the timestep.
@@ -317,9 +317,9 @@ impl ClothScene {
                 .and_then(|rest| rest.find("cloth:"))
                 .map_or(search_from, |o| search_from + o);
             let garment = match &entry.cloth.shape {
-                crate::shape::ClothShape::Garment { file, resolution } => {
-                    crate::garment::GarmentLayout::load(
-                        &crate::garment::asset_path(file),
+                crate::layout::shape::ClothShape::Garment { file, resolution } => {
+                    crate::layout::garment::GarmentLayout::load(
+                        &crate::layout::garment::asset_path(file),
                         *resolution,
                     )
                     .err()

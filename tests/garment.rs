@@ -4,9 +4,9 @@ use std::path::Path;
 
 use bevy::math::{Affine3A, Vec3};
 use bevy::prelude::App;
-use bevy_cloth::garment::{GarmentLayout, asset_path};
 use bevy_cloth::headless::SceneRun;
-use bevy_cloth::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
+use bevy_cloth::layout::garment::{GarmentLayout, asset_path};
+use bevy_cloth::layout::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Collider, ColliderShape, Layout, SpringKind};
 

@@ -14,8 +14,8 @@ use bevy::math::Affine3A;
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
+use bevy_cloth::layout::shape::{ClothShape, Pins};
 use bevy_cloth::params::{ClothParams, Environment, Model, PatchParams, ShapeMatchingParams};
-use bevy_cloth::shape::{ClothShape, Pins};
 use bevy_cloth::solver;
 
 pub use bevy_cloth::headless::SceneRun;

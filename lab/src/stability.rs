@@ -28,11 +28,11 @@ use bevy::math::{Affine3A, Vec3};
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
+use bevy_cloth::layout::shape::{ClothShape, Pins};
 use bevy_cloth::params::{
     ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
     ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind,
 };
-use bevy_cloth::shape::{ClothShape, Pins};
 use bevy_cloth::solver::{self, SpringKind};
 
 /// Spring (and pull) stiffnesses of the grid, N/m (seed 002 §1.4's range).

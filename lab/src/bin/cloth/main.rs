@@ -536,7 +536,7 @@ fn print_by_model(cells: &[BenchCell], per_model: usize, show: impl Fn(&BenchCel
 /// The accuracy study's cases: the curtain without and with its wind, and the card.
 fn accuracy_cases(names: &[&str], seconds: f32) -> Result<Vec<Case>, String> {
     let load = |file: &str| {
-        let path = bevy_cloth::garment::asset_path(&format!("scenes/{file}"));
+        let path = bevy_cloth::layout::garment::asset_path(&format!("scenes/{file}"));
         ClothScene::load(&path).map_err(|e| e.to_string())
     };
     let mut cases = Vec::new();

@@ -5,9 +5,9 @@ use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
-use crate::garment::{GarmentLayout, asset_path};
+use crate::layout::garment::{GarmentLayout, asset_path};
+use crate::layout::shape::{ClothShape, Pins};
 use crate::params::{ClothParams, Environment};
-use crate::shape::{ClothShape, Pins};
 use crate::solver;
 
 /// A cloth: its shape, its pins and its model parameters. Spawn it on an entity and the
@@ -77,7 +77,7 @@ impl Cloth {
         self.params.validate()
     }
 
-    /// A garment from a garment file under `assets/` (see [`crate::garment`]), at
+    /// A garment from a garment file under `assets/` (see [`crate::layout::garment`]), at
     /// resolution 1, pinned nowhere.
     pub fn garment(file: impl Into<String>) -> Self {
         Self {

@@ -11,7 +11,7 @@ use bevy::reflect::TypePath;
 
 use super::{GarmentFile, GarmentLayout};
 use crate::error::ClothError;
-use crate::pattern::{Pattern, PatternError, PatternErrorKind, PatternWarning};
+use crate::layout::pattern::{Pattern, PatternError, PatternErrorKind, PatternWarning};
 
 type PatternRead = Result<(Pattern, Vec<PatternWarning>), PatternError>;
 
@@ -46,7 +46,7 @@ impl Garment {
 
 /// Loads [`Garment`]s. Only an unreadable garment file fails the load: a malformed
 /// garment or pattern loads (so Bevy watches every file it read) and the cloth built from
-/// it is [`crate::components::ClothInvalid`] with the file, line and column at fault,
+/// it is [`crate::ecs::components::ClothInvalid`] with the file, line and column at fault,
 /// until an edit fixes it.
 #[derive(TypePath, Default)]
 pub struct GarmentLoader;

@@ -30,7 +30,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
 
-use crate::pattern::{Pattern, PatternWarning};
+use crate::layout::pattern::{Pattern, PatternWarning};
 use crate::solver::topology::{grid_spring_pairs, grid_triangles};
 use crate::solver::{Layout, SpringKind};
 
@@ -169,7 +169,7 @@ impl GarmentLayout {
             &str,
         ) -> Result<
             (Pattern, Vec<PatternWarning>),
-            crate::pattern::PatternError,
+            crate::layout::pattern::PatternError,
         >,
     ) -> Result<GarmentLayout, ClothError> {
         let error = |needle: &str, message: String| {

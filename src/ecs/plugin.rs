@@ -24,18 +24,18 @@ use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
-use crate::components::{
+use crate::ecs::components::{
     Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats,
     ClothTorn,
 };
+use crate::ecs::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::error::ClothError;
-use crate::garment::{Garment, GarmentLoader};
-use crate::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
+use crate::layout::garment::{Garment, GarmentLoader};
+use crate::layout::shape::{ClothShape, Pins};
 use crate::params::{
     ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, RotationMethod,
     ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
 };
-use crate::shape::{ClothShape, Pins};
 use crate::solver::{self, Layout};
 
 /// The ordered system sets of the cloth simulation in the plugin's schedule (and, for
@@ -134,7 +134,7 @@ impl Plugin for ClothPlugin {
             .register_type::<ClothShape>()
             .register_type::<Pins>()
             .register_type::<ClothCollider>()
-            .register_type::<crate::components::ColliderKind>()
+            .register_type::<crate::ecs::components::ColliderKind>()
             .register_type::<ClothParams>()
             .register_type::<SpringParams>()
             .register_type::<SpringFamily>()

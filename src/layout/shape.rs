@@ -27,7 +27,7 @@ pub enum ClothShape {
     /// triangles sharing an edge a bend spring.
     Mesh,
     /// A garment: 0/1 pattern pieces stitched by seams (seed 002 §1.4), from a garment file
-    /// (see [`crate::garment`]); the local origin is the garment file's origin.
+    /// (see [`crate::layout::garment`]); the local origin is the garment file's origin.
     Garment {
         /// The garment file, relative to the `assets` folder (or absolute).
         file: String,
@@ -50,7 +50,7 @@ impl ClothShape {
     /// The layout of a grid (seed 000 §3.2's construction): particle `(i, j)` at
     /// `(i·spacing − (width−1)·spacing/2, −j·spacing, 0)`, structural, shear and bend
     /// springs, two triangles per cell. A mesh or a garment is laid out from its data
-    /// ([`Layout::from_mesh`], [`crate::garment::GarmentLayout::into_layout`]): an error here.
+    /// ([`Layout::from_mesh`], [`crate::layout::garment::GarmentLayout::into_layout`]): an error here.
     pub fn layout(&self) -> Result<Layout, ClothError> {
         self.validate()?;
         match *self {
@@ -125,7 +125,7 @@ impl ClothShape {
             }
         }
         if let ClothShape::Garment { resolution, .. } = *self
-            && !(1..=crate::garment::MAX_RESOLUTION).contains(&resolution)
+            && !(1..=crate::layout::garment::MAX_RESOLUTION).contains(&resolution)
         {
             return Err(ClothError::InvalidParameter {
                 field: "shape.resolution",
