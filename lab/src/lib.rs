@@ -5,6 +5,7 @@
 //! instrument steps the same [`solver::ClothSolver`] a game runs.
 
 pub mod accuracy;
+pub mod baseline;
 pub mod fps;
 pub mod stability;
 

@@ -18,6 +18,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver;
 use bevy_cloth_lab::accuracy::{self, Case};
+use bevy_cloth_lab::baseline;
 use bevy_cloth_lab::fps::{self, APP_COUNTS};
 use bevy_cloth_lab::stability::{
     self, MASS, MODELS, NONLINEAR_MODELS, NONLINEAR_TIMESTEP, Regime, STIFFNESS, TIMESTEP,
@@ -413,6 +414,15 @@ fn bench(args: BenchArgs) -> Result<(), String> {
     let with_app = args.app || !args.app_models.is_empty();
     let app_models = or_all(args.app_models, &SEED_MODELS);
     let counts: Vec<usize> = SEED_COUNTS.into_iter().filter(|&c| c <= max).collect();
+    // The bare kernel first, in this run: the ratios below are to it.
+    let bare: Vec<f64> = counts
+        .iter()
+        .map(|&count| {
+            let ns = baseline::ns_per_particle_substep(count, repeats.max(5));
+            eprintln!("bare kernel, {count:>6} particles: {ns:6.2} ns per particle-substep");
+            ns
+        })
+        .collect();
     let mut cells = Vec::new();
     for &model in &models {
         for &count in &counts {
@@ -466,7 +476,14 @@ fn bench(args: BenchArgs) -> Result<(), String> {
         charts::bench(chart, &cells, &frames)?;
     }
     if args.output.json {
-        return print_json(&serde_json::json!({ "solver": cells, "app": frames }));
+        let bare: Vec<_> = counts
+            .iter()
+            .zip(&bare)
+            .map(|(count, ns)| serde_json::json!({ "particles": count, "ns_per_particle_substep": ns }))
+            .collect();
+        return print_json(
+            &serde_json::json!({ "solver": cells, "bare_kernel": bare, "app": frames }),
+        );
     }
     if !cells.is_empty() {
         println!(
@@ -499,6 +516,29 @@ fn bench(args: BenchArgs) -> Result<(), String> {
             match (cell.seed_ms, cell.ms_per_step) {
                 (Some(seed), Some(ms)) if seed > 0.0 => format!("{:.0}×", seed / ms),
                 _ => "-".to_string(),
+            }
+        });
+        println!();
+        println!(
+            "ns per particle-substep, and in brackets × the bare kernel's (SoA grid, structural + \
+             shear + bend, Verlet, one core) in this run"
+        );
+        print!("{:>8}", "bare");
+        for ns in &bare {
+            print!(" {:>17}", format!("{ns:.2}"));
+        }
+        println!();
+        print_by_model(&cells, counts.len(), |cell| {
+            let bare = counts
+                .iter()
+                .position(|&c| c == cell.particles)
+                .map(|i| bare[i]);
+            match (cell.ms_per_substep, bare) {
+                (Some(ms), Some(bare)) => {
+                    let ns = ms * 1e6 / cell.particles as f64;
+                    format!("{ns:.1}[{:.1}×]", ns / bare)
+                }
+                _ => "failed".to_string(),
             }
         });
     }
