@@ -40,6 +40,13 @@ impl ClothSolver {
         }
 
         let damping = self.params.springs.damping;
+        if self.stencil.is_some() {
+            let k = SpringKind::ALL.map(|kind| self.stiffness(kind));
+            if let Some(stencil) = &mut self.stencil {
+                stencil.spring_forces(&mut self.particles, |kind| k[kind as usize], damping);
+            }
+            return;
+        }
         for kind in SpringKind::ALL {
             let k = self.stiffness(kind);
             if k == 0.0 {

@@ -136,6 +136,31 @@ impl ClothSolver {
     /// within `(1 + limit + tolerance)·l0`.
     fn limit_strain(&mut self, limit: f32, h: f32) {
         let sweeps = self.params.strain_limit_iterations;
+        if let Some(stencil) = &mut self.stencil {
+            let springs = self.params.springs;
+            let enabled = |kind| match kind {
+                SpringKind::Structural => springs.structural.enabled,
+                SpringKind::Shear => springs.shear.enabled,
+                _ => false,
+            };
+            let p = &mut self.particles;
+            match self.params.strain_limit_tolerance {
+                None => {
+                    for _ in 0..sweeps {
+                        stencil.limit_strain_sweep::<false>(p, enabled, limit, f32::INFINITY, h);
+                    }
+                }
+                Some(tolerance) => {
+                    let past = 1.0 + limit + tolerance;
+                    for _ in 0..sweeps {
+                        if !stencil.limit_strain_sweep::<true>(p, enabled, limit, past, h) {
+                            break;
+                        }
+                    }
+                }
+            }
+            return;
+        }
         match self.params.strain_limit_tolerance {
             None => {
                 for _ in 0..sweeps {

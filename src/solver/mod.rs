@@ -17,6 +17,7 @@ mod drivers;
 mod forces;
 mod integrate;
 mod interact;
+mod lattice;
 mod layout;
 pub mod patches;
 pub mod shape_matching;
@@ -81,6 +82,9 @@ pub struct ClothSolver {
     seam_start: Vec<f32>,
     /// Colliders in world space the particles are kept out of (see `collide.rs`).
     colliders: Vec<Collider>,
+    /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
+    /// garments.
+    stencil: Option<lattice::Stencil>,
 }
 
 /// The active model's own state: none for mass-spring (or before the first step
@@ -148,6 +152,8 @@ impl ClothSolver {
         params.validate()?;
         check_model_fits(params, grid)?;
         let springs = Springs::from_pairs(pairs, &local);
+        let stencil =
+            grid.and_then(|(w, _)| lattice::Stencil::new(&springs, w as usize, local.len()));
         let (triangle_springs, spring_triangles) =
             topology::triangle_edge_springs(&triangles, &springs);
         let n = local.len();
@@ -185,6 +191,7 @@ impl ClothSolver {
             },
             seam_start: Vec::new(),
             colliders: Vec::new(),
+            stencil,
         };
         let seams = cloth.springs.ranges[SpringKind::Seam as usize].clone();
         cloth.seam_start = cloth.springs.rest_length[seams].to_vec();
@@ -229,6 +236,7 @@ impl ClothSolver {
             .extend(self.pins.iter().map(|&i| p.position[i as usize]));
         self.pin_from.clone_from(&self.pin_to);
         self.springs.alive.fill(true);
+        self.sync_stencil();
         self.triangle_visible.fill(true);
         self.faces_changed = true;
         self.torn_count = 0;
@@ -418,12 +426,22 @@ impl ClothSolver {
             return false;
         }
         self.springs.alive[k] = false;
+        if let Some(stencil) = &mut self.stencil {
+            stencil.tear(k);
+        }
         for &t in &self.spring_triangles[k] {
             self.triangle_visible[t as usize] = false;
         }
         self.faces_changed = true;
         self.torn_count += 1;
         true
+    }
+
+    /// Mirrors the springs' rest lengths, factors and alive flags into the stencil.
+    fn sync_stencil(&mut self) {
+        if let Some(stencil) = &mut self.stencil {
+            stencil.sync(&self.springs);
+        }
     }
 
     /// Builds or drops the model state (shape-matching clusters, patch lattice) when the
