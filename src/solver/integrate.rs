@@ -143,22 +143,11 @@ impl ClothSolver {
                 SpringKind::Shear => springs.shear.enabled,
                 _ => false,
             };
-            let p = &mut self.particles;
-            match self.params.strain_limit_tolerance {
-                None => {
-                    for _ in 0..sweeps {
-                        stencil.limit_strain_sweep::<false>(p, enabled, limit, f32::INFINITY, h);
-                    }
-                }
-                Some(tolerance) => {
-                    let past = 1.0 + limit + tolerance;
-                    for _ in 0..sweeps {
-                        if !stencil.limit_strain_sweep::<true>(p, enabled, limit, past, h) {
-                            break;
-                        }
-                    }
-                }
-            }
+            let past = self
+                .params
+                .strain_limit_tolerance
+                .map(|tolerance| 1.0 + limit + tolerance);
+            stencil.limit_strain(&mut self.particles, enabled, limit, sweeps, past, h);
             return;
         }
         match self.params.strain_limit_tolerance {

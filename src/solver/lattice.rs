@@ -34,6 +34,24 @@ struct Offset {
     weight: Vec<f32>,
 }
 
+/// Three lanes of `f32`, one per coordinate (x, y, z): the form the compiler vectorises.
+#[derive(Clone, Debug, Default)]
+struct Lanes([Vec<f32>; 3]);
+
+impl Lanes {
+    fn new(n: usize) -> Self {
+        Self([vec![0.0; n], vec![0.0; n], vec![0.0; n]])
+    }
+
+    /// Copies `v` into the lanes.
+    fn load(&mut self, v: &[Vec3]) {
+        let [x, y, z] = &mut self.0;
+        for (((x, y), z), v) in x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut()).zip(v) {
+            (*x, *y, *z) = (v.x, v.y, v.z);
+        }
+    }
+}
+
 /// A grid cloth's springs as stencil offsets.
 #[derive(Clone, Debug)]
 pub(super) struct Stencil {
@@ -41,9 +59,13 @@ pub(super) struct Stencil {
     offsets: Vec<Offset>,
     /// For each spring: its offset and `a`, to follow tearing.
     slot: Vec<(u8, u32)>,
-    /// One force per spring of an offset, or the limiter's corrections of two offsets,
-    /// reused.
-    scratch: Vec<Vec3>,
+    /// Positions, velocities and forces as lanes, for the substep's kernels.
+    x: Lanes,
+    v: Lanes,
+    f: Lanes,
+    /// One value per spring of an offset (its force, or a limiter correction), and a
+    /// second for the limiter's other diagonal.
+    scratch: [Lanes; 2],
 }
 
 impl Stencil {
@@ -95,7 +117,10 @@ impl Stencil {
             width,
             offsets,
             slot,
-            scratch: vec![Vec3::ZERO; 2 * n],
+            x: Lanes::new(n),
+            v: Lanes::new(n),
+            f: Lanes::new(n),
+            scratch: [Lanes::new(n), Lanes::new(n)],
         };
         stencil.sync(springs);
         Some(stencil)
@@ -129,141 +154,300 @@ impl Stencil {
         damping: f32,
     ) {
         let n = p.len();
+        self.x.load(&p.position);
+        self.v.load(&p.velocity);
+        for lane in &mut self.f.0 {
+            lane.fill(0.0);
+        }
+        let [x, y, z] = &self.x.0;
+        let [vx, vy, vz] = &self.v.0;
         for offset in &self.offsets {
             let k = k(offset.kind);
             if k == 0.0 {
                 continue;
             }
-            let m = n - offset.step;
-            let pairs = self.scratch[..m]
+            let (m, step) = (n - offset.step, offset.step);
+            let [sx, sy, sz] = &mut self.scratch[0].0;
+            let springs = sx[..m]
                 .iter_mut()
+                .zip(&mut sy[..m])
+                .zip(&mut sz[..m])
                 .zip(offset.rest.iter().zip(&offset.weight))
-                .zip(p.position[..m].iter().zip(&p.position[offset.step..]))
-                .zip(p.velocity[..m].iter().zip(&p.velocity[offset.step..]));
-            for (((f, (&rest, &weight)), (&xa, &xb)), (&va, &vb)) in pairs {
-                let d = xb - xa;
-                let len = d.length();
-                let live = weight != 0.0 && len > f32::EPSILON;
-                let dir = d / if live { len } else { 1.0 };
-                let magnitude = k * weight * (len - rest) + damping * (vb - va).dot(dir);
-                *f = if live { dir * magnitude } else { Vec3::ZERO };
+                .zip(x[..m].iter().zip(&x[step..]))
+                .zip(y[..m].iter().zip(&y[step..]))
+                .zip(z[..m].iter().zip(&z[step..]))
+                .zip(vx[..m].iter().zip(&vx[step..]))
+                .zip(vy[..m].iter().zip(&vy[step..]))
+                .zip(vz[..m].iter().zip(&vz[step..]));
+            for (((((((((fx, fy), fz), (&rest, &weight)), x), y), z), vx), vy), vz) in springs {
+                let (dx, dy, dz) = (x.1 - x.0, y.1 - y.0, z.1 - z.0);
+                let len = (dx * dx + dy * dy + dz * dz).sqrt();
+                // 1/|l| for a live spring, 0 for a torn or missing one (no branch).
+                let live = f32::from(u8::from(weight != 0.0 && len > f32::EPSILON));
+                let inv = live / len.max(f32::EPSILON);
+                let along = (vx.1 - vx.0) * dx + (vy.1 - vy.0) * dy + (vz.1 - vz.0) * dz;
+                let magnitude = k * weight * (len - rest) + damping * along * inv;
+                let scale = magnitude * inv;
+                (*fx, *fy, *fz) = (dx * scale, dy * scale, dz * scale);
             }
-            for (force, f) in p.force[..m].iter_mut().zip(&self.scratch[..m]) {
-                *force += *f;
+            for (force, spring) in self.f.0.iter_mut().zip(&self.scratch[0].0) {
+                for (f, s) in force[..m].iter_mut().zip(&spring[..m]) {
+                    *f += s;
+                }
+                for (f, s) in force[step..].iter_mut().zip(&spring[..m]) {
+                    *f -= s;
+                }
             }
-            for (force, f) in p.force[offset.step..].iter_mut().zip(&self.scratch[..m]) {
-                *force -= *f;
-            }
+        }
+        let [fx, fy, fz] = &self.f.0;
+        for (((force, fx), fy), fz) in p.force.iter_mut().zip(fx).zip(fy).zip(fz) {
+            *force += Vec3::new(*fx, *fy, *fz);
         }
     }
 
-    /// One sweep of Provot's strain limit over the enabled `kinds`' springs, colour by
-    /// colour (see the module doc). With `TRACK`, returns whether a spring was longer than
-    /// `past·l0`.
-    pub fn limit_strain_sweep<const TRACK: bool>(
+    /// Provot's strain limit (the general path's law, `integrate.rs`) over the enabled
+    /// structural and shear springs: `sweeps` coloured sweeps (see the module doc), or
+    /// fewer once one finds every spring within `past·l0` (with `past` given). Works on
+    /// lanes; each particle's velocity takes its whole correction over `h`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn limit_strain(
         &mut self,
         p: &mut Particles,
         enabled: impl Fn(SpringKind) -> bool,
         limit: f32,
-        past: f32,
+        sweeps: u32,
+        past: Option<f32>,
         h: f32,
+    ) {
+        self.x.load(&p.position);
+        for _ in 0..sweeps {
+            let unconverged = match past {
+                None => self.sweep::<false>(&p.inv_mass, &enabled, limit, f32::INFINITY),
+                Some(past) => self.sweep::<true>(&p.inv_mass, &enabled, limit, past),
+            };
+            if past.is_some() && !unconverged {
+                break;
+            }
+        }
+        let [x, y, z] = &self.x.0;
+        let lanes = x.iter().zip(y).zip(z);
+        for ((position, velocity), ((x, y), z)) in
+            p.position.iter_mut().zip(&mut p.velocity).zip(lanes)
+        {
+            let corrected = Vec3::new(*x, *y, *z);
+            *velocity += (corrected - *position) / h;
+            *position = corrected;
+        }
+    }
+
+    /// One coloured sweep; with `TRACK`, whether a spring was longer than `past·l0`.
+    fn sweep<const TRACK: bool>(
+        &mut self,
+        inv_mass: &[f32],
+        enabled: &impl Fn(SpringKind) -> bool,
+        limit: f32,
+        past: f32,
     ) -> bool {
         let limited = |o: &&Offset| {
             matches!(o.kind, SpringKind::Structural | SpringKind::Shear) && enabled(o.kind)
         };
-        // At most two offsets per colour: the row springs, the column springs, the two
-        // diagonals.
         let pick = |keep: &dyn Fn(&Offset) -> bool| {
             let mut found = self.offsets.iter().filter(limited).filter(|o| keep(o));
             [found.next(), found.next()]
         };
         let along = pick(&|o| o.dy == 0);
         let down = pick(&|o| o.dy == 1 && o.dx == 0);
-        let diagonal = pick(&|o| o.dy == 1 && o.dx != 0);
-        let colour = Colour {
-            width: self.width,
-            limit,
-            past,
-            h,
-        };
-        let scratch = &mut self.scratch;
+        let diagonals = pick(&|o| o.dy == 1 && o.dx != 0);
+        let projection = Projection { limit, past };
+        let w = self.width;
+        let x = &mut self.x.0;
         let mut unconverged = false;
         for parity in 0..2 {
             for o in along.iter().flatten() {
-                unconverged |= colour.limit::<TRACK>(p, [Some(o), None], 1, parity, scratch);
+                unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, parity);
             }
         }
         for parity in 0..2 {
+            let scratch = &mut self.scratch;
             for o in down.iter().flatten() {
-                unconverged |= colour.limit::<TRACK>(p, [Some(o), None], 2, parity, scratch);
+                unconverged |=
+                    projection.across_rows::<TRACK>(x, inv_mass, &[o], w, parity, scratch);
             }
-            unconverged |= colour.limit::<TRACK>(p, diagonal, 2, parity, scratch);
+            if let [Some(d1), Some(d2)] = diagonals {
+                unconverged |=
+                    projection.across_rows::<TRACK>(x, inv_mass, &[d1, d2], w, parity, scratch);
+            }
         }
         unconverged
     }
 }
 
-/// The numbers one colour of the limiter needs.
-struct Colour {
-    width: usize,
+/// Provot's projection of one spring: how far to move its ends.
+#[derive(Clone, Copy)]
+struct Projection {
     limit: f32,
     past: f32,
-    h: f32,
 }
 
-impl Colour {
-    /// The spring starts `a` of one colour of an offset (`m` of them in all): every
-    /// other particle (`rows` 1), or every particle of every other row (`rows` 2),
-    /// starting at `parity`.
-    fn starts(&self, rows: usize, parity: usize, m: usize) -> impl Iterator<Item = usize> {
-        let w = self.width;
-        let (step, len) = if rows == 1 { (2, 1) } else { (2 * w, w) };
-        (parity * len..m)
-            .step_by(step)
-            .flat_map(move |first| first..(first + len).min(m))
+impl Projection {
+    /// The correction `c` of the spring from `a` to `b` (`a += c·w_a`, `b −= c·w_b`) that
+    /// brings it back to `(1 + limit)·rest`, zero when it is within it, torn or held at
+    /// both ends; and whether it was longer than `past·rest`.
+    #[inline(always)]
+    fn correction(
+        &self,
+        a: [f32; 3],
+        b: [f32; 3],
+        wa: f32,
+        wb: f32,
+        rest: f32,
+        weight: f32,
+    ) -> ([f32; 3], bool) {
+        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let live = weight != 0.0 && wa + wb != 0.0;
+        let excess = (len - (1.0 + self.limit) * rest).max(0.0);
+        let factor = f32::from(u8::from(live)) * excess / (len * (wa + wb)).max(f32::MIN_POSITIVE);
+        (
+            [d[0] * factor, d[1] * factor, d[2] * factor],
+            live && len > self.past * rest,
+        )
     }
 
-    /// Limits the springs of `offsets` of one colour: every correction from the positions
-    /// before any of them (within one offset no two springs share a particle, and two
-    /// offsets are summed), then applied to positions and velocities by inverse mass.
-    fn limit<const TRACK: bool>(
+    /// The springs `(a, a + 1)` with `a` of one parity: disjoint pairs of particles.
+    fn along_rows<const TRACK: bool>(
         &self,
-        p: &mut Particles,
-        offsets: [Option<&Offset>; 2],
-        rows: usize,
+        x: &mut [Vec<f32>; 3],
+        inv_mass: &[f32],
+        o: &Offset,
         parity: usize,
-        scratch: &mut [Vec3],
     ) -> bool {
         let mut unconverged = false;
-        let n = p.len();
-        for (o, corrections) in offsets.iter().flatten().zip(scratch.chunks_mut(n)) {
-            for a in self.starts(rows, parity, n - o.step) {
-                let b = a + o.step;
-                let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
-                let mut correction = Vec3::ZERO;
-                if o.weight[a] != 0.0 && wa + wb != 0.0 {
-                    let d = p.position[b] - p.position[a];
-                    let len = d.length();
-                    let max = (1.0 + self.limit) * o.rest[a];
-                    if TRACK {
-                        unconverged |= len > self.past * o.rest[a];
-                    }
-                    if len > max {
-                        correction = d * ((len - max) / (len * (wa + wb)));
-                    }
+        if o.rest.len() <= parity {
+            return false;
+        }
+        let [x, y, z] = x;
+        let springs = x[parity..]
+            .chunks_exact_mut(2)
+            .zip(y[parity..].chunks_exact_mut(2))
+            .zip(z[parity..].chunks_exact_mut(2))
+            .zip(inv_mass[parity..].chunks_exact(2))
+            .zip(
+                o.rest[parity..]
+                    .iter()
+                    .step_by(2)
+                    .zip(o.weight[parity..].iter().step_by(2)),
+            );
+        for ((((x, y), z), w), (&rest, &weight)) in springs {
+            let (c, long) = self.correction(
+                [x[0], y[0], z[0]],
+                [x[1], y[1], z[1]],
+                w[0],
+                w[1],
+                rest,
+                weight,
+            );
+            unconverged |= TRACK && long;
+            (x[0], y[0], z[0]) = (x[0] + c[0] * w[0], y[0] + c[1] * w[0], z[0] + c[2] * w[0]);
+            (x[1], y[1], z[1]) = (x[1] - c[0] * w[1], y[1] - c[1] * w[1], z[1] - c[2] * w[1]);
+        }
+        unconverged
+    }
+
+    /// The springs of `offsets` (the vertical one, or both diagonals together) from the
+    /// rows of one parity to the next row. Each band of two rows is disjoint from the
+    /// others; every correction comes from the positions before any (the two diagonals
+    /// share particles), then all are applied.
+    #[allow(clippy::too_many_arguments)]
+    fn across_rows<const TRACK: bool>(
+        &self,
+        x: &mut [Vec<f32>; 3],
+        inv_mass: &[f32],
+        offsets: &[&Offset],
+        width: usize,
+        parity: usize,
+        scratch: &mut [Lanes; 2],
+    ) -> bool {
+        let mut unconverged = false;
+        let from = parity * width;
+        let band = 2 * width;
+        if offsets.iter().any(|o| o.rest.len() <= from) {
+            return false; // too few rows for a band from this parity
+        }
+        // A band's springs: (top columns, bottom columns) for a column offset of −1, 0, 1.
+        let columns = |o: &Offset| match o.dx {
+            1 => (0..width - 1, 1..width),
+            -1 => (1..width, 0..width - 1),
+            _ => (0..width, 0..width),
+        };
+        for (o, corrections) in offsets.iter().zip(scratch.iter_mut()) {
+            let (top, bottom) = columns(o);
+            let [cx, cy, cz] = &mut corrections.0;
+            let bands = x[0][from..]
+                .chunks_exact(band)
+                .zip(x[1][from..].chunks_exact(band))
+                .zip(x[2][from..].chunks_exact(band))
+                .zip(inv_mass[from..].chunks_exact(band))
+                .zip(
+                    o.rest[from..]
+                        .chunks(band)
+                        .zip(o.weight[from..].chunks(band)),
+                )
+                .zip(
+                    cx[from..]
+                        .chunks_mut(band)
+                        .zip(cy[from..].chunks_mut(band))
+                        .zip(cz[from..].chunks_mut(band)),
+                );
+            for (((((xs, ys), zs), w), (rest, weight)), ((cx, cy), cz)) in bands {
+                let (t, b) = (top.clone(), bottom.start + width..bottom.end + width);
+                let springs = xs[t.clone()]
+                    .iter()
+                    .zip(&xs[b.clone()])
+                    .zip(ys[t.clone()].iter().zip(&ys[b.clone()]))
+                    .zip(zs[t.clone()].iter().zip(&zs[b.clone()]))
+                    .zip(w[t.clone()].iter().zip(&w[b]))
+                    .zip(rest[t.clone()].iter().zip(&weight[t.clone()]))
+                    .zip(
+                        cx[t.clone()]
+                            .iter_mut()
+                            .zip(&mut cy[t.clone()])
+                            .zip(&mut cz[t]),
+                    );
+                for (((((x, y), z), (&wa, &wb)), (&rest, &weight)), ((cx, cy), cz)) in springs {
+                    let (c, long) = self.correction(
+                        [*x.0, *y.0, *z.0],
+                        [*x.1, *y.1, *z.1],
+                        wa,
+                        wb,
+                        rest,
+                        weight,
+                    );
+                    unconverged |= TRACK && long;
+                    (*cx, *cy, *cz) = (c[0], c[1], c[2]);
                 }
-                corrections[a] = correction;
             }
         }
-        for (o, corrections) in offsets.iter().flatten().zip(scratch.chunks(n)) {
-            for a in self.starts(rows, parity, n - o.step) {
-                let b = a + o.step;
-                let c = corrections[a];
-                let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
-                p.position[a] += c * wa;
-                p.position[b] -= c * wb;
-                p.velocity[a] += c * (wa / self.h);
-                p.velocity[b] -= c * (wb / self.h);
+        for (o, corrections) in offsets.iter().zip(scratch.iter()) {
+            let (top, bottom) = columns(o);
+            for (lane, c) in x.iter_mut().zip(&corrections.0) {
+                let bands = lane[from..]
+                    .chunks_exact_mut(band)
+                    .zip(inv_mass[from..].chunks_exact(band))
+                    .zip(c[from..].chunks(band));
+                for ((lane, w), c) in bands {
+                    let (t, b) = lane.split_at_mut(width);
+                    let (wt, wb) = w.split_at(width);
+                    let pairs = t[top.clone()]
+                        .iter_mut()
+                        .zip(&mut b[bottom.clone()])
+                        .zip(wt[top.clone()].iter().zip(&wb[bottom.clone()]))
+                        .zip(&c[top.clone()]);
+                    for (((a, b), (wa, wb)), c) in pairs {
+                        *a += c * wa;
+                        *b -= c * wb;
+                    }
+                }
             }
         }
         unconverged
