@@ -213,6 +213,78 @@ pub fn bench_cell(
     })
 }
 
+/// What a mass-spring substep of the timing table's curtain costs, part by part, and
+/// what the second core buys: the numbers issue 14's speed targets are stated in.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct KernelCosts {
+    /// Particles.
+    pub particles: usize,
+    /// Substeps per step (the default material's automatic count, fixed for every run
+    /// here so they compare).
+    pub substeps: u32,
+    /// ns per particle-substep of the bare kernel ([`baseline`]), one core.
+    pub bare_ns: f64,
+    /// ns per particle-substep without the strain limiter, one core.
+    pub plain_ns: Option<f64>,
+    /// ns per particle-substep of one limiter sweep, one core: (with the limiter − without)
+    /// / sweeps.
+    pub sweep_ns: Option<f64>,
+    /// Median ms per step of the default curtain (limiter on), one core.
+    pub one_core_ms: Option<f64>,
+    /// The same on every core (kernels on the compute pool).
+    pub all_cores_ms: Option<f64>,
+    /// Threads the kernels used in `all_cores_ms`.
+    pub threads: usize,
+}
+
+/// Measures [`KernelCosts`] at `count` particles: each variant of the timing table's
+/// mass-spring curtain runs [`BENCH_CHECK_STEPS`] steps (the median of `repeats` after
+/// three of warm-up); a variant that fails the check gets no time. Variants alternate
+/// within one call, so they share the machine's state.
+pub fn kernel_costs(count: usize, repeats: usize) -> Result<KernelCosts, ClothError> {
+    let default = seed_model_params("1").expect("model 1");
+    let substeps = bench_cloth("1", count)?.stable_substeps(0.016);
+    let fixed = ClothParams {
+        substeps: bevy_cloth::params::Substeps::Fixed(substeps),
+        ..default
+    };
+    let plain = ClothParams {
+        strain_limit: None,
+        ..fixed
+    };
+    let time = |params: &ClothParams, parallel: bool| -> Result<Option<f64>, ClothError> {
+        let (width, height) = grid_for(count);
+        let shape = ClothShape::Grid {
+            width,
+            height,
+            spacing: 0.05,
+        };
+        let mut cloth = shape.build_solver(&BENCH_PINS, params, Affine3A::IDENTITY)?;
+        solver::set_parallel(parallel);
+        let (mut times, _, failed) = timed_steps(&mut cloth, &Environment::default(), 3, repeats);
+        solver::set_parallel(true);
+        Ok(failed.is_none().then(|| median(&mut times)))
+    };
+    let per = |ms: f64| ms * 1e6 / (count as f64 * f64::from(substeps));
+    let plain_ms = time(&plain, false)?;
+    let limited_ms = time(&fixed, false)?;
+    let sweeps = f64::from(default.strain_limit_iterations.max(1));
+    let one_core_ms = time(&default, false)?;
+    let all_cores_ms = time(&default, true)?;
+    Ok(KernelCosts {
+        particles: count,
+        substeps,
+        bare_ns: baseline::ns_per_particle_substep(count, repeats.max(5)),
+        plain_ns: plain_ms.map(per),
+        sweep_ns: plain_ms
+            .zip(limited_ms)
+            .map(|(plain, limited)| per(limited - plain) / sweeps),
+        one_core_ms,
+        all_cores_ms,
+        threads: solver::threads(),
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

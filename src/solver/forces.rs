@@ -1,5 +1,6 @@
 //! Phase 1 of a substep: every force from the old state.
 
+use super::parallel::{self, PIECE};
 use super::{ClothSolver, Particles, SpringKind, Springs, pull_scale};
 use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams};
 
@@ -27,13 +28,27 @@ impl ClothSolver {
         let wind = env.wind;
         let has_wind = !held && wind.strength > 0.0 && wind.direction != bevy::math::Vec3::ZERO;
         let p = &mut self.particles;
-        for i in 0..p.position.len() {
-            let mut f = p.mass[i] * g - drag * p.lump[i] * p.velocity[i];
-            if has_wind {
-                f += wind.force_at(p.position[i], time) * p.lump[i];
-            }
-            p.force[i] = f;
-        }
+        let pieces = p.force.chunks_mut(PIECE).zip(
+            p.mass
+                .chunks(PIECE)
+                .zip(p.lump.chunks(PIECE))
+                .zip(p.velocity.chunks(PIECE).zip(p.position.chunks(PIECE))),
+        );
+        parallel::for_each(
+            p.position.len(),
+            pieces,
+            |(force, ((mass, lump), (v, x)))| {
+                let particles = force
+                    .iter_mut()
+                    .zip(mass.iter().zip(lump).zip(v.iter().zip(x)));
+                for (f, ((&mass, &lump), (&v, &x))) in particles {
+                    *f = mass * g - drag * lump * v;
+                    if has_wind {
+                        *f += wind.force_at(x, time) * lump;
+                    }
+                }
+            },
+        );
         if let Model::ShapeMatching(sm) = self.params.model {
             self.goal_forces(&sm);
             return;

@@ -1,5 +1,6 @@
 //! Phases 2 and 3 of a substep: integration and constraints.
 
+use super::parallel::{self, PIECE};
 use super::{ClothSolver, SpringKind};
 use crate::params::{GoalUpdate, Integrator, Model};
 
@@ -21,6 +22,7 @@ impl ClothSolver {
         }
         let h2 = h * h;
         let p = &mut self.particles;
+        let n = p.len();
         match self.params.integrator {
             Integrator::Verlet => {
                 // Seed 002 eq. 1.12 prints `+ a Δt²/2`; substituting eq. 1.10 into 1.9
@@ -31,32 +33,64 @@ impl ClothSolver {
                 // when added, and the plain form then recomputes `x − x_prev = 0`: at 512
                 // substeps of 16 ms a curtain at y = 2 m never started to fall (g Δt² = 1e-8
                 // m against 1.2e-7 m). What rounding drops is carried to the next substep.
-                for i in 0..p.position.len() {
-                    let w = p.inv_mass[i];
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let x = p.position[i];
-                    let step = (x - p.previous[i]) + p.residue[i] + p.force[i] * (w * h2);
-                    let next = x + step;
-                    p.residue[i] = step - (next - x);
-                    p.previous[i] = x;
-                    p.position[i] = next;
-                    p.velocity[i] = step / h;
-                }
+                let pieces = p
+                    .position
+                    .chunks_mut(PIECE)
+                    .zip(p.previous.chunks_mut(PIECE))
+                    .zip(p.residue.chunks_mut(PIECE))
+                    .zip(p.velocity.chunks_mut(PIECE))
+                    .zip(p.force.chunks(PIECE).zip(p.inv_mass.chunks(PIECE)));
+                parallel::for_each(
+                    n,
+                    pieces,
+                    |((((position, previous), residue), velocity), (force, inv_mass))| {
+                        let particles = position
+                            .iter_mut()
+                            .zip(previous)
+                            .zip(residue)
+                            .zip(velocity)
+                            .zip(force.iter().zip(inv_mass));
+                        for ((((x, previous), residue), velocity), (force, &w)) in particles {
+                            if w == 0.0 {
+                                continue;
+                            }
+                            let step = (*x - *previous) + *residue + *force * (w * h2);
+                            let next = *x + step;
+                            *residue = step - (next - *x);
+                            *previous = *x;
+                            *x = next;
+                            *velocity = step / h;
+                        }
+                    },
+                );
             }
             Integrator::SemiImplicitEuler => {
                 // Seed 000 eq. 21–22: the new velocity first, then the position from it.
-                for i in 0..p.position.len() {
-                    let w = p.inv_mass[i];
-                    if w == 0.0 {
-                        continue;
-                    }
-                    let v = p.velocity[i] + p.force[i] * (w * h);
-                    p.previous[i] = p.position[i];
-                    p.velocity[i] = v;
-                    p.position[i] += v * h;
-                }
+                let pieces = p
+                    .position
+                    .chunks_mut(PIECE)
+                    .zip(p.previous.chunks_mut(PIECE))
+                    .zip(p.velocity.chunks_mut(PIECE))
+                    .zip(p.force.chunks(PIECE).zip(p.inv_mass.chunks(PIECE)));
+                parallel::for_each(
+                    n,
+                    pieces,
+                    |(((position, previous), velocity), (force, inv_mass))| {
+                        let particles = position
+                            .iter_mut()
+                            .zip(previous)
+                            .zip(velocity)
+                            .zip(force.iter().zip(inv_mass));
+                        for (((x, previous), velocity), (force, &w)) in particles {
+                            if w == 0.0 {
+                                continue;
+                            }
+                            *velocity += *force * (w * h);
+                            *previous = *x;
+                            *x += *velocity * h;
+                        }
+                    },
+                );
             }
         }
     }

@@ -13,8 +13,13 @@
 //! diagonals of one band of rows are corrected together (Jacobi, summed), so a mirror
 //! image of the cloth is corrected as the mirror image (for an even width).
 
+use std::iter::Zip;
+use std::ops::Range;
+use std::slice::{ChunksMut, Iter};
+
 use bevy::math::Vec3;
 
+use super::parallel::{self, PIECE};
 use super::{Particles, SpringKind, Springs};
 
 /// One stencil offset: the springs `(a, a + step)` of one family.
@@ -43,11 +48,88 @@ impl Lanes {
         Self([vec![0.0; n], vec![0.0; n], vec![0.0; n]])
     }
 
-    /// Copies `v` into the lanes.
+    /// Copies `v` into the lanes (in pieces over the compute pool).
     fn load(&mut self, v: &[Vec3]) {
         let [x, y, z] = &mut self.0;
-        for (((x, y), z), v) in x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut()).zip(v) {
-            (*x, *y, *z) = (v.x, v.y, v.z);
+        let pieces = x
+            .chunks_mut(PIECE)
+            .zip(y.chunks_mut(PIECE))
+            .zip(z.chunks_mut(PIECE))
+            .zip(v.chunks(PIECE));
+        parallel::for_each(v.len(), pieces, |(((x, y), z), v)| {
+            for (((x, y), z), v) in x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut()).zip(v) {
+                (*x, *y, *z) = (v.x, v.y, v.z);
+            }
+        });
+    }
+}
+
+/// The forces of one piece of an offset's springs (those from `from` on, as many as
+/// `out` holds) into `out`, branch-free so the loop vectorises.
+fn spring_piece(
+    o: &Offset,
+    k: f32,
+    damping: f32,
+    from: usize,
+    x: &Lanes,
+    v: &Lanes,
+    out: [&mut [f32]; 3],
+) {
+    let [sx, sy, sz] = out;
+    let len = sx.len();
+    let (a, b) = (from..from + len, from + o.step..from + o.step + len);
+    let [x, y, z] = &x.0;
+    let [vx, vy, vz] = &v.0;
+    let springs = sx
+        .iter_mut()
+        .zip(sy.iter_mut())
+        .zip(sz.iter_mut())
+        .zip(o.rest[a.clone()].iter().zip(&o.weight[a.clone()]))
+        .zip(pair(x, &a, &b))
+        .zip(pair(y, &a, &b))
+        .zip(pair(z, &a, &b))
+        .zip(pair(vx, &a, &b))
+        .zip(pair(vy, &a, &b))
+        .zip(pair(vz, &a, &b));
+    for (((((((((fx, fy), fz), (&rest, &weight)), x), y), z), vx), vy), vz) in springs {
+        let (dx, dy, dz) = (x.1 - x.0, y.1 - y.0, z.1 - z.0);
+        let len = (dx * dx + dy * dy + dz * dz).sqrt();
+        // 1/|l| for a live spring, 0 for a torn or missing one (no branch).
+        let live = f32::from(u8::from(weight != 0.0 && len > f32::EPSILON));
+        let inv = live / len.max(f32::EPSILON);
+        let along = (vx.1 - vx.0) * dx + (vy.1 - vy.0) * dy + (vz.1 - vz.0) * dz;
+        let magnitude = k * weight * (len - rest) + damping * along * inv;
+        let scale = magnitude * inv;
+        (*fx, *fy, *fz) = (dx * scale, dy * scale, dz * scale);
+    }
+}
+
+/// The elements `a` and `b` of one lane, side by side.
+fn pair<'l>(
+    lane: &'l [f32],
+    a: &Range<usize>,
+    b: &Range<usize>,
+) -> Zip<Iter<'l, f32>, Iter<'l, f32>> {
+    lane[a.clone()].iter().zip(&lane[b.clone()])
+}
+
+/// Adds to `sum` (one lane of the particles from `from` on) the forces `springs` of an
+/// offset of `step` (one lane): `+` on each spring's start, `−` on its end.
+fn add_ends(sum: &mut [f32], springs: &[f32], from: usize, step: usize, n: usize) {
+    let (len, m) = (sum.len(), n - step);
+    if from < m {
+        let end = (from + len).min(m);
+        for (f, s) in sum[..end - from].iter_mut().zip(&springs[from..end]) {
+            *f += s;
+        }
+    }
+    let (lo, hi) = (from.max(step), from + len);
+    if lo < hi {
+        for (f, s) in sum[lo - from..]
+            .iter_mut()
+            .zip(&springs[lo - step..hi - step])
+        {
+            *f -= s;
         }
     }
 }
@@ -59,6 +141,10 @@ pub(super) struct Stencil {
     offsets: Vec<Offset>,
     /// For each spring: its offset and `a`, to follow tearing.
     slot: Vec<(u8, u32)>,
+    /// Each offset's stiffness in this substep (0: its family is off).
+    stiffness: Vec<f32>,
+    /// Each offset's spring forces (as many as it has springs; room for `n`).
+    springs: Vec<Lanes>,
     /// Positions, velocities and forces as lanes, for the substep's kernels.
     x: Lanes,
     v: Lanes,
@@ -114,6 +200,8 @@ impl Stencil {
             slot.push((index as u8, a as u32));
         }
         let mut stencil = Self {
+            stiffness: vec![0.0; offsets.len()],
+            springs: vec![Lanes::new(n); offsets.len()],
             width,
             offsets,
             slot,
@@ -146,7 +234,10 @@ impl Stencil {
     }
 
     /// Adds every spring's Hooke force `k (|l| − l0) l/|l|` plus damping along it
-    /// (the general path's law, `forces.rs`) to `p.force`; `k` per family.
+    /// (the general path's law, `forces.rs`) to `p.force`; `k` per family. Two passes,
+    /// each split over the compute pool: every spring's force, then every particle's sum
+    /// of its springs (offset by offset, `+` from the springs it starts, `−` from those
+    /// it ends).
     pub fn spring_forces(
         &mut self,
         p: &mut Particles,
@@ -156,53 +247,50 @@ impl Stencil {
         let n = p.len();
         self.x.load(&p.position);
         self.v.load(&p.velocity);
-        for lane in &mut self.f.0 {
-            lane.fill(0.0);
+        for (stiffness, offset) in self.stiffness.iter_mut().zip(&self.offsets) {
+            *stiffness = k(offset.kind);
         }
-        let [x, y, z] = &self.x.0;
-        let [vx, vy, vz] = &self.v.0;
-        for offset in &self.offsets {
-            let k = k(offset.kind);
-            if k == 0.0 {
-                continue;
-            }
-            let (m, step) = (n - offset.step, offset.step);
-            let [sx, sy, sz] = &mut self.scratch[0].0;
-            let springs = sx[..m]
-                .iter_mut()
-                .zip(&mut sy[..m])
-                .zip(&mut sz[..m])
-                .zip(offset.rest.iter().zip(&offset.weight))
-                .zip(x[..m].iter().zip(&x[step..]))
-                .zip(y[..m].iter().zip(&y[step..]))
-                .zip(z[..m].iter().zip(&z[step..]))
-                .zip(vx[..m].iter().zip(&vx[step..]))
-                .zip(vy[..m].iter().zip(&vy[step..]))
-                .zip(vz[..m].iter().zip(&vz[step..]));
-            for (((((((((fx, fy), fz), (&rest, &weight)), x), y), z), vx), vy), vz) in springs {
-                let (dx, dy, dz) = (x.1 - x.0, y.1 - y.0, z.1 - z.0);
-                let len = (dx * dx + dy * dy + dz * dz).sqrt();
-                // 1/|l| for a live spring, 0 for a torn or missing one (no branch).
-                let live = f32::from(u8::from(weight != 0.0 && len > f32::EPSILON));
-                let inv = live / len.max(f32::EPSILON);
-                let along = (vx.1 - vx.0) * dx + (vy.1 - vy.0) * dy + (vz.1 - vz.0) * dz;
-                let magnitude = k * weight * (len - rest) + damping * along * inv;
-                let scale = magnitude * inv;
-                (*fx, *fy, *fz) = (dx * scale, dy * scale, dz * scale);
-            }
-            for (force, spring) in self.f.0.iter_mut().zip(&self.scratch[0].0) {
-                for (f, s) in force[..m].iter_mut().zip(&spring[..m]) {
-                    *f += s;
-                }
-                for (f, s) in force[step..].iter_mut().zip(&spring[..m]) {
-                    *f -= s;
+        let (x, v) = (&self.x, &self.v);
+        let pieces = self
+            .offsets
+            .iter()
+            .zip(&mut self.springs)
+            .zip(&self.stiffness)
+            .filter(|(_, k)| **k != 0.0)
+            .flat_map(|((o, springs), &k)| {
+                let m = n - o.step;
+                let [sx, sy, sz] = &mut springs.0;
+                let chunks = sx[..m].chunks_mut(PIECE).zip(sy[..m].chunks_mut(PIECE));
+                chunks
+                    .zip(sz[..m].chunks_mut(PIECE))
+                    .enumerate()
+                    .map(move |(i, ((sx, sy), sz))| (o, k, i * PIECE, [sx, sy, sz]))
+            });
+        parallel::for_each(n, pieces, |(o, k, from, out)| {
+            spring_piece(o, k, damping, from, x, v, out);
+        });
+        let (springs, offsets, stiffness) = (&self.springs, &self.offsets, &self.stiffness);
+        let [fx, fy, fz] = &mut self.f.0;
+        let pieces = fx
+            .chunks_mut(PIECE)
+            .zip(fy.chunks_mut(PIECE))
+            .zip(fz.chunks_mut(PIECE))
+            .zip(p.force.chunks_mut(PIECE))
+            .enumerate();
+        parallel::for_each(n, pieces, |(i, (((fx, fy), fz), force))| {
+            let from = i * PIECE;
+            for (lane, sum) in [&mut *fx, &mut *fy, &mut *fz].into_iter().enumerate() {
+                sum.fill(0.0);
+                for ((o, springs), k) in offsets.iter().zip(springs).zip(stiffness) {
+                    if *k != 0.0 {
+                        add_ends(sum, &springs.0[lane], from, o.step, n);
+                    }
                 }
             }
-        }
-        let [fx, fy, fz] = &self.f.0;
-        for (((force, fx), fy), fz) in p.force.iter_mut().zip(fx).zip(fy).zip(fz) {
-            *force += Vec3::new(*fx, *fy, *fz);
-        }
+            for (((force, x), y), z) in force.iter_mut().zip(&*fx).zip(&*fy).zip(&*fz) {
+                *force += Vec3::new(*x, *y, *z);
+            }
+        });
     }
 
     /// Provot's strain limit (the general path's law, `integrate.rs`) over the enabled
@@ -230,14 +318,20 @@ impl Stencil {
             }
         }
         let [x, y, z] = &self.x.0;
-        let lanes = x.iter().zip(y).zip(z);
-        for ((position, velocity), ((x, y), z)) in
-            p.position.iter_mut().zip(&mut p.velocity).zip(lanes)
-        {
-            let corrected = Vec3::new(*x, *y, *z);
-            *velocity += (corrected - *position) / h;
-            *position = corrected;
-        }
+        let pieces = p
+            .position
+            .chunks_mut(PIECE)
+            .zip(p.velocity.chunks_mut(PIECE))
+            .zip(x.chunks(PIECE).zip(y.chunks(PIECE)).zip(z.chunks(PIECE)));
+        parallel::for_each(x.len(), pieces, |((position, velocity), ((x, y), z))| {
+            let lanes = x.iter().zip(y).zip(z);
+            for ((position, velocity), ((x, y), z)) in position.iter_mut().zip(velocity).zip(lanes)
+            {
+                let corrected = Vec3::new(*x, *y, *z);
+                *velocity += (corrected - *position) / h;
+                *position = corrected;
+            }
+        });
     }
 
     /// One coloured sweep; with `TRACK`, whether a spring was longer than `past·l0`.
@@ -264,7 +358,8 @@ impl Stencil {
         let mut unconverged = false;
         for parity in 0..2 {
             for o in along.iter().flatten() {
-                unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, parity);
+                let scratch = &mut self.scratch[0];
+                unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, parity, scratch);
             }
         }
         for parity in 0..2 {
@@ -314,50 +409,105 @@ impl Projection {
         )
     }
 
-    /// The springs `(a, a + 1)` with `a` of one parity: disjoint pairs of particles.
+    /// The springs `(a, a + 1)` with `a` of one parity: disjoint pairs of particles. Two
+    /// passes over shifted slices, each in pieces over the compute pool and vectorised:
+    /// every spring's correction (zero for the other parity), then every particle's
+    /// (`+` as a start, `−` as an end; one of the two is zero).
     fn along_rows<const TRACK: bool>(
         &self,
         x: &mut [Vec<f32>; 3],
         inv_mass: &[f32],
         o: &Offset,
         parity: usize,
+        scratch: &mut Lanes,
     ) -> bool {
-        let mut unconverged = false;
-        if o.rest.len() <= parity {
+        let (n, m) = (x[0].len(), o.rest.len());
+        if m <= parity {
             return false;
         }
-        let [x, y, z] = x;
-        let springs = x[parity..]
-            .chunks_exact_mut(2)
-            .zip(y[parity..].chunks_exact_mut(2))
-            .zip(z[parity..].chunks_exact_mut(2))
-            .zip(inv_mass[parity..].chunks_exact(2))
+        let [cx, cy, cz] = &mut scratch.0;
+        let pieces = cx[..m]
+            .chunks_mut(PIECE)
+            .zip(cy[..m].chunks_mut(PIECE))
+            .zip(cz[..m].chunks_mut(PIECE))
+            .enumerate();
+        let positions = &*x;
+        let unconverged = parallel::any(n, pieces, |(i, ((cx, cy), cz))| {
+            let from = i * PIECE;
+            self.row_corrections::<TRACK>(positions, inv_mass, o, parity, from, [cx, cy, cz])
+        });
+        let c = &scratch.0;
+        for (lane, c) in x.iter_mut().zip(c) {
+            let pieces = lane
+                .chunks_mut(PIECE)
+                .zip(inv_mass.chunks(PIECE))
+                .enumerate();
+            parallel::for_each(n, pieces, |(i, (lane, w))| {
+                let from = i * PIECE;
+                // As a start: x_a += c_a w_a.
+                let starts = (from + lane.len()).min(m).saturating_sub(from);
+                for ((x, w), c) in lane[..starts].iter_mut().zip(w).zip(&c[from..]) {
+                    *x += c * w;
+                }
+                // As an end: x_b −= c_{b−1} w_b.
+                let skip = usize::from(from == 0);
+                for ((x, w), c) in lane[skip..]
+                    .iter_mut()
+                    .zip(&w[skip..])
+                    .zip(&c[from + skip - 1..m])
+                {
+                    *x -= c * w;
+                }
+            });
+        }
+        unconverged
+    }
+
+    /// The corrections of the springs `(a, a + 1)` from `from` on (as many as `out`
+    /// holds) into `out`, zero for the springs whose `a` is not of `parity`.
+    fn row_corrections<const TRACK: bool>(
+        &self,
+        x: &[Vec<f32>; 3],
+        inv_mass: &[f32],
+        o: &Offset,
+        parity: usize,
+        from: usize,
+        [cx, cy, cz]: [&mut [f32]; 3],
+    ) -> bool {
+        let len = cx.len();
+        let (a, b) = (from..from + len, from + 1..from + 1 + len);
+        let mut unconverged = false;
+        let springs = cx
+            .iter_mut()
+            .zip(cy.iter_mut())
+            .zip(cz.iter_mut())
+            .zip(o.rest[a.clone()].iter().zip(&o.weight[a.clone()]))
             .zip(
-                o.rest[parity..]
-                    .iter()
-                    .step_by(2)
-                    .zip(o.weight[parity..].iter().step_by(2)),
-            );
-        for ((((x, y), z), w), (&rest, &weight)) in springs {
+                pair(&x[0], &a, &b)
+                    .zip(pair(&x[1], &a, &b))
+                    .zip(pair(&x[2], &a, &b)),
+            )
+            .zip(pair(inv_mass, &a, &b))
+            .enumerate();
+        for (i, (((((cx, cy), cz), (&rest, &weight)), ((x, y), z)), (&wa, &wb))) in springs {
+            let mine = f32::from(u8::from((from + i) % 2 == parity));
             let (c, long) = self.correction(
-                [x[0], y[0], z[0]],
-                [x[1], y[1], z[1]],
-                w[0],
-                w[1],
+                [*x.0, *y.0, *z.0],
+                [*x.1, *y.1, *z.1],
+                wa,
+                wb,
                 rest,
-                weight,
+                weight * mine,
             );
             unconverged |= TRACK && long;
-            (x[0], y[0], z[0]) = (x[0] + c[0] * w[0], y[0] + c[1] * w[0], z[0] + c[2] * w[0]);
-            (x[1], y[1], z[1]) = (x[1] - c[0] * w[1], y[1] - c[1] * w[1], z[1] - c[2] * w[1]);
+            (*cx, *cy, *cz) = (c[0], c[1], c[2]);
         }
         unconverged
     }
 
     /// The springs of `offsets` (the vertical one, or both diagonals together) from the
     /// rows of one parity to the next row. Each band of two rows is disjoint from the
-    /// others; every correction comes from the positions before any (the two diagonals
-    /// share particles), then all are applied.
+    /// others, so groups of bands run in pieces over the compute pool.
     #[allow(clippy::too_many_arguments)]
     fn across_rows<const TRACK: bool>(
         &self,
@@ -368,12 +518,60 @@ impl Projection {
         parity: usize,
         scratch: &mut [Lanes; 2],
     ) -> bool {
-        let mut unconverged = false;
         let from = parity * width;
         let band = 2 * width;
         if offsets.iter().any(|o| o.rest.len() <= from) {
             return false; // too few rows for a band from this parity
         }
+        let n = x[0].len();
+        let end = from + (n - from) / band * band; // whole bands only
+        let group = band * (PIECE / band).max(1);
+        let [x, y, z] = x;
+        let [s0, s1] = scratch;
+        let [c0x, c0y, c0z] = &mut s0.0;
+        let [c1x, c1y, c1z] = &mut s1.0;
+        fn cut(lane: &mut [f32], range: Range<usize>, group: usize) -> ChunksMut<'_, f32> {
+            lane[range].chunks_mut(group)
+        }
+        let chunks = |lane| cut(lane, from..end, group);
+        let pieces = chunks(x)
+            .zip(chunks(y))
+            .zip(chunks(z))
+            .zip(chunks(c0x).zip(chunks(c0y)).zip(chunks(c0z)))
+            .zip(chunks(c1x).zip(chunks(c1y)).zip(chunks(c1z)))
+            .enumerate();
+        parallel::any(
+            n,
+            pieces,
+            |(i, ((((x, y), z), ((c0x, c0y), c0z)), ((c1x, c1y), c1z)))| {
+                let start = from + i * group;
+                let rows = Bands {
+                    x: [x, y, z],
+                    inv_mass: &inv_mass[start..],
+                    width,
+                };
+                self.bands::<TRACK>(rows, offsets, start, [[c0x, c0y, c0z], [c1x, c1y, c1z]])
+            },
+        )
+    }
+
+    /// [`Self::across_rows`] on one group of bands starting at particle `start`: every
+    /// correction comes from the positions before any (the two diagonals share
+    /// particles), then all are applied.
+    fn bands<const TRACK: bool>(
+        &self,
+        rows: Bands<'_>,
+        offsets: &[&Offset],
+        start: usize,
+        mut scratch: [[&mut [f32]; 3]; 2],
+    ) -> bool {
+        let Bands {
+            mut x,
+            inv_mass,
+            width,
+        } = rows;
+        let band = 2 * width;
+        let mut unconverged = false;
         // A band's springs: (top columns, bottom columns) for a column offset of −1, 0, 1.
         let columns = |o: &Offset| match o.dx {
             1 => (0..width - 1, 1..width),
@@ -382,22 +580,19 @@ impl Projection {
         };
         for (o, corrections) in offsets.iter().zip(scratch.iter_mut()) {
             let (top, bottom) = columns(o);
-            let [cx, cy, cz] = &mut corrections.0;
-            let bands = x[0][from..]
+            let [cx, cy, cz] = corrections;
+            let rest = &o.rest[start.min(o.rest.len())..];
+            let weight = &o.weight[start.min(o.rest.len())..];
+            let bands = x[0]
                 .chunks_exact(band)
-                .zip(x[1][from..].chunks_exact(band))
-                .zip(x[2][from..].chunks_exact(band))
-                .zip(inv_mass[from..].chunks_exact(band))
+                .zip(x[1].chunks_exact(band))
+                .zip(x[2].chunks_exact(band))
+                .zip(inv_mass.chunks_exact(band))
+                .zip(rest.chunks(band).zip(weight.chunks(band)))
                 .zip(
-                    o.rest[from..]
-                        .chunks(band)
-                        .zip(o.weight[from..].chunks(band)),
-                )
-                .zip(
-                    cx[from..]
-                        .chunks_mut(band)
-                        .zip(cy[from..].chunks_mut(band))
-                        .zip(cz[from..].chunks_mut(band)),
+                    cx.chunks_mut(band)
+                        .zip(cy.chunks_mut(band))
+                        .zip(cz.chunks_mut(band)),
                 );
             for (((((xs, ys), zs), w), (rest, weight)), ((cx, cy), cz)) in bands {
                 let (t, b) = (top.clone(), bottom.start + width..bottom.end + width);
@@ -430,11 +625,11 @@ impl Projection {
         }
         for (o, corrections) in offsets.iter().zip(scratch.iter()) {
             let (top, bottom) = columns(o);
-            for (lane, c) in x.iter_mut().zip(&corrections.0) {
-                let bands = lane[from..]
+            for (lane, c) in x.iter_mut().zip(corrections) {
+                let bands = lane
                     .chunks_exact_mut(band)
-                    .zip(inv_mass[from..].chunks_exact(band))
-                    .zip(c[from..].chunks(band));
+                    .zip(inv_mass.chunks_exact(band))
+                    .zip(c.chunks(band));
                 for ((lane, w), c) in bands {
                     let (t, b) = lane.split_at_mut(width);
                     let (wt, wb) = w.split_at(width);
@@ -452,4 +647,12 @@ impl Projection {
         }
         unconverged
     }
+}
+
+/// A group of whole bands of two rows: positions as lanes, inverse masses from the
+/// group's first particle on.
+struct Bands<'a> {
+    x: [&'a mut [f32]; 3],
+    inv_mass: &'a [f32],
+    width: usize,
 }

@@ -97,6 +97,10 @@ struct BenchArgs {
     /// The models of the full-app experiment (implies --app; all when absent).
     #[arg(long = "app-models", value_delimiter = ',', value_parser = seed_model)]
     app_models: Vec<&'static str>,
+    /// Skips the mass-spring kernel costs (plain substep, limiter sweep, one core
+    /// against all) at 4,096, 16,384 and 65,536 particles.
+    #[arg(long = "no-kernels")]
+    no_kernels: bool,
     #[command(flatten)]
     output: Output,
 }
@@ -408,6 +412,48 @@ fn print_json<T: serde::Serialize>(value: &T) -> Result<(), String> {
     Ok(())
 }
 
+/// The counts at which `bench` measures the mass-spring kernel costs.
+const KERNEL_COUNTS: [usize; 3] = [4_096, 16_384, 65_536];
+
+/// The kernel costs as a table: one core per substep against the bare kernel, a limiter
+/// sweep against a plain substep, all cores against one.
+fn print_kernels(kernels: &[bevy_cloth_lab::KernelCosts]) {
+    if kernels.is_empty() {
+        return;
+    }
+    let ns = |v: Option<f64>| v.map_or("failed".to_string(), |v| format!("{v:.2}"));
+    println!();
+    println!(
+        "mass-spring curtain, one core unless said: ns per particle-substep of the bare kernel, \
+         a plain substep (no limiter) [× bare], one limiter sweep [× plain]; ms per step on one \
+         core and on all, and the speed-up"
+    );
+    println!(
+        "| particles | substeps | bare | plain | sweep | 1 core ms | {} threads ms | speed-up |",
+        kernels[0].threads
+    );
+    println!("|---:|---:|---:|---:|---:|---:|---:|---:|");
+    for k in kernels {
+        let ratio = |a: Option<f64>, b: Option<f64>| {
+            a.zip(b)
+                .map_or("-".to_string(), |(a, b)| format!("{:.2}", a / b))
+        };
+        println!(
+            "| {} | {} | {:.2} | {} [{}×] | {} [{}×] | {} | {} | {}× |",
+            k.particles,
+            k.substeps,
+            k.bare_ns,
+            ns(k.plain_ns),
+            ratio(k.plain_ns, Some(k.bare_ns)),
+            ns(k.sweep_ns),
+            ratio(k.sweep_ns, k.plain_ns),
+            ns(k.one_core_ms),
+            ns(k.all_cores_ms),
+            ratio(k.one_core_ms, k.all_cores_ms),
+        );
+    }
+}
+
 fn bench(args: BenchArgs) -> Result<(), String> {
     let (max, repeats) = (args.max, args.repeats);
     let models = or_all(args.models, &SEED_MODELS);
@@ -448,6 +494,15 @@ fn bench(args: BenchArgs) -> Result<(), String> {
             cells.push(cell);
         }
     }
+    let mut kernels = Vec::new();
+    if !args.no_kernels {
+        for count in KERNEL_COUNTS.into_iter().filter(|&c| c <= max) {
+            let costs =
+                bevy_cloth_lab::kernel_costs(count, repeats.min(9)).map_err(|e| e.to_string())?;
+            eprintln!("kernel costs, {count:>6} particles: {costs:?}");
+            kernels.push(costs);
+        }
+    }
     let mut frames = Vec::new();
     if with_app {
         for &model in &app_models {
@@ -481,9 +536,12 @@ fn bench(args: BenchArgs) -> Result<(), String> {
             .zip(&bare)
             .map(|(count, ns)| serde_json::json!({ "particles": count, "ns_per_particle_substep": ns }))
             .collect();
-        return print_json(
-            &serde_json::json!({ "solver": cells, "bare_kernel": bare, "app": frames }),
-        );
+        return print_json(&serde_json::json!({
+            "solver": cells,
+            "bare_kernel": bare,
+            "kernels": kernels,
+            "app": frames
+        }));
     }
     if !cells.is_empty() {
         println!(
@@ -542,6 +600,7 @@ fn bench(args: BenchArgs) -> Result<(), String> {
             }
         });
     }
+    print_kernels(&kernels);
     if !frames.is_empty() {
         println!();
         println!("| model | masses | ms per frame | fps | seed 002 fps |");

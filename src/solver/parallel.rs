@@ -1,0 +1,74 @@
+//! Both cores: a cloth's kernels split into fixed pieces run on Bevy's compute task pool
+//! (the engine's own threads; the pool is made on first use outside an app). Every
+//! element is computed the same way whichever thread takes its piece, so results do not
+//! depend on the number of threads.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use bevy::tasks::{ComputeTaskPool, TaskPool};
+
+/// Elements per piece of work: large enough that a task's bookkeeping is a small share
+/// of it, small enough that two threads share a 16,384-particle cloth evenly.
+pub(super) const PIECE: usize = 4096;
+
+/// Below this many elements a kernel runs on the calling thread (no task bookkeeping,
+/// no allocation).
+pub(super) const PARALLEL_FROM: usize = 2 * PIECE;
+
+/// Whether a cloth's kernels may use the compute pool (the default).
+static PARALLEL: AtomicBool = AtomicBool::new(true);
+
+/// Lets a cloth's kernels use Bevy's compute task pool (`true`, the default) or keeps
+/// every kernel on the calling thread (`false`), for the whole process. Results are the
+/// same bits either way; this is for measuring what the second core buys (`cloth bench`)
+/// and for checking that it changes nothing.
+pub fn set_parallel(on: bool) {
+    PARALLEL.store(on, Ordering::Relaxed);
+}
+
+/// The threads a large cloth's kernels use: the compute pool's threads and the calling
+/// thread (which works on a scope's tasks while it waits), at most one per core; 1 with
+/// [`set_parallel`]`(false)`.
+pub fn threads() -> usize {
+    if PARALLEL.load(Ordering::Relaxed) {
+        let cores = std::thread::available_parallelism().map_or(1, usize::from);
+        (ComputeTaskPool::get_or_init(TaskPool::default).thread_num() + 1).min(cores)
+    } else {
+        1
+    }
+}
+
+/// Runs `work` on every piece, spread over the compute pool when there are
+/// `len ≥ PARALLEL_FROM` elements and more than one thread, else in order on this
+/// thread. A piece is the same work whichever thread takes it.
+pub(super) fn for_each<T: Send>(
+    len: usize,
+    pieces: impl Iterator<Item = T>,
+    work: impl Fn(T) + Sync,
+) {
+    if len < PARALLEL_FROM || !PARALLEL.load(Ordering::Relaxed) {
+        pieces.for_each(work);
+        return;
+    }
+    let work = &work;
+    ComputeTaskPool::get_or_init(TaskPool::default).scope(|scope| {
+        for piece in pieces {
+            scope.spawn(async move { work(piece) });
+        }
+    });
+}
+
+/// As [`for_each`], for work that reports a flag: whether any piece returned `true`.
+pub(super) fn any<T: Send>(
+    len: usize,
+    pieces: impl Iterator<Item = T>,
+    work: impl Fn(T) -> bool + Sync,
+) -> bool {
+    let found = AtomicBool::new(false);
+    for_each(len, pieces, |piece| {
+        if work(piece) {
+            found.store(true, Ordering::Relaxed);
+        }
+    });
+    found.into_inner()
+}
