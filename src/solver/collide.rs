@@ -49,7 +49,47 @@ pub struct Collider {
     pub friction: f32,
 }
 
+/// An axis-aligned box a collider's reach lies in: a particle outside it is farther than
+/// the thickness from the surface (the broad phase of [`ClothSolver::collide`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct Bounds {
+    min: Vec3,
+    max: Vec3,
+}
+
+impl Bounds {
+    /// Whether `x` lies in the box.
+    #[inline]
+    fn contains(&self, x: Vec3) -> bool {
+        x.cmpge(self.min).all() && x.cmple(self.max).all()
+    }
+}
+
 impl Collider {
+    /// The box around every point within `thickness` of the solid, grown by a relative
+    /// 1e-4 against rounding (a plane's is everything).
+    pub(super) fn bounds(&self) -> Bounds {
+        let around = |lo: Vec3, hi: Vec3, reach: f32| {
+            let reach = reach * 1.0001 + 1e-6;
+            Bounds {
+                min: lo - Vec3::splat(reach),
+                max: hi + Vec3::splat(reach),
+            }
+        };
+        match self.shape {
+            ColliderShape::Sphere { center, radius } => {
+                around(center, center, radius + self.thickness)
+            }
+            ColliderShape::Capsule { a, b, radius } => {
+                around(a.min(b), a.max(b), radius + self.thickness)
+            }
+            ColliderShape::Plane { .. } => Bounds {
+                min: Vec3::NEG_INFINITY,
+                max: Vec3::INFINITY,
+            },
+        }
+    }
+
     /// Signed distance from the surface (negative inside) and the outward normal at the
     /// closest surface point.
     pub fn distance(&self, x: Vec3) -> (f32, Vec3) {
@@ -90,7 +130,10 @@ impl ClothSolver {
             }
             let mut x = p.position[i];
             let mut touched = false;
-            for c in &self.colliders {
+            for (c, bounds) in self.colliders.iter().zip(&self.collider_bounds) {
+                if !bounds.contains(x) {
+                    continue; // farther than the thickness: the distance would say so
+                }
                 let (d, n) = c.distance(x);
                 let depth = c.thickness - d;
                 if depth <= 0.0 {

@@ -356,22 +356,19 @@ impl Stencil {
         let w = self.width;
         let x = &mut self.x.0;
         let mut unconverged = false;
-        for parity in 0..2 {
-            for o in along.iter().flatten() {
-                let scratch = &mut self.scratch[0];
-                unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, parity, scratch);
-            }
+        let [along, _] = along;
+        if let Some(o) = along {
+            unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, w, &mut self.scratch[0]);
         }
+        let [down, _] = down;
+        let diagonals = match diagonals {
+            [Some(d1), Some(d2)] => Some([d1, d2]),
+            _ => None,
+        };
         for parity in 0..2 {
             let scratch = &mut self.scratch;
-            for o in down.iter().flatten() {
-                unconverged |=
-                    projection.across_rows::<TRACK>(x, inv_mass, &[o], w, parity, scratch);
-            }
-            if let [Some(d1), Some(d2)] = diagonals {
-                unconverged |=
-                    projection.across_rows::<TRACK>(x, inv_mass, &[d1, d2], w, parity, scratch);
-            }
+            unconverged |=
+                projection.across_rows::<TRACK>(x, inv_mass, down, diagonals, w, parity, scratch);
         }
         unconverged
     }
@@ -409,121 +406,129 @@ impl Projection {
         )
     }
 
-    /// The springs `(a, a + 1)` with `a` of one parity: disjoint pairs of particles. Two
-    /// passes over shifted slices, each in pieces over the compute pool and vectorised:
-    /// every spring's correction (zero for the other parity), then every particle's
-    /// (`+` as a start, `−` as an end; one of the two is zero).
+    /// The springs `(a, a + 1)` along the rows: those with `a` even, then those with `a`
+    /// odd, each colour a set of disjoint pairs of particles. Rows do not share these
+    /// springs, so groups of whole rows run in pieces over the compute pool (one task
+    /// each for both colours).
     fn along_rows<const TRACK: bool>(
         &self,
         x: &mut [Vec<f32>; 3],
         inv_mass: &[f32],
         o: &Offset,
-        parity: usize,
+        width: usize,
         scratch: &mut Lanes,
     ) -> bool {
-        let (n, m) = (x[0].len(), o.rest.len());
-        if m <= parity {
-            return false;
-        }
+        let n = x[0].len();
+        let group = width * (PIECE / width).max(1);
+        let [x, y, z] = x;
         let [cx, cy, cz] = &mut scratch.0;
-        let pieces = cx[..m]
-            .chunks_mut(PIECE)
-            .zip(cy[..m].chunks_mut(PIECE))
-            .zip(cz[..m].chunks_mut(PIECE))
-            .enumerate();
-        let positions = &*x;
-        let unconverged = parallel::any(n, pieces, |(i, ((cx, cy), cz))| {
-            let from = i * PIECE;
-            self.row_corrections::<TRACK>(positions, inv_mass, o, parity, from, [cx, cy, cz])
-        });
-        let c = &scratch.0;
-        for (lane, c) in x.iter_mut().zip(c) {
-            let pieces = lane
-                .chunks_mut(PIECE)
-                .zip(inv_mass.chunks(PIECE))
-                .enumerate();
-            parallel::for_each(n, pieces, |(i, (lane, w))| {
-                let from = i * PIECE;
-                // As a start: x_a += c_a w_a.
-                let starts = (from + lane.len()).min(m).saturating_sub(from);
-                for ((x, w), c) in lane[..starts].iter_mut().zip(w).zip(&c[from..]) {
-                    *x += c * w;
-                }
-                // As an end: x_b −= c_{b−1} w_b.
-                let skip = usize::from(from == 0);
-                for ((x, w), c) in lane[skip..]
-                    .iter_mut()
-                    .zip(&w[skip..])
-                    .zip(&c[from + skip - 1..m])
-                {
-                    *x -= c * w;
-                }
-            });
-        }
-        unconverged
-    }
-
-    /// The corrections of the springs `(a, a + 1)` from `from` on (as many as `out`
-    /// holds) into `out`, zero for the springs whose `a` is not of `parity`.
-    fn row_corrections<const TRACK: bool>(
-        &self,
-        x: &[Vec<f32>; 3],
-        inv_mass: &[f32],
-        o: &Offset,
-        parity: usize,
-        from: usize,
-        [cx, cy, cz]: [&mut [f32]; 3],
-    ) -> bool {
-        let len = cx.len();
-        let (a, b) = (from..from + len, from + 1..from + 1 + len);
-        let mut unconverged = false;
-        let springs = cx
-            .iter_mut()
-            .zip(cy.iter_mut())
-            .zip(cz.iter_mut())
-            .zip(o.rest[a.clone()].iter().zip(&o.weight[a.clone()]))
+        let pieces = x
+            .chunks_mut(group)
+            .zip(y.chunks_mut(group))
+            .zip(z.chunks_mut(group))
             .zip(
-                pair(&x[0], &a, &b)
-                    .zip(pair(&x[1], &a, &b))
-                    .zip(pair(&x[2], &a, &b)),
+                cx.chunks_mut(group)
+                    .zip(cy.chunks_mut(group))
+                    .zip(cz.chunks_mut(group)),
             )
-            .zip(pair(inv_mass, &a, &b))
             .enumerate();
-        for (i, (((((cx, cy), cz), (&rest, &weight)), ((x, y), z)), (&wa, &wb))) in springs {
-            let mine = f32::from(u8::from((from + i) % 2 == parity));
-            let (c, long) = self.correction(
-                [*x.0, *y.0, *z.0],
-                [*x.1, *y.1, *z.1],
-                wa,
-                wb,
-                rest,
-                weight * mine,
+        parallel::any(n, pieces, |(i, (((x, y), z), ((cx, cy), cz)))| {
+            let from = i * group;
+            let mut x = [x, y, z];
+            let mut c = [cx, cy, cz];
+            let w = &inv_mass[from..from + x[0].len()];
+            let springs = (
+                &o.rest[from.min(o.rest.len())..],
+                &o.weight[from.min(o.rest.len())..],
             );
-            unconverged |= TRACK && long;
-            (*cx, *cy, *cz) = (c[0], c[1], c[2]);
+            let mut unconverged = false;
+            for parity in 0..2 {
+                unconverged |= self.row_colour::<TRACK>(&mut x, w, springs, from, parity, &mut c);
+            }
+            unconverged
+        })
+    }
+
+    /// One colour of [`Self::along_rows`] on a group of rows starting at particle `from`,
+    /// in two vectorised passes over shifted slices: every spring's correction into `c`
+    /// (zero for the springs of the other colour), then every particle's (`+` as a start,
+    /// `−` as an end; one of the two is zero).
+    fn row_colour<const TRACK: bool>(
+        &self,
+        x: &mut [&mut [f32]; 3],
+        inv_mass: &[f32],
+        (rest, weight): (&[f32], &[f32]),
+        from: usize,
+        parity: usize,
+        c: &mut [&mut [f32]; 3],
+    ) -> bool {
+        let m = (x[0].len() - 1).min(rest.len()); // springs starting in the group
+        let (a, b) = (0..m, 1..m + 1);
+        let mut unconverged = false;
+        {
+            let [cx, cy, cz] = c;
+            let springs = cx[..m]
+                .iter_mut()
+                .zip(cy[..m].iter_mut())
+                .zip(cz[..m].iter_mut())
+                .zip(rest.iter().zip(weight))
+                .zip(
+                    pair(x[0], &a, &b)
+                        .zip(pair(x[1], &a, &b))
+                        .zip(pair(x[2], &a, &b)),
+                )
+                .zip(pair(inv_mass, &a, &b))
+                .enumerate();
+            for (i, (((((cx, cy), cz), (&rest, &weight)), ((x, y), z)), (&wa, &wb))) in springs {
+                let mine = f32::from(u8::from((from + i) % 2 == parity));
+                let (c, long) = self.correction(
+                    [*x.0, *y.0, *z.0],
+                    [*x.1, *y.1, *z.1],
+                    wa,
+                    wb,
+                    rest,
+                    weight * mine,
+                );
+                unconverged |= TRACK && long;
+                (*cx, *cy, *cz) = (c[0], c[1], c[2]);
+            }
+        }
+        for (lane, c) in x.iter_mut().zip(c.iter()) {
+            // As a start: x_a += c_a w_a; as an end: x_b −= c_{b−1} w_b.
+            for ((x, w), c) in lane[..m].iter_mut().zip(inv_mass).zip(&c[..m]) {
+                *x += c * w;
+            }
+            for ((x, w), c) in lane[1..m + 1].iter_mut().zip(&inv_mass[1..]).zip(&c[..m]) {
+                *x -= c * w;
+            }
         }
         unconverged
     }
 
-    /// The springs of `offsets` (the vertical one, or both diagonals together) from the
-    /// rows of one parity to the next row. Each band of two rows is disjoint from the
-    /// others, so groups of bands run in pieces over the compute pool.
+    /// The springs from the rows of one parity to the next row: the vertical ones, then
+    /// both diagonals together. Each band of two rows is disjoint from the others, so
+    /// groups of bands run in pieces over the compute pool (one task each for both).
     #[allow(clippy::too_many_arguments)]
     fn across_rows<const TRACK: bool>(
         &self,
         x: &mut [Vec<f32>; 3],
         inv_mass: &[f32],
-        offsets: &[&Offset],
+        down: Option<&Offset>,
+        diagonals: Option<[&Offset; 2]>,
         width: usize,
         parity: usize,
         scratch: &mut [Lanes; 2],
     ) -> bool {
         let from = parity * width;
         let band = 2 * width;
-        if offsets.iter().any(|o| o.rest.len() <= from) {
-            return false; // too few rows for a band from this parity
-        }
+        // Too few rows for a band from this parity: no springs to take.
+        let fits = |o: &&Offset| o.rest.len() > from;
+        let down = down.filter(fits);
+        let diagonals = diagonals.filter(|d| d.iter().all(fits));
         let n = x[0].len();
+        if (down.is_none() && diagonals.is_none()) || n < from + band {
+            return false;
+        }
         let end = from + (n - from) / band * band; // whole bands only
         let group = band * (PIECE / band).max(1);
         let [x, y, z] = x;
@@ -545,12 +550,20 @@ impl Projection {
             pieces,
             |(i, ((((x, y), z), ((c0x, c0y), c0z)), ((c1x, c1y), c1z)))| {
                 let start = from + i * group;
-                let rows = Bands {
+                let mut rows = Bands {
                     x: [x, y, z],
                     inv_mass: &inv_mass[start..],
                     width,
                 };
-                self.bands::<TRACK>(rows, offsets, start, [[c0x, c0y, c0z], [c1x, c1y, c1z]])
+                let mut scratch = [[c0x, c0y, c0z], [c1x, c1y, c1z]];
+                let mut unconverged = false;
+                if let Some(o) = down {
+                    unconverged |= self.bands::<TRACK>(&mut rows, &[o], start, &mut scratch);
+                }
+                if let Some(d) = diagonals {
+                    unconverged |= self.bands::<TRACK>(&mut rows, &d, start, &mut scratch);
+                }
+                unconverged
             },
         )
     }
@@ -560,16 +573,13 @@ impl Projection {
     /// particles), then all are applied.
     fn bands<const TRACK: bool>(
         &self,
-        rows: Bands<'_>,
+        rows: &mut Bands<'_>,
         offsets: &[&Offset],
         start: usize,
-        mut scratch: [[&mut [f32]; 3]; 2],
+        scratch: &mut [[&mut [f32]; 3]; 2],
     ) -> bool {
-        let Bands {
-            mut x,
-            inv_mass,
-            width,
-        } = rows;
+        let Bands { x, inv_mass, width } = rows;
+        let (inv_mass, width) = (*inv_mass, *width);
         let band = 2 * width;
         let mut unconverged = false;
         // A band's springs: (top columns, bottom columns) for a column offset of −1, 0, 1.

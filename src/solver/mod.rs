@@ -84,6 +84,8 @@ pub struct ClothSolver {
     seam_start: Vec<f32>,
     /// Colliders in world space the particles are kept out of (see `collide.rs`).
     colliders: Vec<Collider>,
+    /// Each collider's bounding box grown by its thickness (`collide.rs`'s broad phase).
+    collider_bounds: Vec<collide::Bounds>,
     /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
     /// garments.
     stencil: Option<lattice::Stencil>,
@@ -193,6 +195,7 @@ impl ClothSolver {
             },
             seam_start: Vec::new(),
             colliders: Vec::new(),
+            collider_bounds: Vec::new(),
             stencil,
         };
         let seams = cloth.springs.ranges[SpringKind::Seam as usize].clone();
@@ -598,6 +601,9 @@ impl ClothSolver {
     pub fn set_colliders(&mut self, colliders: impl IntoIterator<Item = Collider>) {
         self.colliders.clear();
         self.colliders.extend(colliders);
+        self.collider_bounds.clear();
+        self.collider_bounds
+            .extend(self.colliders.iter().map(Collider::bounds));
         // The part centres meet the colliders too: otherwise the targets sink into a
         // collider and pull the particles in after it.
         if let Some(patches) = self.model.patches_mut() {

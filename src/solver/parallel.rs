@@ -5,15 +5,17 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use bevy::tasks::{ComputeTaskPool, TaskPool};
+use bevy::tasks::{ComputeTaskPool, TaskPool, TaskPoolBuilder};
 
 /// Elements per piece of work: large enough that a task's bookkeeping is a small share
-/// of it, small enough that two threads share a 16,384-particle cloth evenly.
-pub(super) const PIECE: usize = 4096;
+/// of it, small enough that two threads share the work evenly (measured on the 65,536
+/// curtain, 4 limiter sweeps on two cores: 60 ns per particle-substep at 2,048 against
+/// 70 at 1,024 and 80–89 at 16,384; `lab/examples/prof.rs`).
+pub(super) const PIECE: usize = 2048;
 
 /// Below this many elements a kernel runs on the calling thread (no task bookkeeping,
 /// no allocation).
-pub(super) const PARALLEL_FROM: usize = 2 * PIECE;
+pub(super) const PARALLEL_FROM: usize = 4 * PIECE;
 
 /// Whether a cloth's kernels may use the compute pool (the default).
 static PARALLEL: AtomicBool = AtomicBool::new(true);
@@ -32,10 +34,23 @@ pub fn set_parallel(on: bool) {
 pub fn threads() -> usize {
     if PARALLEL.load(Ordering::Relaxed) {
         let cores = std::thread::available_parallelism().map_or(1, usize::from);
-        (ComputeTaskPool::get_or_init(TaskPool::default).thread_num() + 1).min(cores)
+        (pool().thread_num() + 1).min(cores)
     } else {
         1
     }
+}
+
+/// Bevy's compute task pool; made on first use outside an app with one thread fewer
+/// than the cores, as the calling thread works on a scope's tasks too (an app's pool
+/// leaves room for its other pools the same way).
+fn pool() -> &'static TaskPool {
+    ComputeTaskPool::get_or_init(|| {
+        let cores = std::thread::available_parallelism().map_or(1, usize::from);
+        TaskPoolBuilder::new()
+            .num_threads(cores.saturating_sub(1).max(1))
+            .thread_name("bevy_cloth compute".to_string())
+            .build()
+    })
 }
 
 /// Runs `work` on every piece, spread over the compute pool when there are
@@ -51,7 +66,7 @@ pub(super) fn for_each<T: Send>(
         return;
     }
     let work = &work;
-    ComputeTaskPool::get_or_init(TaskPool::default).scope(|scope| {
+    pool().scope(|scope| {
         for piece in pieces {
             scope.spawn(async move { work(piece) });
         }

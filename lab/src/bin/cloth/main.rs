@@ -67,6 +67,9 @@ struct RunArgs {
     /// Dumps every K steps.
     #[arg(long, value_name = "K", default_value_t = 10, value_parser = at_least_one)]
     every: usize,
+    /// Keeps every kernel on one thread (the results are the same bits; for comparing).
+    #[arg(long = "one-thread")]
+    one_thread: bool,
 }
 
 /// What every measuring verb can write besides its tables.
@@ -235,6 +238,7 @@ fn progress(total: usize, unit: &str) -> ProgressBar {
 const ACCURACY_SCENES: [&str; 3] = ["curtain", "curtain-wind", "card"];
 
 fn run(args: RunArgs) -> Result<(), String> {
+    bevy_cloth::solver::set_parallel(!args.one_thread);
     let scene_path = &args.scene;
     let mut scene = ClothScene::load(scene_path).map_err(|e| e.to_string())?;
     if let Some(model) = args.model {
