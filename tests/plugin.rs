@@ -581,3 +581,49 @@ fn a_scene_spawns_its_cloths_colliders_and_world() {
     let fixed = app.world().resource::<Time<Fixed>>().timestep();
     assert!((fixed.as_secs_f32() - scene.timestep).abs() < 1e-6);
 }
+
+#[test]
+fn a_hidden_cloth_steps_but_writes_its_mesh_only_when_shown() {
+    let mut app = app();
+    let e = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(5, 4, 0.1).with_params(quiet_params()),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+        ))
+        .id();
+    app.update();
+    app.update();
+    let handle = app.world().get::<Mesh3d>(e).unwrap().0.clone();
+    let read = |app: &App| -> Vec<[f32; 3]> {
+        let mesh = app.world().resource::<Assets<Mesh>>().get(&handle).unwrap();
+        match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
+            Some(VertexAttributeValues::Float32x3(p)) => p.clone(),
+            _ => panic!("no positions"),
+        }
+    };
+    app.world_mut().entity_mut(e).insert(Visibility::Hidden);
+    app.update();
+    let hidden = read(&app);
+    let solver_at = |app: &App| {
+        app.world()
+            .get::<ClothSimulation>(e)
+            .unwrap()
+            .solver
+            .positions()[19]
+    };
+    let before = solver_at(&app);
+    for _ in 0..10 {
+        app.update();
+    }
+    assert_ne!(solver_at(&app), before, "a hidden cloth still steps");
+    assert_eq!(read(&app), hidden, "a hidden cloth's mesh is not rewritten");
+    app.world_mut().entity_mut(e).insert(Visibility::Inherited);
+    app.update();
+    let shown = Vec3::from(read(&app)[19]);
+    let world = solver_at(&app);
+    assert!(
+        (shown + Vec3::new(0.0, 2.0, 0.0) - world).length() < 1e-4,
+        "written when shown"
+    );
+}

@@ -3,6 +3,7 @@
 use bevy::asset::RenderAssetUsages;
 use bevy::math::Vec3;
 use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
+use bevy::tasks::ParallelSliceMut;
 
 use crate::error::ClothError;
 use crate::solver;
@@ -49,18 +50,18 @@ pub fn write_mesh(
     if let Some(VertexAttributeValues::Float32x3(out)) =
         mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
     {
-        for (o, x) in out.iter_mut().zip(cloth.positions()) {
-            *o = to_local.transform_point3(*x).to_array();
-        }
+        let x = cloth.positions();
+        write_each(out, |i, o| *o = to_local.transform_point3(x[i]).to_array());
     }
     if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_NORMAL)
     {
-        for (o, n) in out.iter_mut().zip(normals.iter()) {
+        let normals = &*normals;
+        write_each(out, |i, o| {
             *o = to_local
-                .transform_vector3(*n)
+                .transform_vector3(normals[i])
                 .normalize_or(Vec3::Z)
                 .to_array();
-        }
+        });
     }
     if faces_changed {
         let visible = cloth.triangle_visible();
@@ -73,6 +74,21 @@ pub fn write_mesh(
             .collect();
         mesh.insert_indices(Indices::U32(indices));
     }
+}
+
+/// Sets every element of `out` by `f(index, element)`: in pieces on Bevy's compute task
+/// pool for a large mesh, on this thread for a small one.
+fn write_each<T: Send>(mut out: &mut [T], f: impl Fn(usize, &mut T) + Send + Sync) {
+    const PIECE: usize = 4096;
+    if out.len() < 4 * PIECE {
+        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
+        return;
+    }
+    out.par_chunk_map_mut(solver::task_pool(), PIECE, |piece, chunk| {
+        for (k, o) in chunk.iter_mut().enumerate() {
+            f(piece * PIECE + k, o);
+        }
+    });
 }
 
 /// What a mesh-shaped cloth takes from its source mesh.

@@ -591,12 +591,18 @@ fn finish_steps(
     }
 }
 
+/// Writes each stepped cloth's positions and normals into its mesh. A cloth whose own
+/// `Visibility` is `Hidden` is not written; it keeps its new state pending and is
+/// written when shown. (Not for a hidden parent, whose effect is known only where
+/// Bevy's visibility systems run; and not for frustum culling: Bevy takes a mesh's
+/// bounding box from what was written, so an unwritten cloth that swings into view
+/// would stay culled.)
 fn write_meshes(
     mut meshes: ResMut<Assets<Mesh>>,
-    mut cloths: Query<(&mut ClothSimulation, &Mesh3d)>,
+    mut cloths: Query<(&mut ClothSimulation, &Mesh3d, Option<&Visibility>)>,
 ) {
-    for (mut sim, mesh3d) in &mut cloths {
-        if !sim.mesh_dirty {
+    for (mut sim, mesh3d, visibility) in &mut cloths {
+        if !sim.mesh_dirty || visibility == Some(&Visibility::Hidden) {
             continue;
         }
         let Some(mut mesh) = meshes.get_mut(&mesh3d.0) else {

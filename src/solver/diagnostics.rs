@@ -3,6 +3,7 @@
 
 use bevy::math::Vec3;
 
+use super::parallel::{self, PIECE};
 use super::{ClothSolver, SpringKind, family_stiffness};
 use crate::params::{Environment, SpringParams};
 
@@ -111,22 +112,27 @@ impl ClothSolver {
     }
 
     /// Smooth vertex normals (area-weighted over the visible triangles) into `out`, which
-    /// must hold one entry per particle. Allocates nothing.
+    /// must hold one entry per particle; in pieces over the compute pool for a large
+    /// cloth (whose tasks are the only allocation).
     pub fn normals_into(&self, out: &mut [Vec3]) {
-        out.fill(Vec3::ZERO);
         let x = &self.particles.position;
-        for (t, tri) in self.triangles.iter().enumerate() {
-            if !self.triangle_visible[t] {
-                continue;
+        let (triangles, visible) = (&self.triangles, &self.triangle_visible);
+        // Gathered per particle over its triangles in increasing order: the same sums, in
+        // the same order, as scattering each triangle's normal onto its corners, and a
+        // particle's normal is written by one piece only.
+        let pieces = out.chunks_mut(PIECE).enumerate();
+        parallel::for_each(x.len(), pieces, |(piece, out)| {
+            for (k, n) in out.iter_mut().enumerate() {
+                let i = piece * PIECE + k;
+                let mut sum = Vec3::ZERO;
+                for &t in self.vertex_faces.of(i) {
+                    if visible[t as usize] {
+                        let [a, b, c] = triangles[t as usize].map(|v| v as usize);
+                        sum += (x[b] - x[a]).cross(x[c] - x[a]);
+                    }
+                }
+                *n = sum.normalize_or(Vec3::Z);
             }
-            let [a, b, c] = tri.map(|v| v as usize);
-            let n = (x[b] - x[a]).cross(x[c] - x[a]);
-            out[a] += n;
-            out[b] += n;
-            out[c] += n;
-        }
-        for n in out.iter_mut() {
-            *n = n.normalize_or(Vec3::Z);
-        }
+        });
     }
 }

@@ -30,7 +30,7 @@ pub use collide::{Collider, ColliderShape};
 pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
-pub use parallel::{set_parallel, threads};
+pub use parallel::{pool as task_pool, set_parallel, threads};
 pub use state::Particles;
 use substeps::SubstepCache;
 pub use topology::{SpringKind, Springs};
@@ -54,6 +54,9 @@ pub struct ClothSolver {
     triangle_springs: Vec<[u32; 3]>,
     spring_triangles: Vec<Vec<u32>>,
     triangle_visible: Vec<bool>,
+    /// Each particle's triangles in increasing order (`start[i]..start[i + 1]` of
+    /// `faces`), for normals gathered per particle.
+    vertex_faces: topology::VertexFaces,
     faces_changed: bool,
     params: ClothParams,
     pins: Vec<u32>,
@@ -168,6 +171,7 @@ impl ClothSolver {
             local_rest: local,
             grid,
             triangle_visible: vec![true; triangles.len()],
+            vertex_faces: topology::VertexFaces::new(&triangles, n),
             triangles,
             triangle_springs,
             spring_triangles,

@@ -43,7 +43,7 @@ pub fn threads() -> usize {
 /// Bevy's compute task pool; made on first use outside an app with one thread fewer
 /// than the cores, as the calling thread works on a scope's tasks too (an app's pool
 /// leaves room for its other pools the same way).
-fn pool() -> &'static TaskPool {
+pub fn pool() -> &'static TaskPool {
     ComputeTaskPool::get_or_init(|| {
         let cores = std::thread::available_parallelism().map_or(1, usize::from);
         TaskPoolBuilder::new()

@@ -251,3 +251,40 @@ pub fn weld(positions: &[Vec3]) -> Welded {
     }
     welded
 }
+
+/// Each particle's triangles, in increasing order: `faces[start[i]..start[i + 1]]`.
+#[derive(Clone, Debug, Default)]
+pub(super) struct VertexFaces {
+    start: Vec<u32>,
+    faces: Vec<u32>,
+}
+
+impl VertexFaces {
+    /// The triangles of each of `n` particles.
+    pub fn new(triangles: &[[u32; 3]], n: usize) -> Self {
+        let mut start = vec![0u32; n + 1];
+        for tri in triangles {
+            for &v in tri {
+                start[v as usize + 1] += 1;
+            }
+        }
+        for i in 0..n {
+            start[i + 1] += start[i];
+        }
+        let mut next = start.clone();
+        let mut faces = vec![0u32; start[n] as usize];
+        for (t, tri) in triangles.iter().enumerate() {
+            for &v in tri {
+                faces[next[v as usize] as usize] = t as u32;
+                next[v as usize] += 1;
+            }
+        }
+        Self { start, faces }
+    }
+
+    /// The triangles of particle `i`.
+    #[inline]
+    pub fn of(&self, i: usize) -> &[u32] {
+        &self.faces[self.start[i] as usize..self.start[i + 1] as usize]
+    }
+}
