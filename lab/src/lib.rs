@@ -237,10 +237,13 @@ pub struct KernelCosts {
     pub threads: usize,
 }
 
-/// Measures [`KernelCosts`] at `count` particles: each variant of the timing table's
-/// mass-spring curtain runs [`BENCH_CHECK_STEPS`] steps (the median of `repeats` after
-/// three of warm-up); a variant that fails the check gets no time. Variants alternate
-/// within one call, so they share the machine's state.
+/// Measures [`KernelCosts`] at `count` particles on the timing table's mass-spring
+/// curtain. The variants run step by step in turn, so a slow moment of the machine falls
+/// on all of them alike: the curtain without the limiter, with it, each on one core, and
+/// the default curtain one step on one core, the next on all (the same cloth: its bits
+/// do not depend on the threads). Each runs [`BENCH_CHECK_STEPS`] steps, the median of
+/// the `repeats` after three of warm-up is its time, and a variant that fails the check
+/// gets none.
 pub fn kernel_costs(count: usize, repeats: usize) -> Result<KernelCosts, ClothError> {
     let default = seed_model_params("1").expect("model 1");
     let substeps = bench_cloth("1", count)?.stable_substeps(0.016);
@@ -252,25 +255,45 @@ pub fn kernel_costs(count: usize, repeats: usize) -> Result<KernelCosts, ClothEr
         strain_limit: None,
         ..fixed
     };
-    let time = |params: &ClothParams, parallel: bool| -> Result<Option<f64>, ClothError> {
-        let (width, height) = grid_for(count);
-        let shape = ClothShape::Grid {
-            width,
-            height,
-            spacing: 0.05,
-        };
-        let mut cloth = shape.build_solver(&BENCH_PINS, params, Affine3A::IDENTITY)?;
-        solver::set_parallel(parallel);
-        let (mut times, _, failed) = timed_steps(&mut cloth, &Environment::default(), 3, repeats);
-        solver::set_parallel(true);
-        Ok(failed.is_none().then(|| median(&mut times)))
+    let (width, height) = grid_for(count);
+    let shape = ClothShape::Grid {
+        width,
+        height,
+        spacing: 0.05,
     };
+    let build = |params: &ClothParams| shape.build_solver(&BENCH_PINS, params, Affine3A::IDENTITY);
+    // Plain, limited, and the default stepped on one core and on all in turn.
+    let mut runs = [build(&plain)?, build(&fixed)?, build(&default)?];
+    let env = Environment::default();
+    let mut times: [Vec<f64>; 4] = Default::default();
+    let mut failed = [false; 4];
+    for step in 1..=(3 + 2 * repeats).max(BENCH_CHECK_STEPS) {
+        for (k, cloth) in runs.iter_mut().enumerate() {
+            // The default curtain alternates one core (even steps) and all (odd).
+            let (slot, parallel) = match k {
+                2 if step % 2 == 1 => (3, true),
+                k => (k, false),
+            };
+            if failed[slot.min(2)] {
+                continue;
+            }
+            solver::set_parallel(parallel);
+            let start = Instant::now();
+            cloth.step(0.016, &env);
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            solver::set_parallel(true);
+            if step > 3 && times[slot].len() < repeats {
+                times[slot].push(ms);
+            }
+            if !cloth.is_stable() {
+                failed[slot.min(2)] = true;
+            }
+        }
+    }
+    let median_of = |k: usize| (!failed[k.min(2)]).then(|| median(&mut times[k].clone()));
     let per = |ms: f64| ms * 1e6 / (count as f64 * f64::from(substeps));
-    let plain_ms = time(&plain, false)?;
-    let limited_ms = time(&fixed, false)?;
+    let (plain_ms, limited_ms) = (median_of(0), median_of(1));
     let sweeps = f64::from(default.strain_limit_iterations.max(1));
-    let one_core_ms = time(&default, false)?;
-    let all_cores_ms = time(&default, true)?;
     Ok(KernelCosts {
         particles: count,
         substeps,
@@ -279,8 +302,8 @@ pub fn kernel_costs(count: usize, repeats: usize) -> Result<KernelCosts, ClothEr
         sweep_ns: plain_ms
             .zip(limited_ms)
             .map(|(plain, limited)| per(limited - plain) / sweeps),
-        one_core_ms,
-        all_cores_ms,
+        one_core_ms: median_of(2),
+        all_cores_ms: median_of(3),
         threads: solver::threads(),
     })
 }

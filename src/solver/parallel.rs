@@ -14,8 +14,11 @@ use bevy::tasks::{ComputeTaskPool, TaskPool, TaskPoolBuilder};
 pub(super) const PIECE: usize = 2048;
 
 /// Below this many elements a kernel runs on the calling thread (no task bookkeeping,
-/// no allocation).
-pub(super) const PARALLEL_FROM: usize = 4 * PIECE;
+/// no allocation). A fork-join on the pool costs about 10 µs here when its thread has
+/// gone to sleep between kernels (`lab/examples/scope_cost.rs`), and a substep takes
+/// about 20 of them: at 8,192 particles two threads were slower than one (180 against
+/// 115 ns per particle-substep in `cloth bench`).
+pub(super) const PARALLEL_FROM: usize = 8 * PIECE;
 
 /// Whether a cloth's kernels may use the compute pool (the default).
 static PARALLEL: AtomicBool = AtomicBool::new(true);
