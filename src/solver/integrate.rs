@@ -1,7 +1,7 @@
 //! Phases 2 and 3 of a substep: integration and constraints.
 
 use super::parallel::{self, PIECE};
-use super::{ClothSolver, SpringKind};
+use super::{ClothSolver, Particles, SpringKind};
 use crate::params::{GoalUpdate, Integrator, Model};
 
 impl ClothSolver {
@@ -20,78 +20,9 @@ impl ClothSolver {
                 return; // tiles: particles are placed on their targets, not integrated
             }
         }
-        let h2 = h * h;
-        let p = &mut self.particles;
-        let n = p.len();
         match self.params.integrator {
-            Integrator::Verlet => {
-                // Seed 002 eq. 1.12 prints `+ a Δt²/2`; substituting eq. 1.10 into 1.9
-                // drops the `x_{n−1}` Taylor term, and the correct Störmer–Verlet step is
-                // `x' = 2x − x_prev + a Δt²` (with the ½, free fall would reach only g t²/4).
-                // Written as `x' = x + ((x − x_prev) + a Δt²)` with compensated summation:
-                // in `f32` a displacement under half the spacing of floats at `x` is lost
-                // when added, and the plain form then recomputes `x − x_prev = 0`: at 512
-                // substeps of 16 ms a curtain at y = 2 m never started to fall (g Δt² = 1e-8
-                // m against 1.2e-7 m). What rounding drops is carried to the next substep.
-                let pieces = p
-                    .position
-                    .chunks_mut(PIECE)
-                    .zip(p.previous.chunks_mut(PIECE))
-                    .zip(p.residue.chunks_mut(PIECE))
-                    .zip(p.velocity.chunks_mut(PIECE))
-                    .zip(p.force.chunks(PIECE).zip(p.inv_mass.chunks(PIECE)));
-                parallel::for_each(
-                    n,
-                    pieces,
-                    |((((position, previous), residue), velocity), (force, inv_mass))| {
-                        let particles = position
-                            .iter_mut()
-                            .zip(previous)
-                            .zip(residue)
-                            .zip(velocity)
-                            .zip(force.iter().zip(inv_mass));
-                        for ((((x, previous), residue), velocity), (force, &w)) in particles {
-                            if w == 0.0 {
-                                continue;
-                            }
-                            let step = (*x - *previous) + *residue + *force * (w * h2);
-                            let next = *x + step;
-                            *residue = step - (next - *x);
-                            *previous = *x;
-                            *x = next;
-                            *velocity = step / h;
-                        }
-                    },
-                );
-            }
-            Integrator::SemiImplicitEuler => {
-                // Seed 000 eq. 21–22: the new velocity first, then the position from it.
-                let pieces = p
-                    .position
-                    .chunks_mut(PIECE)
-                    .zip(p.previous.chunks_mut(PIECE))
-                    .zip(p.velocity.chunks_mut(PIECE))
-                    .zip(p.force.chunks(PIECE).zip(p.inv_mass.chunks(PIECE)));
-                parallel::for_each(
-                    n,
-                    pieces,
-                    |(((position, previous), velocity), (force, inv_mass))| {
-                        let particles = position
-                            .iter_mut()
-                            .zip(previous)
-                            .zip(velocity)
-                            .zip(force.iter().zip(inv_mass));
-                        for (((x, previous), velocity), (force, &w)) in particles {
-                            if w == 0.0 {
-                                continue;
-                            }
-                            *velocity += *force * (w * h);
-                            *previous = *x;
-                            *x += *velocity * h;
-                        }
-                    },
-                );
-            }
+            Integrator::Verlet => verlet(&mut self.particles, h),
+            Integrator::SemiImplicitEuler => symplectic_euler(&mut self.particles, h),
         }
     }
 
@@ -256,4 +187,78 @@ impl ClothSolver {
             }
         }
     }
+}
+
+/// One Verlet substep of every free particle, in pieces over the compute pool.
+fn verlet(p: &mut Particles, h: f32) {
+    let (n, h2) = (p.len(), h * h);
+    // Seed 002 eq. 1.12 prints `+ a Δt²/2`; substituting eq. 1.10 into 1.9
+    // drops the `x_{n−1}` Taylor term, and the correct Störmer–Verlet step is
+    // `x' = 2x − x_prev + a Δt²` (with the ½, free fall would reach only g t²/4).
+    // Written as `x' = x + ((x − x_prev) + a Δt²)` with compensated summation:
+    // in `f32` a displacement under half the spacing of floats at `x` is lost
+    // when added, and the plain form then recomputes `x − x_prev = 0`: at 512
+    // substeps of 16 ms a curtain at y = 2 m never started to fall (g Δt² = 1e-8
+    // m against 1.2e-7 m). What rounding drops is carried to the next substep.
+    let pieces = p
+        .position
+        .chunks_mut(PIECE)
+        .zip(p.previous.chunks_mut(PIECE))
+        .zip(p.residue.chunks_mut(PIECE))
+        .zip(p.velocity.chunks_mut(PIECE))
+        .zip(p.force.chunks(PIECE).zip(p.inv_mass.chunks(PIECE)));
+    parallel::for_each(
+        n,
+        pieces,
+        |((((position, previous), residue), velocity), (force, inv_mass))| {
+            let particles = position
+                .iter_mut()
+                .zip(previous)
+                .zip(residue)
+                .zip(velocity)
+                .zip(force.iter().zip(inv_mass));
+            for ((((x, previous), residue), velocity), (force, &w)) in particles {
+                if w == 0.0 {
+                    continue;
+                }
+                let step = (*x - *previous) + *residue + *force * (w * h2);
+                let next = *x + step;
+                *residue = step - (next - *x);
+                *previous = *x;
+                *x = next;
+                *velocity = step / h;
+            }
+        },
+    );
+}
+
+/// One symplectic Euler substep of every free particle, in pieces over the compute pool.
+fn symplectic_euler(p: &mut Particles, h: f32) {
+    let n = p.len();
+    // Seed 000 eq. 21–22: the new velocity first, then the position from it.
+    let pieces = p
+        .position
+        .chunks_mut(PIECE)
+        .zip(p.previous.chunks_mut(PIECE))
+        .zip(p.velocity.chunks_mut(PIECE))
+        .zip(p.force.chunks(PIECE).zip(p.inv_mass.chunks(PIECE)));
+    parallel::for_each(
+        n,
+        pieces,
+        |(((position, previous), velocity), (force, inv_mass))| {
+            let particles = position
+                .iter_mut()
+                .zip(previous)
+                .zip(velocity)
+                .zip(force.iter().zip(inv_mass));
+            for (((x, previous), velocity), (force, &w)) in particles {
+                if w == 0.0 {
+                    continue;
+                }
+                *velocity += *force * (w * h);
+                *previous = *x;
+                *x += *velocity * h;
+            }
+        },
+    );
 }

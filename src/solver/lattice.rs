@@ -582,14 +582,8 @@ impl Projection {
         let (inv_mass, width) = (*inv_mass, *width);
         let band = 2 * width;
         let mut unconverged = false;
-        // A band's springs: (top columns, bottom columns) for a column offset of −1, 0, 1.
-        let columns = |o: &Offset| match o.dx {
-            1 => (0..width - 1, 1..width),
-            -1 => (1..width, 0..width - 1),
-            _ => (0..width, 0..width),
-        };
         for (o, corrections) in offsets.iter().zip(scratch.iter_mut()) {
-            let (top, bottom) = columns(o);
+            let (top, bottom) = band_columns(o, width);
             let [cx, cy, cz] = corrections;
             let rest = &o.rest[start.min(o.rest.len())..];
             let weight = &o.weight[start.min(o.rest.len())..];
@@ -633,28 +627,7 @@ impl Projection {
                 }
             }
         }
-        for (o, corrections) in offsets.iter().zip(scratch.iter()) {
-            let (top, bottom) = columns(o);
-            for (lane, c) in x.iter_mut().zip(corrections) {
-                let bands = lane
-                    .chunks_exact_mut(band)
-                    .zip(inv_mass.chunks_exact(band))
-                    .zip(c.chunks(band));
-                for ((lane, w), c) in bands {
-                    let (t, b) = lane.split_at_mut(width);
-                    let (wt, wb) = w.split_at(width);
-                    let pairs = t[top.clone()]
-                        .iter_mut()
-                        .zip(&mut b[bottom.clone()])
-                        .zip(wt[top.clone()].iter().zip(&wb[bottom.clone()]))
-                        .zip(&c[top.clone()]);
-                    for (((a, b), (wa, wb)), c) in pairs {
-                        *a += c * wa;
-                        *b -= c * wb;
-                    }
-                }
-            }
-        }
+        apply_bands(x, inv_mass, width, offsets, scratch);
         unconverged
     }
 }
@@ -665,4 +638,47 @@ struct Bands<'a> {
     x: [&'a mut [f32]; 3],
     inv_mass: &'a [f32],
     width: usize,
+}
+
+/// The columns of a band's springs of an offset: (top row, bottom row) for a column
+/// offset of −1, 0 or 1.
+fn band_columns(o: &Offset, width: usize) -> (Range<usize>, Range<usize>) {
+    match o.dx {
+        1 => (0..width - 1, 1..width),
+        -1 => (1..width, 0..width - 1),
+        _ => (0..width, 0..width),
+    }
+}
+
+/// Applies the corrections of [`Projection::bands`] to each band's two rows.
+fn apply_bands(
+    x: &mut [&mut [f32]; 3],
+    inv_mass: &[f32],
+    width: usize,
+    offsets: &[&Offset],
+    scratch: &[[&mut [f32]; 3]; 2],
+) {
+    let band = 2 * width;
+    for (o, corrections) in offsets.iter().zip(scratch.iter()) {
+        let (top, bottom) = band_columns(o, width);
+        for (lane, c) in x.iter_mut().zip(corrections) {
+            let bands = lane
+                .chunks_exact_mut(band)
+                .zip(inv_mass.chunks_exact(band))
+                .zip(c.chunks(band));
+            for ((lane, w), c) in bands {
+                let (t, b) = lane.split_at_mut(width);
+                let (wt, wb) = w.split_at(width);
+                let pairs = t[top.clone()]
+                    .iter_mut()
+                    .zip(&mut b[bottom.clone()])
+                    .zip(wt[top.clone()].iter().zip(&wb[bottom.clone()]))
+                    .zip(&c[top.clone()]);
+                for (((a, b), (wa, wb)), c) in pairs {
+                    *a += c * wa;
+                    *b -= c * wb;
+                }
+            }
+        }
+    }
 }
