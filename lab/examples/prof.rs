@@ -1,7 +1,9 @@
 //! Where a mass-spring substep's time goes: the timing table's 65,536-particle curtain
 //! (top row pinned), ns per particle-substep in each phase (forces, integration, target
 //! fitting, constraints), without and with the strain limiter (4 sweeps), beside the
-//! bare kernel. `ONE=1` keeps the kernels on one thread; `NOWIND=1` switches the wind off.
+//! bare kernel, at 5 substeps. `ONE=1` keeps the kernels on one thread; `NOWIND=1` switches
+//! the wind off; `GENERAL=1` steps the same springs on the general path (as a mesh or a
+//! garment would), not the grid's stencil.
 //!
 //! `cargo run -p bevy_cloth_lab --example prof`
 use bevy_cloth::prelude::*;
@@ -9,6 +11,7 @@ use std::time::Instant;
 fn main() {
     let n = 65536;
     let parallel = std::env::var("ONE").is_err();
+    let general = std::env::var("GENERAL").is_ok();
     bevy_cloth::solver::set_parallel(parallel);
     for (label, limit, iters) in [("no limiter", None, 0), ("limiter 4", Some(0.1), 4)] {
         let params = ClothParams {
@@ -17,12 +20,25 @@ fn main() {
             ..ClothParams::default()
         };
         let (w, h) = bevy_cloth_lab::grid_for(n);
-        let mut cloth = ClothShape::Grid {
+        let shape = ClothShape::Grid {
             width: w,
             height: h,
             spacing: 0.05,
+        };
+        let mut layout = shape.layout().unwrap();
+        let pins = Pins::TopRow.resolve_for(&layout).unwrap();
+        if general {
+            layout.grid = None; // the same springs, told it is not a grid
         }
-        .build_solver(&Pins::TopRow, &params, bevy::math::Affine3A::IDENTITY)
+        let mut cloth = bevy_cloth::solver::ClothSolver::new(
+            layout,
+            &pins,
+            &ClothParams {
+                substeps: Substeps::Fixed(5),
+                ..params
+            },
+            bevy::math::Affine3A::IDENTITY,
+        )
         .unwrap();
         let mut env = Environment::default();
         if std::env::var("NOWIND").is_ok() {

@@ -15,7 +15,7 @@
 
 use std::iter::Zip;
 use std::ops::Range;
-use std::slice::{ChunksMut, Iter};
+use std::slice::Iter;
 
 use bevy::math::Vec3;
 
@@ -149,9 +149,6 @@ pub(super) struct Stencil {
     x: Lanes,
     v: Lanes,
     f: Lanes,
-    /// One value per spring of an offset (its force, or a limiter correction), and a
-    /// second for the limiter's other diagonal.
-    scratch: [Lanes; 2],
 }
 
 impl Stencil {
@@ -208,7 +205,6 @@ impl Stencil {
             x: Lanes::new(n),
             v: Lanes::new(n),
             f: Lanes::new(n),
-            scratch: [Lanes::new(n), Lanes::new(n)],
         };
         stencil.sync(springs);
         Some(stencil)
@@ -358,7 +354,7 @@ impl Stencil {
         let mut unconverged = false;
         let [along, _] = along;
         if let Some(o) = along {
-            unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, w, &mut self.scratch[0]);
+            unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, w);
         }
         let [down, _] = down;
         let diagonals = match diagonals {
@@ -366,148 +362,104 @@ impl Stencil {
             _ => None,
         };
         for parity in 0..2 {
-            let scratch = &mut self.scratch;
-            unconverged |=
-                projection.across_rows::<TRACK>(x, inv_mass, down, diagonals, w, parity, scratch);
+            unconverged |= projection.across_rows::<TRACK>(x, inv_mass, down, diagonals, w, parity);
         }
         unconverged
     }
 }
 
-/// Provot's projection of one spring: how far to move its ends.
+/// Provot's projection of one spring in place.
 #[derive(Clone, Copy)]
 struct Projection {
     limit: f32,
     past: f32,
 }
 
+/// A group of whole rows or bands: positions as lanes, inverse masses from the group's
+/// first particle on.
+struct Group<'a> {
+    x: [&'a mut [f32]; 3],
+    inv_mass: &'a [f32],
+}
+
 impl Projection {
-    /// The correction `c` of the spring from `a` to `b` (`a += c·w_a`, `b −= c·w_b`) that
-    /// brings it back to `(1 + limit)·rest`, zero when it is within it, torn or held at
-    /// both ends; and whether it was longer than `past·rest`.
+    /// Shortens the spring from `a` to `b` (indices in `g`) to `(1 + limit)·rest` when it
+    /// is longer, each end moved by its share of inverse mass (seed 000 eq. 2); nothing
+    /// when it is within, torn (`weight` 0) or held at both ends. Most springs are within,
+    /// so the test comes first, on squared lengths. With `TRACK`, whether it was longer
+    /// than `past·rest`.
     #[inline(always)]
-    fn correction(
+    fn project<const TRACK: bool>(
         &self,
-        a: [f32; 3],
-        b: [f32; 3],
-        wa: f32,
-        wb: f32,
+        g: &mut Group<'_>,
+        a: usize,
+        b: usize,
         rest: f32,
         weight: f32,
-    ) -> ([f32; 3], bool) {
-        let d = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        let live = weight != 0.0 && wa + wb != 0.0;
-        let excess = (len - (1.0 + self.limit) * rest).max(0.0);
-        let factor = f32::from(u8::from(live)) * excess / (len * (wa + wb)).max(f32::MIN_POSITIVE);
-        (
-            [d[0] * factor, d[1] * factor, d[2] * factor],
-            live && len > self.past * rest,
-        )
+    ) -> bool {
+        let (wa, wb) = (g.inv_mass[a], g.inv_mass[b]);
+        let [x, y, z] = &mut g.x;
+        let d = [x[b] - x[a], y[b] - y[a], z[b] - z[a]];
+        let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        let max = (1.0 + self.limit) * rest;
+        if weight == 0.0 || wa + wb == 0.0 || len2 <= max * max {
+            return false;
+        }
+        let len = len2.sqrt();
+        let factor = (len - max) / (len * (wa + wb));
+        for (lane, d) in [&mut **x, &mut **y, &mut **z].into_iter().zip(d) {
+            lane[a] += d * factor * wa;
+            lane[b] -= d * factor * wb;
+        }
+        TRACK && len > self.past * rest
     }
 
     /// The springs `(a, a + 1)` along the rows: those with `a` even, then those with `a`
     /// odd, each colour a set of disjoint pairs of particles. Rows do not share these
-    /// springs, so groups of whole rows run in pieces over the compute pool (one task
-    /// each for both colours).
+    /// springs, so groups of whole rows run in pieces over the compute pool.
     fn along_rows<const TRACK: bool>(
         &self,
         x: &mut [Vec<f32>; 3],
         inv_mass: &[f32],
         o: &Offset,
         width: usize,
-        scratch: &mut Lanes,
     ) -> bool {
         let n = x[0].len();
         let group = width * (PIECE / width).max(1);
         let [x, y, z] = x;
-        let [cx, cy, cz] = &mut scratch.0;
         let pieces = x
             .chunks_mut(group)
             .zip(y.chunks_mut(group))
             .zip(z.chunks_mut(group))
-            .zip(
-                cx.chunks_mut(group)
-                    .zip(cy.chunks_mut(group))
-                    .zip(cz.chunks_mut(group)),
-            )
             .enumerate();
-        parallel::any(n, pieces, |(i, (((x, y), z), ((cx, cy), cz)))| {
+        parallel::any(n, pieces, |(i, ((x, y), z))| {
             let from = i * group;
-            let mut x = [x, y, z];
-            let mut c = [cx, cy, cz];
-            let w = &inv_mass[from..from + x[0].len()];
-            let springs = (
+            let len = x.len();
+            let mut g = Group {
+                x: [x, y, z],
+                inv_mass: &inv_mass[from..],
+            };
+            let (rest, weight) = (
                 &o.rest[from.min(o.rest.len())..],
                 &o.weight[from.min(o.rest.len())..],
             );
+            let springs = rest.len().min(len - 1); // those starting in the group
             let mut unconverged = false;
             for parity in 0..2 {
-                unconverged |= self.row_colour::<TRACK>(&mut x, w, springs, from, parity, &mut c);
+                for a in ((parity + from) % 2..springs).step_by(2) {
+                    unconverged |= self.project::<TRACK>(&mut g, a, a + 1, rest[a], weight[a]);
+                }
             }
             unconverged
         })
     }
 
-    /// One colour of [`Self::along_rows`] on a group of rows starting at particle `from`,
-    /// in two vectorised passes over shifted slices: every spring's correction into `c`
-    /// (zero for the springs of the other colour), then every particle's (`+` as a start,
-    /// `−` as an end; one of the two is zero).
-    fn row_colour<const TRACK: bool>(
-        &self,
-        x: &mut [&mut [f32]; 3],
-        inv_mass: &[f32],
-        (rest, weight): (&[f32], &[f32]),
-        from: usize,
-        parity: usize,
-        c: &mut [&mut [f32]; 3],
-    ) -> bool {
-        let m = (x[0].len() - 1).min(rest.len()); // springs starting in the group
-        let (a, b) = (0..m, 1..m + 1);
-        let mut unconverged = false;
-        {
-            let [cx, cy, cz] = c;
-            let springs = cx[..m]
-                .iter_mut()
-                .zip(cy[..m].iter_mut())
-                .zip(cz[..m].iter_mut())
-                .zip(rest.iter().zip(weight))
-                .zip(
-                    pair(x[0], &a, &b)
-                        .zip(pair(x[1], &a, &b))
-                        .zip(pair(x[2], &a, &b)),
-                )
-                .zip(pair(inv_mass, &a, &b))
-                .enumerate();
-            for (i, (((((cx, cy), cz), (&rest, &weight)), ((x, y), z)), (&wa, &wb))) in springs {
-                let mine = f32::from(u8::from((from + i) % 2 == parity));
-                let (c, long) = self.correction(
-                    [*x.0, *y.0, *z.0],
-                    [*x.1, *y.1, *z.1],
-                    wa,
-                    wb,
-                    rest,
-                    weight * mine,
-                );
-                unconverged |= TRACK && long;
-                (*cx, *cy, *cz) = (c[0], c[1], c[2]);
-            }
-        }
-        for (lane, c) in x.iter_mut().zip(c.iter()) {
-            // As a start: x_a += c_a w_a; as an end: x_b −= c_{b−1} w_b.
-            for ((x, w), c) in lane[..m].iter_mut().zip(inv_mass).zip(&c[..m]) {
-                *x += c * w;
-            }
-            for ((x, w), c) in lane[1..m + 1].iter_mut().zip(&inv_mass[1..]).zip(&c[..m]) {
-                *x -= c * w;
-            }
-        }
-        unconverged
-    }
-
-    /// The springs from the rows of one parity to the next row: the vertical ones, then
-    /// both diagonals together. Each band of two rows is disjoint from the others, so
-    /// groups of bands run in pieces over the compute pool (one task each for both).
+    /// The springs from the rows of one parity to the next row, band by band (two rows):
+    /// the vertical ones, then the diagonal pairs of even cells, then of odd cells (a
+    /// cell's two diagonals share no particle, nor do cells two apart). Every colour is a
+    /// set of disjoint springs, and a mirror image of the cloth (even width) maps each
+    /// colour onto itself, so the result depends neither on order nor on side. Bands do
+    /// not share particles, so groups of bands run in pieces over the compute pool.
     #[allow(clippy::too_many_arguments)]
     fn across_rows<const TRACK: bool>(
         &self,
@@ -517,168 +469,63 @@ impl Projection {
         diagonals: Option<[&Offset; 2]>,
         width: usize,
         parity: usize,
-        scratch: &mut [Lanes; 2],
     ) -> bool {
         let from = parity * width;
         let band = 2 * width;
-        // Too few rows for a band from this parity: no springs to take.
-        let fits = |o: &&Offset| o.rest.len() > from;
-        let down = down.filter(fits);
-        let diagonals = diagonals.filter(|d| d.iter().all(fits));
         let n = x[0].len();
-        if (down.is_none() && diagonals.is_none()) || n < from + band {
-            return false;
+        if n < from + band {
+            return false; // too few rows for a band from this parity
         }
         let end = from + (n - from) / band * band; // whole bands only
         let group = band * (PIECE / band).max(1);
         let [x, y, z] = x;
-        let [s0, s1] = scratch;
-        let [c0x, c0y, c0z] = &mut s0.0;
-        let [c1x, c1y, c1z] = &mut s1.0;
-        fn cut(lane: &mut [f32], range: Range<usize>, group: usize) -> ChunksMut<'_, f32> {
-            lane[range].chunks_mut(group)
-        }
-        let chunks = |lane| cut(lane, from..end, group);
-        let pieces = chunks(x)
-            .zip(chunks(y))
-            .zip(chunks(z))
-            .zip(chunks(c0x).zip(chunks(c0y)).zip(chunks(c0z)))
-            .zip(chunks(c1x).zip(chunks(c1y)).zip(chunks(c1z)))
+        let pieces = x[from..end]
+            .chunks_mut(group)
+            .zip(y[from..end].chunks_mut(group))
+            .zip(z[from..end].chunks_mut(group))
             .enumerate();
-        parallel::any(
-            n,
-            pieces,
-            |(i, ((((x, y), z), ((c0x, c0y), c0z)), ((c1x, c1y), c1z)))| {
-                let start = from + i * group;
-                let mut rows = Bands {
-                    x: [x, y, z],
-                    inv_mass: &inv_mass[start..],
-                    width,
-                };
-                let mut scratch = [[c0x, c0y, c0z], [c1x, c1y, c1z]];
-                let mut unconverged = false;
+        /// `(rest, weight)` of an offset's springs from particle `start` on.
+        fn springs(o: &Offset, start: usize) -> (&[f32], &[f32]) {
+            (&o.rest[start..], &o.weight[start..])
+        }
+        // The diagonal from (r, c) to (r + 1, c + 1), and the one from (r, c + 1) to (r + 1, c).
+        let (right, left) = match diagonals {
+            Some([d1, d2]) if d1.dx == 1 => (Some(d1), Some(d2)),
+            Some([d1, d2]) => (Some(d2), Some(d1)),
+            None => (None, None),
+        };
+        parallel::any(n, pieces, |(i, ((x, y), z))| {
+            let start = from + i * group;
+            let bands = x.len() / band;
+            let mut g = Group {
+                x: [x, y, z],
+                inv_mass: &inv_mass[start..],
+            };
+            let mut unconverged = false;
+            for k in 0..bands {
+                let top = k * band;
                 if let Some(o) = down {
-                    unconverged |= self.bands::<TRACK>(&mut rows, &[o], start, &mut scratch);
+                    let (rest, weight) = springs(o, start);
+                    for a in top..top + width {
+                        unconverged |=
+                            self.project::<TRACK>(&mut g, a, a + width, rest[a], weight[a]);
+                    }
                 }
-                if let Some(d) = diagonals {
-                    unconverged |= self.bands::<TRACK>(&mut rows, &d, start, &mut scratch);
-                }
-                unconverged
-            },
-        )
-    }
-
-    /// [`Self::across_rows`] on one group of bands starting at particle `start`: every
-    /// correction comes from the positions before any (the two diagonals share
-    /// particles), then all are applied.
-    fn bands<const TRACK: bool>(
-        &self,
-        rows: &mut Bands<'_>,
-        offsets: &[&Offset],
-        start: usize,
-        scratch: &mut [[&mut [f32]; 3]; 2],
-    ) -> bool {
-        let Bands { x, inv_mass, width } = rows;
-        let (inv_mass, width) = (*inv_mass, *width);
-        let band = 2 * width;
-        let mut unconverged = false;
-        for (o, corrections) in offsets.iter().zip(scratch.iter_mut()) {
-            let (top, bottom) = band_columns(o, width);
-            let [cx, cy, cz] = corrections;
-            let rest = &o.rest[start.min(o.rest.len())..];
-            let weight = &o.weight[start.min(o.rest.len())..];
-            let bands = x[0]
-                .chunks_exact(band)
-                .zip(x[1].chunks_exact(band))
-                .zip(x[2].chunks_exact(band))
-                .zip(inv_mass.chunks_exact(band))
-                .zip(rest.chunks(band).zip(weight.chunks(band)))
-                .zip(
-                    cx.chunks_mut(band)
-                        .zip(cy.chunks_mut(band))
-                        .zip(cz.chunks_mut(band)),
-                );
-            for (((((xs, ys), zs), w), (rest, weight)), ((cx, cy), cz)) in bands {
-                let (t, b) = (top.clone(), bottom.start + width..bottom.end + width);
-                let springs = xs[t.clone()]
-                    .iter()
-                    .zip(&xs[b.clone()])
-                    .zip(ys[t.clone()].iter().zip(&ys[b.clone()]))
-                    .zip(zs[t.clone()].iter().zip(&zs[b.clone()]))
-                    .zip(w[t.clone()].iter().zip(&w[b]))
-                    .zip(rest[t.clone()].iter().zip(&weight[t.clone()]))
-                    .zip(
-                        cx[t.clone()]
-                            .iter_mut()
-                            .zip(&mut cy[t.clone()])
-                            .zip(&mut cz[t]),
-                    );
-                for (((((x, y), z), (&wa, &wb)), (&rest, &weight)), ((cx, cy), cz)) in springs {
-                    let (c, long) = self.correction(
-                        [*x.0, *y.0, *z.0],
-                        [*x.1, *y.1, *z.1],
-                        wa,
-                        wb,
-                        rest,
-                        weight,
-                    );
-                    unconverged |= TRACK && long;
-                    (*cx, *cy, *cz) = (c[0], c[1], c[2]);
+                let (Some(right), Some(left)) = (right, left) else {
+                    continue;
+                };
+                let ((r_rest, r_weight), (l_rest, l_weight)) =
+                    (springs(right, start), springs(left, start));
+                for cells in 0..2 {
+                    for c in (top + cells..top + width - 1).step_by(2) {
+                        let (a, b) = (c, c + width + 1);
+                        unconverged |= self.project::<TRACK>(&mut g, a, b, r_rest[a], r_weight[a]);
+                        let (a, b) = (c + 1, c + width);
+                        unconverged |= self.project::<TRACK>(&mut g, a, b, l_rest[a], l_weight[a]);
+                    }
                 }
             }
-        }
-        apply_bands(x, inv_mass, width, offsets, scratch);
-        unconverged
-    }
-}
-
-/// A group of whole bands of two rows: positions as lanes, inverse masses from the
-/// group's first particle on.
-struct Bands<'a> {
-    x: [&'a mut [f32]; 3],
-    inv_mass: &'a [f32],
-    width: usize,
-}
-
-/// The columns of a band's springs of an offset: (top row, bottom row) for a column
-/// offset of −1, 0 or 1.
-fn band_columns(o: &Offset, width: usize) -> (Range<usize>, Range<usize>) {
-    match o.dx {
-        1 => (0..width - 1, 1..width),
-        -1 => (1..width, 0..width - 1),
-        _ => (0..width, 0..width),
-    }
-}
-
-/// Applies the corrections of [`Projection::bands`] to each band's two rows.
-fn apply_bands(
-    x: &mut [&mut [f32]; 3],
-    inv_mass: &[f32],
-    width: usize,
-    offsets: &[&Offset],
-    scratch: &[[&mut [f32]; 3]; 2],
-) {
-    let band = 2 * width;
-    for (o, corrections) in offsets.iter().zip(scratch.iter()) {
-        let (top, bottom) = band_columns(o, width);
-        for (lane, c) in x.iter_mut().zip(corrections) {
-            let bands = lane
-                .chunks_exact_mut(band)
-                .zip(inv_mass.chunks_exact(band))
-                .zip(c.chunks(band));
-            for ((lane, w), c) in bands {
-                let (t, b) = lane.split_at_mut(width);
-                let (wt, wb) = w.split_at(width);
-                let pairs = t[top.clone()]
-                    .iter_mut()
-                    .zip(&mut b[bottom.clone()])
-                    .zip(wt[top.clone()].iter().zip(&wb[bottom.clone()]))
-                    .zip(&c[top.clone()]);
-                for (((a, b), (wa, wb)), c) in pairs {
-                    *a += c * wa;
-                    *b -= c * wb;
-                }
-            }
-        }
+            unconverged
+        })
     }
 }
