@@ -114,20 +114,24 @@ fn pair<'l>(
 }
 
 /// Adds to `sum` (one lane of the particles from `from` on) the forces `springs` of an
-/// offset of `step` (one lane): `+` on each spring's start, `−` on its end.
-fn add_ends(sum: &mut [f32], springs: &[f32], from: usize, step: usize, n: usize) {
-    let (len, m) = (sum.len(), n - step);
+/// offset of `step` (one lane, the springs from `lo` on, of `m` in all): `+` on each
+/// spring's start, `−` on its end, in that order for every particle.
+fn add_ends(sum: &mut [f32], springs: &[f32], from: usize, lo: usize, step: usize, m: usize) {
+    let len = sum.len();
     if from < m {
         let end = (from + len).min(m);
-        for (f, s) in sum[..end - from].iter_mut().zip(&springs[from..end]) {
+        for (f, s) in sum[..end - from]
+            .iter_mut()
+            .zip(&springs[from - lo..end - lo])
+        {
             *f += s;
         }
     }
-    let (lo, hi) = (from.max(step), from + len);
-    if lo < hi {
-        for (f, s) in sum[lo - from..]
+    let (first, last) = (from.max(step), from + len);
+    if first < last {
+        for (f, s) in sum[first - from..]
             .iter_mut()
-            .zip(&springs[lo - step..hi - step])
+            .zip(&springs[first - step - lo..last - step - lo])
         {
             *f -= s;
         }
@@ -143,8 +147,12 @@ pub(super) struct Stencil {
     slot: Vec<(u8, u32)>,
     /// Each offset's stiffness in this substep (0: its family is off).
     stiffness: Vec<f32>,
-    /// Each offset's spring forces (as many as it has springs; room for `n`).
-    springs: Vec<Lanes>,
+    /// Each piece's spring forces of one offset at a time: the springs that start or
+    /// end in the piece (`PIECE + max_step` per piece), so a piece's forces stay in its
+    /// core's cache and no piece writes another's.
+    halo: Lanes,
+    /// The largest offset `b − a`.
+    max_step: usize,
     /// Positions, velocities and forces as lanes, for the substep's kernels.
     x: Lanes,
     v: Lanes,
@@ -196,9 +204,11 @@ impl Stencil {
             offset.rest[a] = springs.rest_length[s];
             slot.push((index as u8, a as u32));
         }
+        let max_step = offsets.iter().map(|o| o.step).max().unwrap_or(0);
         let mut stencil = Self {
             stiffness: vec![0.0; offsets.len()],
-            springs: vec![Lanes::new(n); offsets.len()],
+            halo: Lanes::new(n.div_ceil(PIECE) * (PIECE + max_step)),
+            max_step,
             width,
             offsets,
             slot,
@@ -230,10 +240,11 @@ impl Stencil {
     }
 
     /// Adds every spring's Hooke force `k (|l| − l0) l/|l|` plus damping along it
-    /// (the general path's law, `forces.rs`) to `p.force`; `k` per family. Two passes,
-    /// each split over the compute pool: every spring's force, then every particle's sum
-    /// of its springs (offset by offset, `+` from the springs it starts, `−` from those
-    /// it ends).
+    /// (the general path's law, `forces.rs`) to `p.force`; `k` per family. In pieces of
+    /// particles over the compute pool: for each offset, the forces of the springs that
+    /// start or end in the piece (those crossing into the previous piece computed by
+    /// both, the same way), then each particle's sum (`+` from the springs it starts, `−`
+    /// from those it ends, offset by offset).
     pub fn spring_forces(
         &mut self,
         p: &mut Particles,
@@ -247,46 +258,56 @@ impl Stencil {
             *stiffness = k(offset.kind);
         }
         let (x, v) = (&self.x, &self.v);
-        let pieces = self
-            .offsets
-            .iter()
-            .zip(&mut self.springs)
-            .zip(&self.stiffness)
-            .filter(|(_, k)| **k != 0.0)
-            .flat_map(|((o, springs), &k)| {
-                let m = n - o.step;
-                let [sx, sy, sz] = &mut springs.0;
-                let chunks = sx[..m].chunks_mut(PIECE).zip(sy[..m].chunks_mut(PIECE));
-                chunks
-                    .zip(sz[..m].chunks_mut(PIECE))
-                    .enumerate()
-                    .map(move |(i, ((sx, sy), sz))| (o, k, i * PIECE, [sx, sy, sz]))
-            });
-        parallel::for_each(n, pieces, |(o, k, from, out)| {
-            spring_piece(o, k, damping, from, x, v, out);
-        });
-        let (springs, offsets, stiffness) = (&self.springs, &self.offsets, &self.stiffness);
+        let (offsets, stiffness) = (&self.offsets, &self.stiffness);
+        let halo = PIECE + self.max_step;
         let [fx, fy, fz] = &mut self.f.0;
+        let [hx, hy, hz] = &mut self.halo.0;
         let pieces = fx
             .chunks_mut(PIECE)
             .zip(fy.chunks_mut(PIECE))
             .zip(fz.chunks_mut(PIECE))
             .zip(p.force.chunks_mut(PIECE))
+            .zip(
+                hx.chunks_mut(halo)
+                    .zip(hy.chunks_mut(halo))
+                    .zip(hz.chunks_mut(halo)),
+            )
             .enumerate();
-        parallel::for_each(n, pieces, |(i, (((fx, fy), fz), force))| {
-            let from = i * PIECE;
-            for (lane, sum) in [&mut *fx, &mut *fy, &mut *fz].into_iter().enumerate() {
-                sum.fill(0.0);
-                for ((o, springs), k) in offsets.iter().zip(springs).zip(stiffness) {
-                    if *k != 0.0 {
-                        add_ends(sum, &springs.0[lane], from, o.step, n);
+        parallel::for_each(
+            n,
+            pieces,
+            |(i, ((((fx, fy), fz), force), ((hx, hy), hz)))| {
+                let from = i * PIECE;
+                let mut sums = [fx, fy, fz];
+                sums.iter_mut().for_each(|sum| sum.fill(0.0));
+                for (o, &k) in offsets.iter().zip(stiffness) {
+                    if k == 0.0 {
+                        continue;
+                    }
+                    // The springs that start or end in this piece: from `lo` to `hi`.
+                    let m = n - o.step;
+                    let lo = from.saturating_sub(o.step).min(m);
+                    let hi = (from + PIECE).min(m).max(lo);
+                    let mut springs = [&mut hx[..hi - lo], &mut hy[..hi - lo], &mut hz[..hi - lo]];
+                    spring_piece(
+                        o,
+                        k,
+                        damping,
+                        lo,
+                        x,
+                        v,
+                        springs.each_mut().map(|s| &mut **s),
+                    );
+                    for (sum, springs) in sums.iter_mut().zip(&springs) {
+                        add_ends(sum, springs, from, lo, o.step, m);
                     }
                 }
-            }
-            for (((force, x), y), z) in force.iter_mut().zip(&*fx).zip(&*fy).zip(&*fz) {
-                *force += Vec3::new(*x, *y, *z);
-            }
-        });
+                let [fx, fy, fz] = sums;
+                for (((force, x), y), z) in force.iter_mut().zip(&*fx).zip(&*fy).zip(&*fz) {
+                    *force += Vec3::new(*x, *y, *z);
+                }
+            },
+        );
     }
 
     /// Provot's strain limit (the general path's law, `integrate.rs`) over the enabled
