@@ -908,8 +908,8 @@ fn the_power_iteration_finds_the_lattice_eigenvalue() {
         }
         let k = |kind| cloth.stiffness(kind);
         let (fast, converged) = (
-            cloth.lattice_eigenvalue(k, 30),
-            cloth.lattice_eigenvalue(k, 2_000),
+            cloth.lattice_eigenvalue(k, true, 30),
+            cloth.lattice_eigenvalue(k, true, 2_000),
         );
         assert!(
             fast <= converged * 1.0001,

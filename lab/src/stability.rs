@@ -460,7 +460,7 @@ pub fn regime_cloth(
 /// where the automatic substeps take 30).
 pub fn lattice_omega_max(cloth: &solver::ClothSolver) -> f32 {
     cloth
-        .lattice_eigenvalue(|kind| cloth.stiffness(kind), 2_000)
+        .lattice_eigenvalue(|kind| cloth.stiffness(kind), true, 2_000)
         .sqrt()
 }
 

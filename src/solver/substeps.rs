@@ -141,16 +141,17 @@ impl ClothSolver {
     /// at most its largest rate to γ.
     ///
     /// Grids only: a garment's or a mesh's springs keep Gershgorin's bounds, as the seams
-    /// closing while it is sewn turn its springs far from where an estimate was taken
-    /// (with the estimate, the T-shirt of seed 002's stiffest material gained energy:
-    /// `the_seed_material_range_stays_stable_on_the_mannequin`).
+    /// closing while it is sewn turn its springs far from where an estimate was taken.
+    /// With the estimate the T-shirt failed `the_seed_material_range_stays_stable_on_the_mannequin`:
+    /// the stiffest material gained energy, and with seams counted as springs of length 0
+    /// (`c I`, see [`Self::lattice_eigenvalue`]) the lightest, softest one went unstable.
     fn spring_frequency(&self) -> (f32, f32) {
         let (omega2_bound, gamma_bound) = self.spring_gershgorin();
         if self.stencil.is_none() {
             return (omega2_bound, gamma_bound);
         }
         let damping = self.params.springs.damping;
-        let omega2 = self.lattice_eigenvalue(|kind| self.stiffness(kind), POWER_ITERATIONS);
+        let omega2 = self.lattice_eigenvalue(|kind| self.stiffness(kind), true, POWER_ITERATIONS);
         let spring_gamma = self.lattice_eigenvalue(
             |kind| {
                 if self.stiffness(kind) > 0.0 {
@@ -159,6 +160,7 @@ impl ClothSolver {
                     0.0
                 }
             },
+            false,
             POWER_ITERATIONS,
         );
         let p = &self.particles;
@@ -203,31 +205,41 @@ impl ClothSolver {
     }
 
     /// The largest eigenvalue of `M⁻¹A` for the spring lattice linearised at its current
-    /// shape, `A u = Σ_springs c_s d̂ d̂ᵀ (u_b − u_a)` on each end with `c_s` =
-    /// `coefficient(family)` × the spring's factor (the stiffness gives ω_max², the
-    /// damping γ_max; at rest length a spring has no stiffness across itself). Power
-    /// iteration on the symmetric `M^−½ A M^−½` from a fixed pseudo-random start, read as
-    /// a Rayleigh quotient: never above the true value, and within a few per cent of it
-    /// after 30 iterations on a grid (test `the_power_iteration_finds_the_lattice_eigenvalue`).
+    /// shape, with `c_s` = `coefficient(family)` × the spring's factor. With `transverse`
+    /// (stiffness: ω_max²) `A` is each spring's Hessian `c_s [d̂ d̂ᵀ + t (I − d̂ d̂ᵀ)]`,
+    /// `t = max(0, 1 − l0/l)` (0 at rest length; a stretched spring resists sideways too;
+    /// a seam, sewn to length 0, is `c_s I` whatever its direction); without it (damping
+    /// along the spring: γ_max) `c_s d̂ d̂ᵀ`. Power iteration on the symmetric
+    /// `M^−½ A M^−½` from a fixed pseudo-random start, read as a Rayleigh quotient: never
+    /// above the true value, and within a few per cent of it after 30 iterations on a grid
+    /// (test `the_power_iteration_finds_the_lattice_eigenvalue`).
     pub fn lattice_eigenvalue(
         &self,
         coefficient: impl Fn(SpringKind) -> f32,
+        transverse: bool,
         iterations: u32,
     ) -> f32 {
         let p = &self.particles;
         let s = &self.springs;
         let n = p.len();
         let root_w: Vec<f32> = p.inv_mass.iter().map(|w| w.sqrt()).collect();
-        let springs: Vec<(usize, usize, Vec3, f32)> = SpringKind::ALL
+        let springs: Vec<(usize, usize, Vec3, f32, f32)> = SpringKind::ALL
             .into_iter()
             .map(|kind| (kind, coefficient(kind)))
             .filter(|&(_, c)| c > 0.0)
-            .flat_map(|(kind, c)| s.ranges[kind as usize].clone().map(move |i| (i, c)))
-            .filter(|&(i, _)| s.alive[i])
-            .map(|(i, c)| {
+            .flat_map(|(kind, c)| s.ranges[kind as usize].clone().map(move |i| (i, kind, c)))
+            .filter(|&(i, _, _)| s.alive[i])
+            .map(|(i, kind, c)| {
                 let (a, b) = (s.a[i] as usize, s.b[i] as usize);
-                let d = (p.position[b] - p.position[a]).normalize_or_zero();
-                (a, b, d, c * s.scale(i))
+                let d = p.position[b] - p.position[a];
+                let len = d.length();
+                let t = match (transverse, kind) {
+                    (false, _) => 0.0,
+                    (true, SpringKind::Seam) => 1.0,
+                    (true, _) if len > 0.0 => (1.0 - s.rest_length[i] / len).clamp(0.0, 1.0),
+                    (true, _) => 0.0,
+                };
+                (a, b, d.normalize_or_zero(), c * s.scale(i), t)
             })
             .collect();
         let mut u: Vec<Vec3> = (0..n)
@@ -250,8 +262,9 @@ impl ClothSolver {
                 .for_each(|v| *v = (v.as_dvec3() / norm).as_vec3());
             // y = M^−½ A M^−½ u
             y.fill(Vec3::ZERO);
-            for &(a, b, d, c) in &springs {
-                let f = d * (c * d.dot(u[b] * root_w[b] - u[a] * root_w[a]));
+            for &(a, b, d, c, t) in &springs {
+                let r = u[b] * root_w[b] - u[a] * root_w[a];
+                let f = (d * ((1.0 - t) * d.dot(r)) + r * t) * c;
                 y[a] -= f;
                 y[b] += f;
             }
