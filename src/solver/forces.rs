@@ -133,13 +133,20 @@ impl ClothSolver {
         }
         let (l, exponent) = (self.length_scale, patch.exponent);
         let p = &mut self.particles;
-        for i in 0..p.position.len() {
-            let d = patches.targets[i] - p.position[i];
-            let scale = pull_scale(d.length(), l, exponent);
-            let damping = patch.particle_damping_ratio * 2.0 * (patch.stiffness * p.mass[i]).sqrt();
-            let relative = p.velocity[i] - patches.target_velocity[i];
-            p.force[i] = d * (patch.stiffness * scale) - damping * relative;
-        }
+        let (targets, target_velocity) = (&patches.targets, &patches.target_velocity);
+        let pieces = p.force.chunks_mut(PIECE).enumerate();
+        let (x, v, mass) = (&p.position, &p.velocity, &p.mass);
+        parallel::for_each(x.len(), pieces, |(piece, force)| {
+            for (k, f) in force.iter_mut().enumerate() {
+                let i = piece * PIECE + k;
+                let d = targets[i] - x[i];
+                let scale = pull_scale(d.length(), l, exponent);
+                let damping =
+                    patch.particle_damping_ratio * 2.0 * (patch.stiffness * mass[i]).sqrt();
+                let relative = v[i] - target_velocity[i];
+                *f = d * (patch.stiffness * scale) - damping * relative;
+            }
+        });
     }
 
     /// Adds an external force (N) to particle `i` for the current substep. Call it between

@@ -16,6 +16,7 @@
 //! is that particle, so its centre is pinned outright; with the seed's targets, or a
 //! cloth one part across, a pin fixes its part, as in the thesis (see `Patches::new`).
 
+use super::parallel::{self, PIECE};
 use bevy::math::{Affine3A, Vec3};
 
 use super::{ClothSolver, Layout, topology};
@@ -306,16 +307,18 @@ impl Patches {
         if self.bilinear(patch) {
             // One pass: each new target and its velocity together.
             let c = &self.parts.particles.position;
-            for ((target, v), stencil) in self
+            let pieces = self
                 .targets
-                .iter_mut()
-                .zip(&mut self.target_velocity)
-                .zip(&self.stencil)
-            {
-                let new = bilinear_at(c, stencil);
-                *v = (new - *target) * inv_h;
-                *target = new;
-            }
+                .chunks_mut(PIECE)
+                .zip(self.target_velocity.chunks_mut(PIECE))
+                .zip(self.stencil.chunks(PIECE));
+            parallel::for_each(x.len(), pieces, |((targets, velocities), stencils)| {
+                for ((target, v), stencil) in targets.iter_mut().zip(velocities).zip(stencils) {
+                    let new = bilinear_at(c, stencil);
+                    *v = (new - *target) * inv_h;
+                    *target = new;
+                }
+            });
             return;
         }
         self.previous_targets.copy_from_slice(&self.targets);
