@@ -7,11 +7,14 @@
 //! and garments); a stencil mirrors their rest lengths and weights (stiffness factor ×
 //! alive) per offset, synced when they change.
 //!
-//! The strain limiter on a stencil is a coloured Gauss–Seidel: within one colour (an
-//! offset's springs starting on even or on odd columns or rows) no two springs share a
-//! particle, so its corrections do not depend on the order they are made in. The two
-//! diagonals of one band of rows are corrected together (Jacobi, summed), so a mirror
-//! image of the cloth is corrected as the mirror image (for an even width).
+//! The strain limiter on a stencil is a coloured Gauss–Seidel: within one colour (row
+//! springs starting on even or on odd particles; per band of two rows the vertical
+//! springs, then both diagonals of even cells, then of odd cells) no two springs share a
+//! particle, so its corrections do not depend on the order they are made in, nor on the
+//! thread. A mirror image of the cloth (even width) maps every colour onto itself, so
+//! it is corrected as the mirror image.
+//!
+//! Both kernels run in fixed pieces over the compute pool (`parallel.rs`).
 
 use std::iter::Zip;
 use std::ops::Range;
