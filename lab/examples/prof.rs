@@ -9,7 +9,7 @@
 use bevy_cloth::prelude::*;
 use std::time::Instant;
 fn main() {
-    let n = 65536;
+    let n: usize = std::env::var("COUNT").map_or(65536, |c| c.parse().expect("COUNT"));
     let parallel = std::env::var("ONE").is_err();
     let general = std::env::var("GENERAL").is_ok();
     bevy_cloth::solver::set_parallel(parallel);

@@ -248,7 +248,7 @@ fn golden_dumps_of_the_scenes_are_unchanged() {
 
 #[test]
 fn dumps_are_the_same_bits_on_one_thread_and_on_all() {
-    // A 128 × 128 curtain (16,384 particles: its kernels run in pieces on the compute
+    // A 256 × 256 curtain (65,536 particles: every kernel runs in pieces on the compute
     // pool) in wind, limiter on: dumped on one thread and on all, byte for byte.
     let mut dumps = Vec::new();
     for one_thread in [true, false] {
@@ -258,13 +258,13 @@ fn dumps_are_the_same_bits_on_one_thread_and_on_all() {
             "run",
             "assets/scenes/curtain.ron",
             "--steps",
-            "30",
+            "20",
             "--every",
-            "15",
+            "20",
             "--set",
-            "cloth.shape.width=128",
+            "cloth.shape.width=256",
             "--set",
-            "cloth.shape.height=128",
+            "cloth.shape.height=256",
             "--dump",
             &dump_arg,
         ];
@@ -277,7 +277,7 @@ fn dumps_are_the_same_bits_on_one_thread_and_on_all() {
     }
     assert_eq!(
         String::from_utf8_lossy(&dumps[0]).lines().count(),
-        1 + 3 * 16_384
+        1 + 2 * 65_536
     );
     assert!(dumps[0] == dumps[1], "the dumps differ");
 }

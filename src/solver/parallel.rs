@@ -17,7 +17,11 @@ pub(super) const PIECE: usize = 2048;
 /// no allocation). A fork-join on the pool costs about 10 µs here when its thread has
 /// gone to sleep between kernels (`lab/examples/scope_cost.rs`), and a substep takes
 /// about 20 of them: at 8,192 particles two threads were slower than one (180 against
-/// 115 ns per particle-substep in `cloth bench`).
+/// 115 ns per particle-substep in `cloth bench`). One threshold for every kernel: the
+/// per-phase times of `lab/examples/prof.rs` at 16,384 showed two threads losing on the
+/// light ones (integration: 3–8 against 3 ns), but a whole step was slower with those
+/// kept on one thread below 65,536 (16,384: 5.6–6.0 against 5.0 ms per step; 32,768:
+/// 8.8–9.6 against 7.9–8.0, `cloth bench --models 1`).
 pub(super) const PARALLEL_FROM: usize = 8 * PIECE;
 
 /// Whether a cloth's kernels may use the compute pool (the default).
