@@ -33,9 +33,7 @@ pub const SAMPLE_INTERVAL: f64 = 0.1;
 
 /// The reference takes this many times the automatic substeps (and its check twice as
 /// many). 100: with ω_max from the power iteration the curtain's automatic count fell
-/// from 8 to 5, and 64× (320 substeps) left the calm curtain's reference unconverged
-/// (its change when halved was 23% of the smallest error); 100× gives 500, about the
-/// 512 it had.
+/// from 8 to 5, and 100× keeps its reference near the 512 substeps it had (500).
 pub const REFERENCE_FACTOR: u32 = 100;
 
 /// The reference's strain limiter: sweeps until no spring is past the limit by more than

@@ -160,6 +160,8 @@ pub(super) struct Stencil {
     x: Lanes,
     v: Lanes,
     f: Lanes,
+    /// The limiter's corrections in one call, summed per particle.
+    dx: Lanes,
 }
 
 impl Stencil {
@@ -218,6 +220,7 @@ impl Stencil {
             x: Lanes::new(n),
             v: Lanes::new(n),
             f: Lanes::new(n),
+            dx: Lanes::new(n),
         };
         stencil.sync(springs);
         Some(stencil)
@@ -328,6 +331,7 @@ impl Stencil {
         h: f32,
     ) {
         self.x.load(&p.position);
+        self.dx.0.iter_mut().for_each(|lane| lane.fill(0.0));
         for _ in 0..sweeps {
             let unconverged = match past {
                 None => self.sweep::<false>(&p.inv_mass, &enabled, limit, f32::INFINITY),
@@ -337,21 +341,31 @@ impl Stencil {
                 break;
             }
         }
-        let [x, y, z] = &self.x.0;
+        // The velocity takes the summed corrections, not the difference of the positions
+        // before and after: at hundreds of substeps a correction is a few float spacings
+        // of a position 2 m from the origin, and that difference was noise (the accuracy
+        // study's reference stopped converging in h).
+        let ([x, y, z], [dx, dy, dz]) = (&self.x.0, &self.dx.0);
+        let lanes = x.chunks(PIECE).zip(y.chunks(PIECE)).zip(z.chunks(PIECE));
+        let sums = dx.chunks(PIECE).zip(dy.chunks(PIECE)).zip(dz.chunks(PIECE));
         let pieces = p
             .position
             .chunks_mut(PIECE)
             .zip(p.velocity.chunks_mut(PIECE))
-            .zip(x.chunks(PIECE).zip(y.chunks(PIECE)).zip(z.chunks(PIECE)));
-        parallel::for_each(x.len(), pieces, |((position, velocity), ((x, y), z))| {
-            let lanes = x.iter().zip(y).zip(z);
-            for ((position, velocity), ((x, y), z)) in position.iter_mut().zip(velocity).zip(lanes)
-            {
-                let corrected = Vec3::new(*x, *y, *z);
-                *velocity += (corrected - *position) / h;
-                *position = corrected;
-            }
-        });
+            .zip(lanes.zip(sums));
+        parallel::for_each(
+            x.len(),
+            pieces,
+            |((position, velocity), (((x, y), z), ((dx, dy), dz)))| {
+                let lanes = x.iter().zip(y).zip(z).zip(dx.iter().zip(dy).zip(dz));
+                for ((position, velocity), (((x, y), z), ((dx, dy), dz))) in
+                    position.iter_mut().zip(velocity).zip(lanes)
+                {
+                    *velocity += Vec3::new(*dx, *dy, *dz) / h;
+                    *position = Vec3::new(*x, *y, *z);
+                }
+            },
+        );
     }
 
     /// One coloured sweep; with `TRACK`, whether a spring was longer than `past·l0`.
@@ -374,11 +388,11 @@ impl Stencil {
         let diagonals = pick(&|o| o.dy == 1 && o.dx != 0);
         let projection = Projection { limit, past };
         let w = self.width;
-        let x = &mut self.x.0;
+        let (x, dx) = (&mut self.x.0, &mut self.dx.0);
         let mut unconverged = false;
         let [along, _] = along;
         if let Some(o) = along {
-            unconverged |= projection.along_rows::<TRACK>(x, inv_mass, o, w);
+            unconverged |= projection.along_rows::<TRACK>((&mut *x, &mut *dx), inv_mass, o, w);
         }
         let [down, _] = down;
         let diagonals = match diagonals {
@@ -386,7 +400,14 @@ impl Stencil {
             _ => None,
         };
         for parity in 0..2 {
-            unconverged |= projection.across_rows::<TRACK>(x, inv_mass, down, diagonals, w, parity);
+            unconverged |= projection.across_rows::<TRACK>(
+                (&mut *x, &mut *dx),
+                inv_mass,
+                down,
+                diagonals,
+                w,
+                parity,
+            );
         }
         unconverged
     }
@@ -403,7 +424,27 @@ struct Projection {
 /// first particle on.
 struct Group<'a> {
     x: [&'a mut [f32]; 3],
+    /// The corrections made in this call, summed (for the velocity: see
+    /// [`Stencil::limit_strain`]).
+    dx: [&'a mut [f32]; 3],
     inv_mass: &'a [f32],
+}
+
+/// Lanes `range` of positions and of summed corrections, in chunks of `size`.
+fn chunks6<'a>(
+    x: &'a mut [Vec<f32>; 3],
+    dx: &'a mut [Vec<f32>; 3],
+    range: Range<usize>,
+    size: usize,
+) -> impl Iterator<Item = ([&'a mut [f32]; 3], [&'a mut [f32]; 3])> {
+    let [x0, x1, x2] = x;
+    let [d0, d1, d2] = dx;
+    let cut = |lane: &'a mut Vec<f32>| lane[range.clone()].chunks_mut(size);
+    cut(x0)
+        .zip(cut(x1))
+        .zip(cut(x2))
+        .zip(cut(d0).zip(cut(d1)).zip(cut(d2)))
+        .map(|(((a, b), c), ((d, e), f))| ([a, b, c], [d, e, f]))
 }
 
 impl Projection {
@@ -431,9 +472,14 @@ impl Projection {
         }
         let len = len2.sqrt();
         let factor = (len - max) / (len * (wa + wb));
-        for (lane, d) in [&mut **x, &mut **y, &mut **z].into_iter().zip(d) {
-            lane[a] += d * factor * wa;
-            lane[b] -= d * factor * wb;
+        let [dx, dy, dz] = &mut g.dx;
+        let lanes = [&mut **x, &mut **y, &mut **z].into_iter();
+        for ((lane, sum), d) in lanes.zip([&mut **dx, &mut **dy, &mut **dz]).zip(d) {
+            let (ca, cb) = (d * factor * wa, d * factor * wb);
+            lane[a] += ca;
+            lane[b] -= cb;
+            sum[a] += ca;
+            sum[b] -= cb;
         }
         TRACK && len > self.past * rest
     }
@@ -443,24 +489,20 @@ impl Projection {
     /// springs, so groups of whole rows run in pieces over the compute pool.
     fn along_rows<const TRACK: bool>(
         &self,
-        x: &mut [Vec<f32>; 3],
+        (x, dx): (&mut [Vec<f32>; 3], &mut [Vec<f32>; 3]),
         inv_mass: &[f32],
         o: &Offset,
         width: usize,
     ) -> bool {
         let n = x[0].len();
         let group = width * (PIECE / width).max(1);
-        let [x, y, z] = x;
-        let pieces = x
-            .chunks_mut(group)
-            .zip(y.chunks_mut(group))
-            .zip(z.chunks_mut(group))
-            .enumerate();
-        parallel::any(n, pieces, |(i, ((x, y), z))| {
+        let pieces = chunks6(x, dx, 0..n, group).enumerate();
+        parallel::any(n, pieces, |(i, (x, dx))| {
             let from = i * group;
-            let len = x.len();
+            let len = x[0].len();
             let mut g = Group {
-                x: [x, y, z],
+                x,
+                dx,
                 inv_mass: &inv_mass[from..],
             };
             let (rest, weight) = (
@@ -487,7 +529,7 @@ impl Projection {
     #[allow(clippy::too_many_arguments)]
     fn across_rows<const TRACK: bool>(
         &self,
-        x: &mut [Vec<f32>; 3],
+        (x, dx): (&mut [Vec<f32>; 3], &mut [Vec<f32>; 3]),
         inv_mass: &[f32],
         down: Option<&Offset>,
         diagonals: Option<[&Offset; 2]>,
@@ -502,12 +544,7 @@ impl Projection {
         }
         let end = from + (n - from) / band * band; // whole bands only
         let group = band * (PIECE / band).max(1);
-        let [x, y, z] = x;
-        let pieces = x[from..end]
-            .chunks_mut(group)
-            .zip(y[from..end].chunks_mut(group))
-            .zip(z[from..end].chunks_mut(group))
-            .enumerate();
+        let pieces = chunks6(x, dx, from..end, group).enumerate();
         /// `(rest, weight)` of an offset's springs from particle `start` on.
         fn springs(o: &Offset, start: usize) -> (&[f32], &[f32]) {
             (&o.rest[start..], &o.weight[start..])
@@ -518,11 +555,12 @@ impl Projection {
             Some([d1, d2]) => (Some(d2), Some(d1)),
             None => (None, None),
         };
-        parallel::any(n, pieces, |(i, ((x, y), z))| {
+        parallel::any(n, pieces, |(i, (x, dx))| {
             let start = from + i * group;
-            let bands = x.len() / band;
+            let bands = x[0].len() / band;
             let mut g = Group {
-                x: [x, y, z],
+                x,
+                dx,
                 inv_mass: &inv_mass[start..],
             };
             let mut unconverged = false;
