@@ -848,23 +848,28 @@ fn a_symmetric_curtain_stays_symmetric() {
     assert!(x[(height - 1) * width].y < -0.2, "the curtain hangs");
 }
 
+/// A `width × height` grid 2 cm apart, hung from its top corners, default parameters.
+fn corner_hung_grid(width: u32, height: u32) -> ClothSolver {
+    ClothShape::Grid {
+        width,
+        height,
+        spacing: 0.02,
+    }
+    .build_solver(
+        &Pins::TopCorners,
+        &ClothParams::default(),
+        Affine3A::IDENTITY,
+    )
+    .unwrap()
+}
+
 #[test]
 fn a_large_cloth_steps_to_the_same_bits_on_one_thread_and_on_the_pool() {
     // 256 × 256 = 65,536 particles: every kernel runs in pieces on the compute pool
     // (from 16,384), several pieces per thread. Wind, limiter on, top corners pinned.
     let run = |parallel: bool| {
         bevy_cloth::solver::set_parallel(parallel);
-        let mut cloth = ClothShape::Grid {
-            width: 256,
-            height: 256,
-            spacing: 0.02,
-        }
-        .build_solver(
-            &Pins::TopCorners,
-            &ClothParams::default(),
-            Affine3A::IDENTITY,
-        )
-        .unwrap();
+        let mut cloth = corner_hung_grid(256, 256);
         let start = cloth.positions().to_vec();
         for _ in 0..20 {
             cloth.step(0.016, &Environment::default());
@@ -889,17 +894,7 @@ fn the_power_iteration_finds_the_lattice_eigenvalue() {
     // crumpled grid: below the true value (a Rayleigh quotient), and close enough that
     // the margin of 1.25 covers it.
     for crumple in [0.0f32, 0.25] {
-        let mut cloth = ClothShape::Grid {
-            width: 48,
-            height: 32,
-            spacing: 0.02,
-        }
-        .build_solver(
-            &Pins::TopCorners,
-            &ClothParams::default(),
-            Affine3A::IDENTITY,
-        )
-        .unwrap();
+        let mut cloth = corner_hung_grid(48, 32);
         let p = cloth.particles_mut();
         for i in 0..p.len() {
             let t = i as f32;

@@ -134,13 +134,21 @@ pub fn bench_cloth(model: &str, count: usize) -> Result<solver::ClothSolver, Clo
         name: model.to_string(),
         known: "1, 2, 3a, 3b, 3c",
     })?;
+    bench_cloth_with(&params, count)
+}
+
+/// The timing table's curtain of `count` particles with `params`.
+pub fn bench_cloth_with(
+    params: &ClothParams,
+    count: usize,
+) -> Result<solver::ClothSolver, ClothError> {
     let (width, height) = grid_for(count);
     let shape = ClothShape::Grid {
         width,
         height,
         spacing: 0.05,
     };
-    shape.build_solver(&BENCH_PINS, &params, Affine3A::IDENTITY)
+    shape.build_solver(&BENCH_PINS, params, Affine3A::IDENTITY)
 }
 
 /// Steps every bench cell runs, timed or not: one simulated second of 16 ms steps. A
@@ -246,7 +254,8 @@ pub struct KernelCosts {
 /// gets none.
 pub fn kernel_costs(count: usize, repeats: usize) -> Result<KernelCosts, ClothError> {
     let default = seed_model_params("1").expect("model 1");
-    let substeps = bench_cloth("1", count)?.stable_substeps(0.016);
+    let default_cloth = bench_cloth_with(&default, count)?;
+    let substeps = default_cloth.stable_substeps(0.016);
     let fixed = ClothParams {
         substeps: bevy_cloth::params::Substeps::Fixed(substeps),
         ..default
@@ -255,15 +264,12 @@ pub fn kernel_costs(count: usize, repeats: usize) -> Result<KernelCosts, ClothEr
         strain_limit: None,
         ..fixed
     };
-    let (width, height) = grid_for(count);
-    let shape = ClothShape::Grid {
-        width,
-        height,
-        spacing: 0.05,
-    };
-    let build = |params: &ClothParams| shape.build_solver(&BENCH_PINS, params, Affine3A::IDENTITY);
     // Plain, limited, and the default stepped on one core and on all in turn.
-    let mut runs = [build(&plain)?, build(&fixed)?, build(&default)?];
+    let mut runs = [
+        bench_cloth_with(&plain, count)?,
+        bench_cloth_with(&fixed, count)?,
+        default_cloth,
+    ];
     let env = Environment::default();
     let mut times: [Vec<f64>; 4] = Default::default();
     let mut failed = [false; 4];

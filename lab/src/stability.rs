@@ -166,22 +166,17 @@ pub fn perturb(cloth: &mut solver::ClothSolver, spacing: f32, fraction: f32) {
         if p.is_pinned(i) {
             continue;
         }
-        let offset = Vec3::new(hash(i, 0), hash(i, 1), hash(i, 2)) * (spacing * fraction);
+        let offset = Vec3::new(
+            solver::unit_hash(i, 0),
+            solver::unit_hash(i, 1),
+            solver::unit_hash(i, 2),
+        ) * (spacing * fraction);
         p.position[i] += offset;
         p.previous[i] = p.position[i];
         p.velocity[i] = Vec3::ZERO;
     }
     // Goals and targets of the displaced cloth, so its energy counts the displacement.
     cloth.update_goals();
-}
-
-/// A number in [−1, 1] from `(i, axis)`.
-fn hash(i: usize, axis: u32) -> f32 {
-    let mut x = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ ((axis as u64 + 1) << 32);
-    x ^= x >> 31;
-    x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x ^= x >> 29;
-    (x % 2_000_001) as f32 / 1_000_000.0 - 1.0
 }
 
 /// Kinetic energy of the free particles, J, summed in `f64` (`ClothSolver::energy` sums in

@@ -3,7 +3,6 @@
 use bevy::asset::RenderAssetUsages;
 use bevy::math::Vec3;
 use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
-use bevy::tasks::ParallelSliceMut;
 
 use crate::error::ClothError;
 use crate::solver;
@@ -51,12 +50,14 @@ pub fn write_mesh(
         mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
     {
         let x = cloth.positions();
-        write_each(out, |i, o| *o = to_local.transform_point3(x[i]).to_array());
+        solver::for_each_indexed(out, |i, o| {
+            *o = to_local.transform_point3(x[i]).to_array();
+        });
     }
     if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_NORMAL)
     {
         let normals = &*normals;
-        write_each(out, |i, o| {
+        solver::for_each_indexed(out, |i, o| {
             *o = to_local
                 .transform_vector3(normals[i])
                 .normalize_or(Vec3::Z)
@@ -74,21 +75,6 @@ pub fn write_mesh(
             .collect();
         mesh.insert_indices(Indices::U32(indices));
     }
-}
-
-/// Sets every element of `out` by `f(index, element)`: in pieces on Bevy's compute task
-/// pool for a large mesh, on this thread for a small one.
-fn write_each<T: Send>(mut out: &mut [T], f: impl Fn(usize, &mut T) + Send + Sync) {
-    const PIECE: usize = 4096;
-    if out.len() < 4 * PIECE {
-        out.iter_mut().enumerate().for_each(|(i, o)| f(i, o));
-        return;
-    }
-    out.par_chunk_map_mut(solver::task_pool(), PIECE, |piece, chunk| {
-        for (k, o) in chunk.iter_mut().enumerate() {
-            f(piece * PIECE + k, o);
-        }
-    });
 }
 
 /// What a mesh-shaped cloth takes from its source mesh.

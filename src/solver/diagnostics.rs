@@ -3,7 +3,7 @@
 
 use bevy::math::Vec3;
 
-use super::parallel::{self, PIECE};
+use super::parallel;
 use super::{ClothSolver, SpringKind, family_stiffness};
 use crate::params::{Environment, SpringParams};
 
@@ -120,19 +120,15 @@ impl ClothSolver {
         // Gathered per particle over its triangles in increasing order: the same sums, in
         // the same order, as scattering each triangle's normal onto its corners, and a
         // particle's normal is written by one piece only.
-        let pieces = out.chunks_mut(PIECE).enumerate();
-        parallel::for_each(x.len(), pieces, |(piece, out)| {
-            for (k, n) in out.iter_mut().enumerate() {
-                let i = piece * PIECE + k;
-                let mut sum = Vec3::ZERO;
-                for &t in self.vertex_faces.of(i) {
-                    if visible[t as usize] {
-                        let [a, b, c] = triangles[t as usize].map(|v| v as usize);
-                        sum += (x[b] - x[a]).cross(x[c] - x[a]);
-                    }
+        parallel::for_each_indexed(out, |i, n| {
+            let mut sum = Vec3::ZERO;
+            for &t in self.vertex_faces.of(i) {
+                if visible[t as usize] {
+                    let [a, b, c] = triangles[t as usize].map(|v| v as usize);
+                    sum += (x[b] - x[a]).cross(x[c] - x[a]);
                 }
-                *n = sum.normalize_or(Vec3::Z);
             }
+            *n = sum.normalize_or(Vec3::Z);
         });
     }
 }

@@ -134,18 +134,13 @@ impl ClothSolver {
         let (l, exponent) = (self.length_scale, patch.exponent);
         let p = &mut self.particles;
         let (targets, target_velocity) = (&patches.targets, &patches.target_velocity);
-        let pieces = p.force.chunks_mut(PIECE).enumerate();
         let (x, v, mass) = (&p.position, &p.velocity, &p.mass);
-        parallel::for_each(x.len(), pieces, |(piece, force)| {
-            for (k, f) in force.iter_mut().enumerate() {
-                let i = piece * PIECE + k;
-                let d = targets[i] - x[i];
-                let scale = pull_scale(d.length(), l, exponent);
-                let damping =
-                    patch.particle_damping_ratio * 2.0 * (patch.stiffness * mass[i]).sqrt();
-                let relative = v[i] - target_velocity[i];
-                *f = d * (patch.stiffness * scale) - damping * relative;
-            }
+        parallel::for_each_indexed(&mut p.force, |i, f| {
+            let d = targets[i] - x[i];
+            let scale = pull_scale(d.length(), l, exponent);
+            let damping = patch.particle_damping_ratio * 2.0 * (patch.stiffness * mass[i]).sqrt();
+            let relative = v[i] - target_velocity[i];
+            *f = d * (patch.stiffness * scale) - damping * relative;
         });
     }
 

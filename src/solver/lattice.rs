@@ -160,7 +160,7 @@ pub(super) struct Stencil {
     x: Lanes,
     v: Lanes,
     f: Lanes,
-    /// The limiter's corrections in one call, summed per particle.
+    /// The limiter's corrections in one call, summed per particle (zero between calls).
     dx: Lanes,
 }
 
@@ -331,7 +331,6 @@ impl Stencil {
         h: f32,
     ) {
         self.x.load(&p.position);
-        self.dx.0.iter_mut().for_each(|lane| lane.fill(0.0));
         for _ in 0..sweeps {
             let unconverged = match past {
                 None => self.sweep::<false>(&p.inv_mass, &enabled, limit, f32::INFINITY),
@@ -345,9 +344,13 @@ impl Stencil {
         // before and after: at hundreds of substeps a correction is a few float spacings
         // of a position 2 m from the origin, and that difference was noise (the accuracy
         // study's reference stopped converging in h).
-        let ([x, y, z], [dx, dy, dz]) = (&self.x.0, &self.dx.0);
+        // The sums are zeroed as they are read, ready for the next call.
+        let ([x, y, z], [dx, dy, dz]) = (&self.x.0, &mut self.dx.0);
         let lanes = x.chunks(PIECE).zip(y.chunks(PIECE)).zip(z.chunks(PIECE));
-        let sums = dx.chunks(PIECE).zip(dy.chunks(PIECE)).zip(dz.chunks(PIECE));
+        let sums = dx
+            .chunks_mut(PIECE)
+            .zip(dy.chunks_mut(PIECE))
+            .zip(dz.chunks_mut(PIECE));
         let pieces = p
             .position
             .chunks_mut(PIECE)
@@ -357,12 +360,17 @@ impl Stencil {
             x.len(),
             pieces,
             |((position, velocity), (((x, y), z), ((dx, dy), dz)))| {
-                let lanes = x.iter().zip(y).zip(z).zip(dx.iter().zip(dy).zip(dz));
+                let lanes = x
+                    .iter()
+                    .zip(y)
+                    .zip(z)
+                    .zip(dx.iter_mut().zip(dy.iter_mut()).zip(dz.iter_mut()));
                 for ((position, velocity), (((x, y), z), ((dx, dy), dz))) in
                     position.iter_mut().zip(velocity).zip(lanes)
                 {
                     *velocity += Vec3::new(*dx, *dy, *dz) / h;
                     *position = Vec3::new(*x, *y, *z);
+                    (*dx, *dy, *dz) = (0.0, 0.0, 0.0);
                 }
             },
         );

@@ -30,9 +30,10 @@ pub use collide::{Collider, ColliderShape};
 pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
-pub use parallel::{pool as task_pool, set_parallel, threads};
+pub use parallel::{for_each_indexed, pool as task_pool, set_parallel, threads};
 pub use state::Particles;
 use substeps::SubstepCache;
+pub use substeps::unit_hash;
 pub use topology::{SpringKind, Springs};
 
 use bevy::math::{Affine3A, Vec3};

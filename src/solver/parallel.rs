@@ -80,6 +80,18 @@ pub(super) fn for_each<T: Send>(
     });
 }
 
+/// Sets every element of `out` by `f(index, element)`, in pieces as [`for_each`] does:
+/// the per-particle kernels that read other arrays by index (normals, the patch pull)
+/// and the plugin's mesh write-back.
+pub fn for_each_indexed<T: Send>(out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
+    let len = out.len();
+    for_each(len, out.chunks_mut(PIECE).enumerate(), |(piece, out)| {
+        for (k, o) in out.iter_mut().enumerate() {
+            f(piece * PIECE + k, o);
+        }
+    });
+}
+
 /// As [`for_each`], for work that reports a flag: whether any piece returned `true`.
 pub(super) fn any<T: Send>(
     len: usize,

@@ -147,7 +147,7 @@ impl ClothSolver {
     /// (`c I`, see [`Self::lattice_eigenvalue`]) the lightest, softest one went unstable.
     fn spring_frequency(&self) -> (f32, f32) {
         let (omega2_bound, gamma_bound) = self.spring_gershgorin();
-        if self.stencil.is_none() {
+        if self.grid.is_none() {
             return (omega2_bound, gamma_bound);
         }
         let damping = self.params.springs.damping;
@@ -300,8 +300,9 @@ pub const POWER_ITERATIONS: u32 = 30;
 /// where they were when it was taken.
 const POWER_MARGIN: f32 = 1.25;
 
-/// A fixed pseudo-random number in [−1, 1] for particle `i` and `axis`.
-fn unit_hash(i: usize, axis: u64) -> f32 {
+/// A fixed pseudo-random number in [−1, 1] for particle `i` and `axis`: the power
+/// iteration's start, and the lab's perturbed cloths.
+pub fn unit_hash(i: usize, axis: u64) -> f32 {
     let mut x = (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ ((axis + 1) << 32);
     x ^= x >> 31;
     x = x.wrapping_mul(0xBF58_476D_1CE4_E5B9);
