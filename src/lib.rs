@@ -56,7 +56,7 @@ pub mod prelude {
     pub use crate::params::{
         ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
         PatchTargets, RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps,
-        Wind, WindField,
+        Wind, WindField, XpbdParams,
     };
     pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError, SpawnedScene};
 }

@@ -380,6 +380,43 @@ impl PatchParams {
     }
 }
 
+/// Parameters of the XPBD model (Macklin, Müller, Chentanez, "XPBD", MIG 2016; Macklin
+/// et al., "Small Steps in Physics Simulation", SCA 2019). The material is the cloth's
+/// own: every spring family is a distance constraint of compliance `1/k` with the
+/// family's stiffness (`k = inf` is an inextensible constraint), the strain limit a
+/// hard inequality, spring damping the paper's constraint damping.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct XpbdParams {
+    /// The accuracy target of `Substeps::Auto`: the stretch (a fraction of the rest
+    /// length) that solving each substep's constraints once may leave beyond what the
+    /// material itself stretches. One iteration per substep makes an inextensible
+    /// constraint act like a spring of stiffness about `m/h²` (Macklin et al. 2019 §4), so
+    /// a cloth `R` springs of length `L` long hanging under gravity `g` stretches its most
+    /// loaded constraint by about `2 R g h² / L`; the automatic substeps are the fewest
+    /// that keep that within this target (`ClothSolver::stable_substeps`).
+    pub max_stretch_error: f32,
+}
+
+impl Default for XpbdParams {
+    fn default() -> Self {
+        Self {
+            max_stretch_error: 0.01,
+        }
+    }
+}
+
+impl XpbdParams {
+    fn validate(&self) -> Result<(), ClothError> {
+        check(
+            "model.max_stretch_error",
+            self.max_stretch_error,
+            self.max_stretch_error > 0.0,
+            "a stretch error > 0 (a fraction of the rest length)",
+        )
+    }
+}
+
 /// Which cloth model moves the particles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
 pub enum Model {
@@ -392,6 +429,9 @@ pub enum Model {
     /// Parts of w×h particles whose centres form a mass-spring lattice; particles follow
     /// targets interpolated between neighbouring centres (seed 000 §3.4). Grids only.
     Patches(PatchParams),
+    /// The springs as compliant distance constraints, solved once per small substep
+    /// (XPBD): stable at any stiffness and substep count. Not in the seeds.
+    Xpbd(XpbdParams),
 }
 
 impl Model {
@@ -401,13 +441,14 @@ impl Model {
             Model::MassSpring => ModelKind::MassSpring,
             Model::ShapeMatching(_) => ModelKind::ShapeMatching,
             Model::Patches(_) => ModelKind::Patches,
+            Model::Xpbd(_) => ModelKind::Xpbd,
         }
     }
 }
 
 /// Which model, without its parameters: the one identifier every front end uses (the
 /// command line's `--model`, the lab's tables and charts, the inspector's list), written
-/// `mass-spring`, `shape-matching`, `patches`.
+/// `mass-spring`, `shape-matching`, `patches`, `xpbd`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Reflect, Serialize, Deserialize)]
 pub enum ModelKind {
     /// [`Model::MassSpring`].
@@ -416,22 +457,26 @@ pub enum ModelKind {
     ShapeMatching,
     /// [`Model::Patches`].
     Patches,
+    /// [`Model::Xpbd`].
+    Xpbd,
 }
 
 impl ModelKind {
-    /// Every model, in the seeds' order.
-    pub const ALL: [ModelKind; 3] = [
+    /// Every model, in the seeds' order, then XPBD.
+    pub const ALL: [ModelKind; 4] = [
         ModelKind::MassSpring,
         ModelKind::ShapeMatching,
         ModelKind::Patches,
+        ModelKind::Xpbd,
     ];
 
-    /// The model's name: `mass-spring`, `shape-matching` or `patches`.
+    /// The model's name: `mass-spring`, `shape-matching`, `patches` or `xpbd`.
     pub const fn name(self) -> &'static str {
         match self {
             ModelKind::MassSpring => "mass-spring",
             ModelKind::ShapeMatching => "shape-matching",
             ModelKind::Patches => "patches",
+            ModelKind::Xpbd => "xpbd",
         }
     }
 
@@ -441,6 +486,7 @@ impl ModelKind {
             ModelKind::MassSpring => Model::MassSpring,
             ModelKind::ShapeMatching => Model::ShapeMatching(ShapeMatchingParams::default()),
             ModelKind::Patches => Model::Patches(PatchParams::default()),
+            ModelKind::Xpbd => Model::Xpbd(XpbdParams::default()),
         }
     }
 }
@@ -460,7 +506,7 @@ impl std::str::FromStr for ModelKind {
             .find(|k| k.name() == name)
             .ok_or_else(|| ClothError::UnknownModel {
                 name: name.to_string(),
-                known: "mass-spring, shape-matching, patches",
+                known: "mass-spring, shape-matching, patches, xpbd",
             })
     }
 }
@@ -469,7 +515,7 @@ impl std::str::FromStr for ModelKind {
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ClothParams {
-    /// The cloth model; spring parameters are used by the mass-spring model.
+    /// The cloth model; spring parameters are used by the mass-spring and XPBD models.
     pub model: Model,
     /// Mass of one particle in kg (seed 002 §1.4: 0.001–1 g, i.e. 1e-6–1e-3 kg).
     pub node_mass: f32,
@@ -540,6 +586,9 @@ impl ClothParams {
             "a positive mass in kg",
         )?;
         let s = &self.springs;
+        // XPBD takes an infinite stiffness as an inextensible constraint (compliance 0);
+        // the explicit models need a finite one.
+        let rigid_ok = matches!(self.model, Model::Xpbd(_));
         for (field, family) in [
             ("springs.structural.stiffness", s.structural),
             ("springs.shear.stiffness", s.shear),
@@ -547,11 +596,14 @@ impl ClothParams {
             ("springs.bend_diagonal.stiffness", s.bend_diagonal),
             ("springs.seam.stiffness", s.seam),
         ] {
+            if rigid_ok && family.stiffness == f32::INFINITY {
+                continue;
+            }
             check(
                 field,
                 family.stiffness,
                 family.stiffness >= 0.0,
-                "a stiffness ≥ 0 N/m",
+                "a stiffness ≥ 0 N/m (inf only for XPBD)",
             )?;
         }
         check(
@@ -607,6 +659,7 @@ impl ClothParams {
         match &self.model {
             Model::ShapeMatching(sm) => sm.validate()?,
             Model::Patches(patches) => patches.validate()?,
+            Model::Xpbd(xpbd) => xpbd.validate()?,
             Model::MassSpring => {}
         }
         Ok(())

@@ -406,14 +406,15 @@ fn set_by_path(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), 
             Some(number()?)
         };
     } else if let Some(f) = field.try_downcast_mut::<crate::params::Model>() {
-        use crate::params::{Model, PatchParams, ShapeMatchingParams};
+        use crate::params::{Model, PatchParams, ShapeMatchingParams, XpbdParams};
         *f = match value {
             "MassSpring" => Model::MassSpring,
             "ShapeMatching" => Model::ShapeMatching(ShapeMatchingParams::default()),
             "Patches" => Model::Patches(PatchParams::default()),
+            "Xpbd" => Model::Xpbd(XpbdParams::default()),
             _ => {
                 return Err(format!(
-                    "`{value}` is not MassSpring, ShapeMatching or Patches"
+                    "`{value}` is not MassSpring, ShapeMatching, Patches or Xpbd"
                 ));
             }
         };

@@ -280,9 +280,21 @@ fn panel(
     Ok(())
 }
 
-fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily) {
+/// A family's switch and stiffness; with `rigid`, also XPBD's inextensible setting
+/// (stiffness `inf`, compliance 0).
+fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily, rigid: bool) {
     ui.horizontal(|ui| {
         ui.checkbox(&mut family.enabled, name);
+        let mut inextensible = family.stiffness == f32::INFINITY;
+        if rigid && ui.checkbox(&mut inextensible, "∞").changed() {
+            family.stiffness = if inextensible { f32::INFINITY } else { 1_000.0 };
+        }
+        if !family.stiffness.is_finite() {
+            if !rigid {
+                family.stiffness = 25_000.0; // the explicit models need a finite one
+            }
+            return;
+        }
         ui.add(
             egui::Slider::new(&mut family.stiffness, 0.0..=25_000.0)
                 .logarithmic(true)
@@ -291,11 +303,11 @@ fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily) {
     });
 }
 
-fn spring_controls(ui: &mut egui::Ui, springs: &mut SpringParams) {
-    family(ui, "structural", &mut springs.structural);
-    family(ui, "shear", &mut springs.shear);
-    family(ui, "bend", &mut springs.bend);
-    family(ui, "diag. bend", &mut springs.bend_diagonal);
+fn spring_controls(ui: &mut egui::Ui, springs: &mut SpringParams, rigid: bool) {
+    family(ui, "structural", &mut springs.structural, rigid);
+    family(ui, "shear", &mut springs.shear, rigid);
+    family(ui, "bend", &mut springs.bend, rigid);
+    family(ui, "diag. bend", &mut springs.bend_diagonal, rigid);
     ui.add(egui::Slider::new(&mut springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
 }
 
@@ -344,11 +356,21 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
         });
     let garment = matches!(cloth.shape, ClothShape::Garment { .. });
     match &mut p.model {
-        Model::MassSpring => {
-            spring_controls(ui, &mut p.springs);
+        model @ (Model::MassSpring | Model::Xpbd(_)) => {
+            let rigid = if let Model::Xpbd(xpbd) = model {
+                ui.add(
+                    egui::Slider::new(&mut xpbd.max_stretch_error, 0.001..=0.1)
+                        .logarithmic(true)
+                        .text("stretch error target (auto substeps)"),
+                );
+                true
+            } else {
+                false
+            };
+            spring_controls(ui, &mut p.springs, rigid);
             if garment {
                 let s = &mut p.springs;
-                family(ui, "seam", &mut s.seam);
+                family(ui, "seam", &mut s.seam, rigid);
                 ui.add(
                     egui::Slider::new(&mut s.seam_rest_length, 0.0..=0.05).text("seam length, m"),
                 );
@@ -395,7 +417,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             );
             ui.checkbox(&mut patch.tiles, "tiles (no oscillation)");
             ui.label("part springs:");
-            spring_controls(ui, &mut p.springs);
+            spring_controls(ui, &mut p.springs, false);
         }
     }
     ui.add(egui::Slider::new(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));

@@ -403,7 +403,7 @@ pub fn regime_cloth(
             particle_damping_ratio: PatchParams::default().particle_damping_ratio,
             ..patch
         }),
-        Model::MassSpring => Model::MassSpring,
+        other @ (Model::MassSpring | Model::Xpbd(_)) => other,
     };
     let limited = ClothParams {
         model,

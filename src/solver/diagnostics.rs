@@ -67,14 +67,14 @@ impl ClothSolver {
     }
 
     /// `Σ ½ k (l − l0)²` over the whole springs, with each family's stiffness from
-    /// `springs`.
+    /// `springs`; an inextensible family (XPBD's `k = inf`) stores none.
     fn spring_energy(&self, springs: &SpringParams) -> f32 {
         let x = &self.particles.position;
         let s = &self.springs;
         let mut energy = 0.0;
         for kind in SpringKind::ALL {
             let k = family_stiffness(springs, kind);
-            if k == 0.0 {
+            if k == 0.0 || k == f32::INFINITY {
                 continue;
             }
             for i in s.ranges[kind as usize].clone() {

@@ -49,9 +49,14 @@ impl ClothSolver {
                 }
             },
         );
-        if let Model::ShapeMatching(sm) = self.params.model {
-            self.goal_forces(&sm);
-            return;
+        match self.params.model {
+            Model::ShapeMatching(sm) => {
+                self.goal_forces(&sm);
+                return;
+            }
+            // XPBD's springs are constraints, projected after the prediction (`xpbd.rs`).
+            Model::Xpbd(_) => return,
+            Model::MassSpring | Model::Patches(_) => {}
         }
 
         let damping = self.params.springs.damping;

@@ -1,7 +1,7 @@
 //! Phases 2 and 3 of a substep: integration and constraints.
 
 use super::parallel::{self, PIECE};
-use super::{ClothSolver, Particles, SpringKind};
+use super::{ClothSolver, ModelState, Particles, SpringKind, family_stiffness, xpbd};
 use crate::params::{GoalUpdate, Integrator, Model};
 
 impl ClothSolver {
@@ -19,6 +19,12 @@ impl ClothSolver {
             if matches!(self.params.model, Model::Patches(patch) if patch.tiles) {
                 return; // tiles: particles are placed on their targets, not integrated
             }
+        }
+        if let Model::Xpbd(_) = self.params.model {
+            // XPBD's prediction from the external forces: `v += h f/m`, `x += h v`
+            // (Macklin et al. 2019, algorithm 1), whatever the integrator setting.
+            symplectic_euler(&mut self.particles, h);
+            return;
         }
         match self.params.integrator {
             Integrator::Verlet => verlet(&mut self.particles, h),
@@ -86,8 +92,11 @@ impl ClothSolver {
         let h = self.h;
         self.drive(t);
         // Strain limiting corrects springs; a model without acting springs has none.
-        if let (Some(limit), Model::MassSpring) = (self.params.strain_limit, self.params.model) {
-            self.limit_strain(limit, h);
+        // XPBD's constraints (and its strain limit) are projected here, after the pins.
+        match (self.params.strain_limit, self.params.model) {
+            (Some(limit), Model::MassSpring) => self.limit_strain(limit, h),
+            (_, Model::Xpbd(_)) => self.project_constraints(h),
+            _ => {}
         }
         // Last, so no later correction pushes a particle back into a collider.
         self.collide();
@@ -174,9 +183,26 @@ impl ClothSolver {
         unconverged
     }
 
+    /// XPBD: every spring's constraint projected once (`xpbd.rs`), the strain limit
+    /// with the structural and shear ones.
+    fn project_constraints(&mut self, h: f32) {
+        let ModelState::Xpbd(constraints) = &mut self.model else {
+            return;
+        };
+        let (c, limit) = (self.params.springs.damping, self.params.strain_limit);
+        let families = SpringKind::ALL.map(|kind| {
+            let k = family_stiffness(&self.params.springs, kind);
+            let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
+            xpbd::Family::new(k, c, h, limit.filter(|_| limited))
+        });
+        constraints.project(&mut self.particles, &self.springs, &families, h);
+    }
+
     /// Keeps Verlet's implicit velocity `(x − x_prev)/h` when `h` changes by `ratio`.
     pub(super) fn rescale_verlet_velocity(&mut self, ratio: f32) {
-        if self.params.integrator != Integrator::Verlet {
+        if self.params.integrator != Integrator::Verlet
+            || matches!(self.params.model, Model::Xpbd(_))
+        {
             return;
         }
         let p = &mut self.particles;

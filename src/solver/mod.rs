@@ -25,6 +25,7 @@ pub mod shape_matching;
 mod state;
 mod substeps;
 pub mod topology;
+mod xpbd;
 
 pub use collide::{Collider, ColliderShape};
 pub use diagnostics::{Energy, Strain};
@@ -96,13 +97,15 @@ pub struct ClothSolver {
 }
 
 /// The active model's own state: none for mass-spring (or before the first step
-/// builds it), the clusters and goals of shape matching, or the part lattice and
-/// targets of the patch model. One at a time, by construction.
+/// builds it), the clusters and goals of shape matching, the part lattice and
+/// targets of the patch model, or XPBD's coloured constraints. One at a time, by
+/// construction.
 #[derive(Clone, Debug)]
 enum ModelState {
     None,
     ShapeMatching(ShapeMatching),
     Patches(Box<Patches>),
+    Xpbd(Box<xpbd::Constraints>),
 }
 
 impl ModelState {
@@ -224,7 +227,7 @@ impl ClothSolver {
             ModelState::ShapeMatching(sm) => sm.reset(),
             // Rebuilt from the rest state by the next step.
             ModelState::Patches(_) => self.model = ModelState::None,
-            ModelState::None => {}
+            ModelState::None | ModelState::Xpbd(_) => {}
         }
         let mass = self.params.node_mass;
         let p = &mut self.particles;
@@ -401,7 +404,9 @@ impl ClothSolver {
                 }
             }
         }
-        if let (Some(ratio), Model::MassSpring) = (self.params.tear_ratio, self.params.model) {
+        if let (Some(ratio), Model::MassSpring | Model::Xpbd(_)) =
+            (self.params.tear_ratio, self.params.model)
+        {
             let x = &self.particles.position;
             let s = &mut self.springs;
             // Seams are sewn to a rest length of 0 and do not tear.
@@ -515,6 +520,15 @@ impl ClothSolver {
                     }
                 }
             }
+            Model::Xpbd(_) => {
+                let n = self.particles.len();
+                let current = matches!(&self.model,
+                    ModelState::Xpbd(c) if c.built_for == self.springs.len());
+                if !current {
+                    let constraints = xpbd::Constraints::new(&self.springs, n);
+                    self.model = ModelState::Xpbd(Box::new(constraints));
+                }
+            }
             Model::MassSpring => self.model = ModelState::None,
         }
     }
@@ -540,9 +554,10 @@ impl ClothSolver {
     }
 
     /// The acting stiffness of a spring kind under the current parameters (0 for every
-    /// kind when the model has no springs).
+    /// kind when the model has no springs; XPBD's constraints have the springs'
+    /// stiffness, `inf` for an inextensible one).
     pub fn stiffness(&self, kind: SpringKind) -> f32 {
-        if self.params.model != Model::MassSpring {
+        if !matches!(self.params.model, Model::MassSpring | Model::Xpbd(_)) {
             return 0.0;
         }
         family_stiffness(&self.params.springs, kind)

@@ -1,0 +1,240 @@
+//! The XPBD model against answers known independently of the code: a hanging chain's
+//! static stretch, an inextensible chain, a pendulum's period, a free cloth's energy.
+
+use bevy::math::{Affine3A, Vec3};
+use bevy_cloth::prelude::*;
+use bevy_cloth::solver::{ClothSolver, Layout};
+
+const DT: f32 = 0.016;
+const G: f32 = 9.81;
+
+/// XPBD with structural stiffness `k` (every other family off), node mass `m`, no drag,
+/// limit or damping, `substeps` fixed.
+fn xpbd(k: f32, m: f32, substeps: u32) -> ClothParams {
+    ClothParams {
+        model: Model::Xpbd(XpbdParams::default()),
+        node_mass: m,
+        springs: SpringParams {
+            structural: SpringFamily::new(k),
+            shear: SpringFamily::off(0.0),
+            bend: SpringFamily::off(0.0),
+            bend_diagonal: SpringFamily::off(0.0),
+            seam: SpringFamily::off(0.0),
+            damping: 0.0,
+            ..SpringParams::default()
+        },
+        drag: 0.0,
+        substeps: Substeps::Fixed(substeps),
+        strain_limit: None,
+        ..ClothParams::default()
+    }
+}
+
+/// A vertical chain of `links` links of `length` hanging from its pinned top particle.
+fn chain(links: u32, length: f32, params: &ClothParams) -> ClothSolver {
+    let positions: Vec<Vec3> = (0..=links)
+        .map(|i| Vec3::new(0.0, -(i as f32) * length, 0.0))
+        .collect();
+    let springs: Vec<[u32; 2]> = (0..links).map(|i| [i, i + 1]).collect();
+    let layout = Layout::from_springs(&positions, &springs).unwrap();
+    ClothSolver::new(layout, &[0], params, Affine3A::IDENTITY).unwrap()
+}
+
+fn gravity_only() -> Environment {
+    Environment::default()
+}
+
+/// Each link's stretch, top first.
+fn stretches(cloth: &ClothSolver, length: f32) -> Vec<f32> {
+    let x = cloth.positions();
+    x.windows(2).map(|w| w[0].distance(w[1]) - length).collect()
+}
+
+/// A chain of `links` links of 0.1 m and 1 g particles hanging from its top, settled for
+/// 48 s by drag (which does nothing at rest): each link's stretch, top first.
+fn settled_chain(links: u32, k: f32, substeps: Substeps, target: f32) -> Vec<f32> {
+    let params = ClothParams {
+        model: Model::Xpbd(XpbdParams {
+            max_stretch_error: target,
+        }),
+        drag: 2e-3,
+        substeps,
+        ..xpbd(k, 1e-3, 1)
+    };
+    params.validate().unwrap();
+    let mut cloth = chain(links, 0.1, &params);
+    for _ in 0..3_000 {
+        cloth.step(DT, &gravity_only());
+    }
+    let speed = cloth
+        .particles()
+        .velocity
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f32::max);
+    assert!(speed < 1e-3, "not at rest: {speed} m/s");
+    stretches(&cloth, 0.1)
+}
+
+#[test]
+fn a_hanging_compliant_chain_converges_to_the_static_stretch_as_h_squared() {
+    // Link i from the top carries the (links − i) particles below it: the static answer
+    // is a stretch of (links − i) m g / k. One iteration per substep leaves an error
+    // that falls as h² (Macklin et al. 2019): measured as the largest error of a link
+    // over the top link's stretch, 10.2% at 20 substeps per 16 ms, 2.6% at 40.
+    let (links, k, m) = (10, 100.0, 1e-3);
+    let top = links as f32 * m * G / k;
+    let worst_error = |substeps| {
+        let stretch = settled_chain(links, k, Substeps::Fixed(substeps), 0.01);
+        (0..links as usize)
+            .map(|i| {
+                let expected = (links as usize - i) as f32 * m * G / k;
+                (stretch[i] - expected).abs() / top
+            })
+            .fold(0.0, f32::max)
+    };
+    let (coarse, fine) = (worst_error(20), worst_error(40));
+    println!(
+        "largest error against the static stretch: {coarse:.3e} at 20 substeps, {fine:.3e} at 40"
+    );
+    assert!(coarse < 0.12, "{:.2}% off at 20 substeps", coarse * 100.0);
+    assert!(fine < 0.03, "{:.2}% off at 40 substeps", fine * 100.0);
+    assert!(
+        coarse / fine > 3.0,
+        "halving h cut the error only {:.2}×",
+        coarse / fine
+    );
+}
+
+#[test]
+fn a_hanging_inextensible_chain_keeps_its_length_to_the_automatic_substeps_target() {
+    // Compliance 0 (k = inf). The automatic substeps aim at a stretch error of 0.1%:
+    // chains of 10 and 40 links at rest stay within it (a 10-link chain at a fixed 20
+    // substeps sits at 0.1005%).
+    for links in [10, 40] {
+        let params = ClothParams {
+            model: Model::Xpbd(XpbdParams {
+                max_stretch_error: 1e-3,
+            }),
+            ..xpbd(f32::INFINITY, 1e-3, 1)
+        };
+        let auto = Substeps::Auto { max: 8192 };
+        let strain = settled_chain(links, f32::INFINITY, auto, 1e-3)
+            .into_iter()
+            .map(|s| s.abs() / 0.1)
+            .fold(0.0, f32::max);
+        let cloth = chain(links, 0.1, &params);
+        println!(
+            "{links} links: {} substeps, largest strain at rest {strain:.3e}",
+            cloth.stable_substeps(DT)
+        );
+        assert!(
+            strain < 1e-3,
+            "{links} links: strain at rest {:.4}%",
+            strain * 100.0
+        );
+    }
+}
+
+#[test]
+fn a_swinging_inextensible_chain_stays_within_half_a_percent() {
+    let (links, length) = (10, 0.1);
+    let mut cloth = chain(links, length, &xpbd(f32::INFINITY, 1e-3, 20));
+    // Released 45° to the side.
+    for i in 0..=links as usize {
+        let s = i as f32 * length;
+        let p = cloth.particles_mut();
+        p.position[i] = Vec3::new(1.0, -1.0, 0.0).normalize() * s;
+        p.previous[i] = p.position[i];
+    }
+    let mut worst = 0.0f32;
+    for _ in 0..200 {
+        cloth.step(DT, &gravity_only());
+        for stretch in stretches(&cloth, length) {
+            worst = worst.max(stretch.abs() / length);
+        }
+    }
+    println!("largest strain while swinging {worst:.3e}");
+    assert!(worst < 5e-3, "strain while swinging {:.4}%", worst * 100.0);
+}
+
+#[test]
+fn a_small_pendulum_swings_with_the_period_2_pi_root_l_over_g() {
+    // An inextensible link of 1 m from a pin, released 5° from the vertical; the period
+    // at that amplitude is 1.0005 × 2π√(L/g) (the first term of the elliptic series).
+    let length = 1.0f32;
+    let angle = 5f32.to_radians();
+    let positions = [
+        Vec3::ZERO,
+        Vec3::new(length * angle.sin(), -length * angle.cos(), 0.0),
+    ];
+    let layout = Layout::from_springs(&positions, &[[0, 1]]).unwrap();
+    let params = xpbd(f32::INFINITY, 1e-3, 20);
+    let mut cloth = ClothSolver::new(layout, &[0], &params, Affine3A::IDENTITY).unwrap();
+    // Times the bob crosses x = 0 going the same way, linearly interpolated in a step.
+    let mut crossings = Vec::new();
+    let mut last_x = cloth.positions()[1].x;
+    let mut t = 0.0f32;
+    while crossings.len() < 11 && t < 60.0 {
+        cloth.step(DT, &gravity_only());
+        t += DT;
+        let x = cloth.positions()[1].x;
+        if last_x > 0.0 && x <= 0.0 {
+            crossings.push(t - DT * x / (x - last_x));
+        }
+        last_x = x;
+    }
+    assert_eq!(crossings.len(), 11, "the pendulum stopped swinging");
+    let period = (crossings[10] - crossings[0]) / 10.0;
+    let expected = 2.0 * std::f32::consts::PI * (length / G).sqrt() * (1.0 + angle * angle / 16.0);
+    let error = (period - expected).abs() / expected;
+    println!("period {period} s against {expected} s");
+    assert!(
+        error < 0.01,
+        "period {period} s, expected {expected} s ({:.3}% off)",
+        error * 100.0
+    );
+}
+
+#[test]
+fn the_energy_of_a_free_undamped_cloth_does_not_grow_over_ten_thousand_steps() {
+    // A free 8×8 cloth in zero gravity, every particle moved off its rest place (so
+    // every spring family starts stretched or compressed), no drag, no damping, no limit.
+    let params = ClothParams {
+        springs: SpringParams {
+            damping: 0.0,
+            ..SpringParams::from_structural(200.0)
+        },
+        ..xpbd(200.0, 1e-3, 20)
+    };
+    let shape = ClothShape::Grid {
+        width: 8,
+        height: 8,
+        spacing: 0.05,
+    };
+    let mut cloth = shape
+        .build_solver(&Pins::None, &params, Affine3A::IDENTITY)
+        .unwrap();
+    for (i, x) in cloth.particles_mut().position.iter_mut().enumerate() {
+        let offset = |axis| bevy_cloth::solver::unit_hash(i, axis) * 0.01;
+        *x += Vec3::new(offset(0), offset(1), offset(2));
+    }
+    let env = Environment {
+        gravity_enabled: false,
+        ..Environment::default()
+    };
+    let start = cloth.energy(&env).total();
+    assert!(start > 0.0);
+    let mut most = start;
+    for _ in 0..10_000 {
+        cloth.step(DT, &env);
+        most = most.max(cloth.energy(&env).total());
+    }
+    assert!(cloth.is_stable());
+    let end = cloth.energy(&env).total();
+    println!("energy {start} J at the start, at most {most} J, {end} J at the end");
+    assert!(
+        most <= start * 1.001,
+        "energy rose from {start} J to {most} J"
+    );
+}
