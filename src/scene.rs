@@ -372,12 +372,14 @@ fn set_by_path(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), 
     let field = target
         .reflect_path_mut(path)
         .map_err(|e| format!("no field `{path}`: {e}"))?;
+    // `inf` passes here (XPBD's inextensible springs); the parameters' validation
+    // refuses it wherever a finite value is needed, naming the field.
     let number = || {
         value
             .parse::<f32>()
             .ok()
-            .filter(|v| v.is_finite())
-            .ok_or_else(|| format!("`{value}` is not a finite number"))
+            .filter(|v| !v.is_nan() && *v != f32::NEG_INFINITY)
+            .ok_or_else(|| format!("`{value}` is not a number (or inf)"))
     };
     if let Some(f) = field.try_downcast_mut::<f32>() {
         *f = number()?;

@@ -24,7 +24,16 @@ use std::ops::Range;
 use bevy::math::Vec3;
 
 use super::parallel::{self, PIECE};
-use super::{Particles, Springs};
+use super::{Particles, SpringKind, Springs};
+
+/// The order families are projected in within a substep (see [`Constraints::new`]).
+const PROJECTION_ORDER: [SpringKind; 5] = [
+    SpringKind::Seam,
+    SpringKind::BendDiagonal,
+    SpringKind::Bend,
+    SpringKind::Shear,
+    SpringKind::Structural,
+];
 
 /// The constraints of a cloth's springs, grouped by colour.
 #[derive(Clone, Debug)]
@@ -34,10 +43,8 @@ pub(super) struct Constraints {
     /// Its particles, in the same order (copied so the projection reads one array).
     a: Vec<u32>,
     b: Vec<u32>,
-    /// Its family, in the same order.
-    kind: Vec<u8>,
-    /// The constraints of each colour.
-    colours: Vec<Range<usize>>,
+    /// The family and the constraints of each colour.
+    colours: Vec<(u8, Range<usize>)>,
     /// The springs this was built for (a new cloth or layout rebuilds it).
     pub built_for: usize,
     /// Corrections made in this substep, summed per particle (zero between substeps).
@@ -75,8 +82,11 @@ impl Family {
 }
 
 impl Constraints {
-    /// Colours the springs greedily (first fit, in their storage order: family by family,
-    /// by first particle), so no two springs of a colour share a particle.
+    /// Colours the springs greedily (first fit, by first particle) one family at a time,
+    /// so no two springs of a colour share a particle and every colour is of one family.
+    /// The families are projected in the order [`PROJECTION_ORDER`]: what is projected
+    /// last is met best after the one iteration, so the structural springs (and their
+    /// strain limit) come last, after the seams that pull against them.
     pub fn new(springs: &Springs, n: usize) -> Self {
         // Each particle's springs (CSR), to find the colours already taken around a spring.
         let mut start = vec![0u32; n + 1];
@@ -97,23 +107,29 @@ impl Constraints {
         }
         let mut colour = vec![u32::MAX; springs.len()];
         let mut taken: Vec<bool> = Vec::new();
+        let mut first = 0usize; // the family's first colour
         let mut count = 0usize;
-        for s in 0..springs.len() {
-            taken.iter_mut().for_each(|t| *t = false);
-            for p in [springs.a[s], springs.b[s]] {
-                let p = p as usize;
-                for &t in &incident[start[p] as usize..start[p + 1] as usize] {
-                    if let Some(slot) = taken.get_mut(colour[t as usize] as usize) {
-                        *slot = true;
+        for kind in PROJECTION_ORDER {
+            for s in springs.ranges[kind as usize].clone() {
+                taken.iter_mut().for_each(|t| *t = false);
+                for p in [springs.a[s], springs.b[s]] {
+                    let p = p as usize;
+                    for &t in &incident[start[p] as usize..start[p + 1] as usize] {
+                        let c = colour[t as usize] as usize;
+                        if let Some(slot) = c.checked_sub(first).and_then(|c| taken.get_mut(c)) {
+                            *slot = true;
+                        }
                     }
                 }
+                let c = taken.iter().position(|&t| !t).unwrap_or(taken.len());
+                if c == taken.len() {
+                    taken.push(false);
+                    count += 1;
+                }
+                colour[s] = (first + c) as u32;
             }
-            let c = taken.iter().position(|&t| !t).unwrap_or(taken.len());
-            if c == taken.len() {
-                taken.push(false);
-                count += 1;
-            }
-            colour[s] = c as u32;
+            first = count;
+            taken.clear();
         }
         // Constraints colour by colour, each colour in storage order.
         let mut order: Vec<u32> = (0..springs.len() as u32).collect();
@@ -122,16 +138,12 @@ impl Constraints {
         let mut from = 0;
         for c in 0..count as u32 {
             let to = from + order[from..].partition_point(|&s| colour[s as usize] == c);
-            colours.push(from..to);
+            colours.push((springs.kind(order[from] as usize) as u8, from..to));
             from = to;
         }
         let constraints = Self {
             a: order.iter().map(|&s| springs.a[s as usize]).collect(),
             b: order.iter().map(|&s| springs.b[s as usize]).collect(),
-            kind: order
-                .iter()
-                .map(|&s| springs.kind(s as usize) as u8)
-                .collect(),
             spring: order,
             colours,
             built_for: springs.len(),
@@ -145,7 +157,7 @@ impl Constraints {
     /// pieces write particles from several threads).
     pub fn colours_are_disjoint(&self, n: usize) -> bool {
         let mut seen = vec![usize::MAX; n];
-        for (c, range) in self.colours.iter().enumerate() {
+        for (c, (_, range)) in self.colours.iter().enumerate() {
             for k in range.clone() {
                 for p in [self.a[k], self.b[k]] {
                     if seen[p as usize] == c {
@@ -175,15 +187,17 @@ impl Constraints {
         let damped = families.iter().any(|f| f.on && f.damping > 0.0);
         let (x, dx) = (&mut p.position, &mut self.dx);
         let (previous, inv_mass) = (&p.previous, &p.inv_mass);
-        for range in &self.colours {
+        for (kind, range) in &self.colours {
+            let family = &families[*kind as usize];
+            if !family.on {
+                continue;
+            }
             let constraints = self.spring[range.clone()]
                 .iter()
-                .zip(&self.kind[range.clone()])
                 .zip(self.a[range.clone()].iter().zip(&self.b[range.clone()]));
-            for ((&s, &kind), (&a, &b)) in constraints {
+            for (&s, (&a, &b)) in constraints {
                 let (s, a, b) = (s as usize, a as usize, b as usize);
-                let family = &families[kind as usize];
-                if !family.on || !springs.alive[s] {
+                if !springs.alive[s] {
                     continue;
                 }
                 let (wa, wb) = (inv_mass[a], inv_mass[b]);

@@ -55,7 +55,7 @@ struct RunArgs {
     /// Steps to run.
     #[arg(long, default_value_t = 300)]
     steps: usize,
-    /// Replaces every cloth's model: mass-spring, shape-matching or patches.
+    /// Replaces every cloth's model: mass-spring, shape-matching, patches or xpbd.
     #[arg(long, value_parser = model_kind)]
     model: Option<ModelKind>,
     /// Overrides a scene field, e.g. `environment.wind.strength=0` (repeatable).
