@@ -850,16 +850,16 @@ fn a_symmetric_curtain_stays_symmetric() {
 
 /// A `width × height` grid 2 cm apart, hung from its top corners, default parameters.
 fn corner_hung_grid(width: u32, height: u32) -> ClothSolver {
+    corner_hung_grid_with(width, height, &ClothParams::default())
+}
+
+fn corner_hung_grid_with(width: u32, height: u32, params: &ClothParams) -> ClothSolver {
     ClothShape::Grid {
         width,
         height,
         spacing: 0.02,
     }
-    .build_solver(
-        &Pins::TopCorners,
-        &ClothParams::default(),
-        Affine3A::IDENTITY,
-    )
+    .build_solver(&Pins::TopCorners, params, Affine3A::IDENTITY)
     .unwrap()
 }
 
@@ -867,9 +867,21 @@ fn corner_hung_grid(width: u32, height: u32) -> ClothSolver {
 fn a_large_cloth_steps_to_the_same_bits_on_one_thread_and_on_the_pool() {
     // 256 × 256 = 65,536 particles: every kernel runs in pieces on the compute pool
     // (from 16,384), several pieces per thread. Wind, limiter on, top corners pinned.
+    // Mass-spring, and XPBD (its colours' pieces side by side).
+    let xpbd = ClothParams {
+        model: Model::Xpbd(XpbdParams::default()),
+        substeps: Substeps::Fixed(10),
+        ..ClothParams::default()
+    };
+    for params in [ClothParams::default(), xpbd] {
+        same_bits_on_one_thread_and_on_the_pool(&params);
+    }
+}
+
+fn same_bits_on_one_thread_and_on_the_pool(params: &ClothParams) {
     let run = |parallel: bool| {
         bevy_cloth::solver::set_parallel(parallel);
-        let mut cloth = corner_hung_grid(256, 256);
+        let mut cloth = corner_hung_grid_with(256, 256, params);
         let start = cloth.positions().to_vec();
         for _ in 0..20 {
             cloth.step(0.016, &Environment::default());
@@ -885,7 +897,13 @@ fn a_large_cloth_steps_to_the_same_bits_on_one_thread_and_on_the_pool() {
     };
     let (one, pool) = (run(false), run(true));
     let differ = one.iter().zip(&pool).filter(|(a, b)| a != b).count();
-    assert_eq!(differ, 0, "{differ} of {} particles differ", one.len());
+    let model = params.model.kind();
+    assert_eq!(
+        differ,
+        0,
+        "{model}: {differ} of {} particles differ",
+        one.len()
+    );
 }
 
 #[test]

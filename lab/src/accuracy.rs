@@ -23,6 +23,7 @@ use serde::Serialize;
 use bevy_cloth::error::ClothError;
 use bevy_cloth::params::{
     ClothParams, Integrator, Model, ModelKind, PatchParams, ShapeMatchingParams, Substeps,
+    XpbdParams,
 };
 use bevy_cloth::scene::ClothScene;
 
@@ -46,7 +47,7 @@ pub const REFERENCE_LIMITER_SWEEPS: u32 = 500;
 /// A configuration: a model with its knobs set.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Config {
-    /// `mass-spring`, `shape-matching` or `patches`.
+    /// `mass-spring`, `shape-matching`, `patches` or `xpbd`.
     pub model: &'static str,
     /// The knobs, e.g. `Verlet, 4 substeps`.
     pub label: String,
@@ -62,7 +63,8 @@ pub struct Config {
 /// matching with 1 and 4×4 clusters at stiffness k, 4k, 16k and 64k (k the structural
 /// spring stiffness: the pins hold a shape-matched cloth only through the fit, so a
 /// hanging cloth needs a stiff pull); patches of 1, 2, 4 and 8 particles square pulled
-/// at 3k.
+/// at 3k; XPBD (the same springs as constraints, the same strain limit) at 5, 10, 20,
+/// 40 and 80 substeps and automatic (its stretch-error target).
 pub fn configs(base: &ClothParams) -> Vec<Config> {
     let mut out = Vec::new();
     for integrator in Integrator::ALL {
@@ -143,6 +145,24 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
                     ..PatchParams::default()
                 }),
                 substeps: Substeps::default(),
+                ..*base
+            },
+        });
+    }
+    for substeps in [5, 10, 20, 40, 80]
+        .map(Substeps::Fixed)
+        .into_iter()
+        .chain([Substeps::default()])
+    {
+        out.push(Config {
+            model: ModelKind::Xpbd.name(),
+            label: match substeps {
+                Substeps::Fixed(n) => format!("{n} substeps"),
+                Substeps::Auto { .. } => "auto substeps".into(),
+            },
+            params: ClothParams {
+                model: Model::Xpbd(XpbdParams::default()),
+                substeps,
                 ..*base
             },
         });

@@ -195,7 +195,7 @@ impl ClothSolver {
             let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
             xpbd::Family::new(k, c, h, limit.filter(|_| limited))
         });
-        constraints.project(&mut self.particles, &self.springs, &families, h);
+        constraints.project(&mut self.particles, &families, h);
     }
 
     /// Keeps Verlet's implicit velocity `(x − x_prev)/h` when `h` changes by `ratio`.

@@ -331,6 +331,10 @@ impl ClothSolver {
         let auto = matches!(self.params.substeps, crate::params::Substeps::Auto { .. });
         self.prepare_model(auto && self.state_dependent_stiffness());
         self.sew();
+        if let ModelState::Xpbd(constraints) = &mut self.model {
+            // This step's seam lengths, torn springs, pins.
+            constraints.sync(&self.springs, &self.particles.inv_mass);
+        }
         if let (Model::Patches(patch), Some(patches)) =
             (self.params.model, self.model.patches_mut())
         {

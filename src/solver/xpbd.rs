@@ -43,8 +43,20 @@ pub(super) struct Constraints {
     /// Its particles, in the same order (copied so the projection reads one array).
     a: Vec<u32>,
     b: Vec<u32>,
-    /// The family and the constraints of each colour.
-    colours: Vec<(u8, Range<usize>)>,
+    /// Its rest length, synced once per step.
+    rest: Vec<f32>,
+    /// The inverse masses of its ends (0 for a torn spring), and `1/(w_a + w_b)` (0
+    /// when both are 0), synced once per step.
+    wa: Vec<f32>,
+    wb: Vec<f32>,
+    inv_w: Vec<f32>,
+    /// `1/((1 + γ) w + α̃)` of its family in the substep (0 when `w` is 0), computed
+    /// when the families' coefficients change ([`Self::project`]).
+    scale: Vec<f32>,
+    /// The coefficients `scale` was computed for.
+    scaled_for: Option<[Family; 5]>,
+    /// The colours, in projection order.
+    colours: Vec<Colour>,
     /// The springs this was built for (a new cloth or layout rebuilds it).
     pub built_for: usize,
     /// Corrections made in this substep, summed per particle (zero between substeps).
@@ -52,7 +64,7 @@ pub(super) struct Constraints {
 }
 
 /// What one family's constraints take in a substep.
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct Family {
     /// Whether its constraints act (the family is on with a stiffness > 0).
     pub on: bool,
@@ -87,6 +99,7 @@ impl Constraints {
     /// The families are projected in the order [`PROJECTION_ORDER`]: what is projected
     /// last is met best after the one iteration, so the structural springs (and their
     /// strain limit) come last, after the seams that pull against them.
+    /// Call [`Self::sync`] before projecting.
     pub fn new(springs: &Springs, n: usize) -> Self {
         // Each particle's springs (CSR), to find the colours already taken around a spring.
         let mut start = vec![0u32; n + 1];
@@ -141,9 +154,22 @@ impl Constraints {
             colours.push((springs.kind(order[from] as usize) as u8, from..to));
             from = to;
         }
+        let a: Vec<u32> = order.iter().map(|&s| springs.a[s as usize]).collect();
+        let b: Vec<u32> = order.iter().map(|&s| springs.b[s as usize]).collect();
+        let colours = colours
+            .into_iter()
+            .map(|(kind, range)| Colour::new(kind, range, &a, &b))
+            .collect();
+        let m = order.len();
         let constraints = Self {
-            a: order.iter().map(|&s| springs.a[s as usize]).collect(),
-            b: order.iter().map(|&s| springs.b[s as usize]).collect(),
+            rest: vec![0.0; m],
+            wa: vec![0.0; m],
+            wb: vec![0.0; m],
+            inv_w: vec![0.0; m],
+            scale: vec![0.0; m],
+            scaled_for: None,
+            a,
+            b,
             spring: order,
             colours,
             built_for: springs.len(),
@@ -153,12 +179,12 @@ impl Constraints {
         constraints
     }
 
-    /// Whether no two constraints of a colour share a particle (what lets a colour's
-    /// pieces write particles from several threads).
+    /// Whether no two constraints of a colour share a particle (what makes a colour's
+    /// result independent of the order and the thread its constraints are projected on).
     pub fn colours_are_disjoint(&self, n: usize) -> bool {
         let mut seen = vec![usize::MAX; n];
-        for (c, (_, range)) in self.colours.iter().enumerate() {
-            for k in range.clone() {
+        for (c, colour) in self.colours.iter().enumerate() {
+            for k in colour.pieces.iter().flat_map(Clone::clone) {
                 for p in [self.a[k], self.b[k]] {
                     if seen[p as usize] == c {
                         return false;
@@ -170,54 +196,96 @@ impl Constraints {
         true
     }
 
+    /// Takes the springs' rest lengths (seams change theirs while sewn), alive flags and
+    /// the particles' inverse masses (pins, mass edits); called once per step, before
+    /// its substeps.
+    pub fn sync(&mut self, springs: &Springs, inv_mass: &[f32]) {
+        let ends = self.spring.iter().zip(self.a.iter().zip(&self.b));
+        let out = self
+            .rest
+            .iter_mut()
+            .zip(self.wa.iter_mut().zip(&mut self.wb))
+            .zip(&mut self.inv_w);
+        for (((rest, (wa, wb)), inv_w), (&s, (&a, &b))) in out.zip(ends) {
+            let alive = f32::from(u8::from(springs.alive[s as usize]));
+            *rest = springs.rest_length[s as usize];
+            (*wa, *wb) = (inv_mass[a as usize] * alive, inv_mass[b as usize] * alive);
+            let w = *wa + *wb;
+            *inv_w = if w > 0.0 { 1.0 / w } else { 0.0 };
+        }
+        self.scaled_for = None;
+    }
+
+    /// Each constraint's `1/((1 + γ) w + α̃)` for `families`, unless already computed.
+    fn rescale(&mut self, families: &[Family; 5]) {
+        if self.scaled_for.as_ref() == Some(families) {
+            return;
+        }
+        for colour in &self.colours {
+            let f = families[colour.kind as usize];
+            for k in colour.pieces.iter().flat_map(Clone::clone) {
+                let w = self.wa[k] + self.wb[k];
+                let denominator = (1.0 + f.damping) * w + f.compliance;
+                self.scale[k] = if w > 0.0 { 1.0 / denominator } else { 0.0 };
+            }
+        }
+        self.scaled_for = Some(*families);
+    }
+
     /// Projects every constraint once, colour by colour, then gives each particle's
-    /// velocity its summed correction over `h`. `families` by [`SpringKind`]; the
-    /// springs' rest lengths and alive flags are read as they are now (seams sewing).
+    /// velocity its summed correction over `h`. `families` by [`SpringKind`].
     ///
-    /// One thread: the crate forbids `unsafe`, and a colour's constraints reach particles
-    /// all over the arrays, so its pieces cannot be handed out as disjoint slices. The
-    /// colours still make the result independent of the order within each.
-    pub fn project(
-        &mut self,
-        p: &mut Particles,
-        springs: &Springs,
-        families: &[Family; 5],
-        h: f32,
-    ) {
-        let damped = families.iter().any(|f| f.on && f.damping > 0.0);
-        let (x, dx) = (&mut p.position, &mut self.dx);
-        let (previous, inv_mass) = (&p.previous, &p.inv_mass);
-        for (kind, range) in &self.colours {
-            let family = &families[*kind as usize];
+    /// A colour's pieces (`PIECE` constraints each, sorted by first particle) reach the
+    /// particles between their first particle and their last: where those windows of
+    /// pieces two apart do not overlap (grids), the even pieces run side by side on the
+    /// compute pool, each on its own slice of the particles, then the odd ones; other
+    /// colours run on this thread. The same bits either way: a colour's constraints
+    /// share no particle.
+    pub fn project(&mut self, p: &mut Particles, families: &[Family; 5], h: f32) {
+        self.rescale(families);
+        let n = p.len();
+        let (x, dx) = (&mut p.position[..], &mut self.dx[..]);
+        let previous = &p.previous[..];
+        for colour in &self.colours {
+            let family = families[colour.kind as usize];
             if !family.on {
                 continue;
             }
-            let constraints = self.spring[range.clone()]
-                .iter()
-                .zip(self.a[range.clone()].iter().zip(&self.b[range.clone()]));
-            for (&s, (&a, &b)) in constraints {
-                let (s, a, b) = (s as usize, a as usize, b as usize);
-                if !springs.alive[s] {
-                    continue;
+            let damped = family.damping > 0.0;
+            let piece = |k: usize| {
+                let range = colour.pieces[k].clone();
+                Piece {
+                    a: &self.a[range.clone()],
+                    b: &self.b[range.clone()],
+                    rest: &self.rest[range.clone()],
+                    wa: &self.wa[range.clone()],
+                    wb: &self.wb[range.clone()],
+                    inv_w: &self.inv_w[range.clone()],
+                    scale: &self.scale[range],
                 }
-                let (wa, wb) = (inv_mass[a], inv_mass[b]);
-                let relative = || (x[b] - previous[b]) - (x[a] - previous[a]);
-                let d = x[b] - x[a];
-                let rest = springs.rest_length[s];
-                let Some(lambda) = family.multiplier(d, rest, wa + wb, damped.then(relative))
-                else {
-                    continue;
+            };
+            if !colour.windowed || colour.pieces.len() < 2 {
+                for k in 0..colour.pieces.len() {
+                    project_piece(piece(k), (&mut *x, &mut *dx, 0), previous, family, damped);
+                }
+                continue;
+            }
+            for parity in 0..2 {
+                let windows = Windows {
+                    x: &mut *x,
+                    dx: &mut *dx,
+                    at: 0,
+                    bounds: &colour.windows,
+                    next: parity,
                 };
-                let normal = d.normalize();
-                let (ca, cb) = (normal * (wa * lambda), normal * (wb * lambda));
-                x[a] -= ca;
-                x[b] += cb;
-                dx[a] -= ca;
-                dx[b] += cb;
+                let pieces = windows.map(|(k, x, dx, offset)| (piece(k), x, dx, offset));
+                parallel::for_each(n, pieces, |(piece, x, dx, offset)| {
+                    project_piece(piece, (x, dx, offset), previous, family, damped);
+                });
             }
         }
-        let pieces = p.velocity.chunks_mut(PIECE).zip(dx.chunks_mut(PIECE));
-        parallel::for_each(p.position.len(), pieces, |(velocity, dx)| {
+        let pieces = p.velocity.chunks_mut(PIECE).zip(self.dx.chunks_mut(PIECE));
+        parallel::for_each(n, pieces, |(velocity, dx)| {
             for (v, d) in velocity.iter_mut().zip(dx) {
                 *v += *d / h;
                 *d = Vec3::ZERO;
@@ -226,31 +294,134 @@ impl Constraints {
     }
 }
 
-impl Family {
-    /// The multiplier change `Δλ` of a constraint along `d = x_b − x_a` of rest length
-    /// `rest`, summed inverse mass `w`, and (when damped) relative motion this substep
-    /// (module doc); `None` when it cannot act (both ends held, or no direction).
-    #[inline(always)]
-    fn multiplier(&self, d: Vec3, rest: f32, w: f32, relative: Option<Vec3>) -> Option<f32> {
+/// One colour: its family, its pieces of constraints, and the particles each piece
+/// reaches.
+#[derive(Clone, Debug)]
+struct Colour {
+    kind: u8,
+    /// Constraint ranges of `PIECE` (the last shorter).
+    pieces: Vec<Range<usize>>,
+    /// For each piece, the first and last particle it reaches.
+    windows: Vec<(usize, usize)>,
+    /// Whether the windows of pieces two apart never overlap (each parity's pieces can
+    /// then have disjoint slices of the particles).
+    windowed: bool,
+}
+
+impl Colour {
+    fn new(kind: u8, range: Range<usize>, a: &[u32], b: &[u32]) -> Self {
+        let pieces: Vec<Range<usize>> = range
+            .clone()
+            .step_by(PIECE)
+            .map(|from| from..(from + PIECE).min(range.end))
+            .collect();
+        let windows: Vec<(usize, usize)> = pieces
+            .iter()
+            .map(|r| {
+                let ends = a[r.clone()]
+                    .iter()
+                    .chain(&b[r.clone()])
+                    .map(|&i| i as usize);
+                let lo = ends.clone().min().unwrap_or(0);
+                (lo, ends.max().unwrap_or(0))
+            })
+            .collect();
+        let windowed = windows
+            .windows(3)
+            .all(|w| w[0].1 < w[2].0 && w[0].0 <= w[2].0);
+        Self {
+            kind,
+            pieces,
+            windows,
+            windowed,
+        }
+    }
+}
+
+/// The pieces of one parity in order, each with its own slice of the particles
+/// (`x[lo..=hi]`, `dx[lo..=hi]`) and `lo`.
+struct Windows<'a, 'w> {
+    x: &'a mut [Vec3],
+    dx: &'a mut [Vec3],
+    /// The particle index `x[0]` is.
+    at: usize,
+    bounds: &'w [(usize, usize)],
+    next: usize,
+}
+
+impl<'a> Iterator for Windows<'a, '_> {
+    type Item = (usize, &'a mut [Vec3], &'a mut [Vec3], usize);
+
+    fn next(&mut self) -> Option<Self::Item> {
+        let k = self.next;
+        let &(lo, hi) = self.bounds.get(k)?;
+        self.next += 2;
+        let x = std::mem::take(&mut self.x);
+        let dx = std::mem::take(&mut self.dx);
+        let (x, dx) = (&mut x[lo - self.at..], &mut dx[lo - self.at..]);
+        let (window, x) = x.split_at_mut(hi + 1 - lo);
+        let (window_dx, dx) = dx.split_at_mut(hi + 1 - lo);
+        (self.x, self.dx, self.at) = (x, dx, hi + 1);
+        Some((k, window, window_dx, lo))
+    }
+}
+
+/// One piece of a colour's constraints (see [`Constraints`]).
+#[derive(Clone, Copy)]
+struct Piece<'a> {
+    a: &'a [u32],
+    b: &'a [u32],
+    rest: &'a [f32],
+    wa: &'a [f32],
+    wb: &'a [f32],
+    inv_w: &'a [f32],
+    scale: &'a [f32],
+}
+
+/// Projects a piece's constraints (module doc) on positions and summed corrections
+/// `x`, `dx` that start at particle `offset`; `previous`: all positions at the start of
+/// the substep.
+#[inline(always)]
+fn project_piece(
+    piece: Piece<'_>,
+    (x, dx, offset): (&mut [Vec3], &mut [Vec3], usize),
+    previous: &[Vec3],
+    family: Family,
+    damped: bool,
+) {
+    let (gamma, max_stretch) = (family.damping, family.max_stretch);
+    let constraints = piece
+        .a
+        .iter()
+        .zip(piece.b)
+        .zip(piece.rest.iter().zip(piece.scale))
+        .zip(piece.wa.iter().zip(piece.wb).zip(piece.inv_w));
+    for (((&a, &b), (&rest, &scale)), ((&wa, &wb), &inv_w)) in constraints {
+        let (a, b) = (a as usize, b as usize);
+        let (la, lb) = (a - offset, b - offset);
+        let d = x[lb] - x[la];
         let len = d.length();
-        if w == 0.0 || len <= f32::EPSILON * rest.max(1.0) {
-            return None;
-        }
-        let c = len - rest;
-        let mut lambda = match relative {
-            Some(relative) if self.damping > 0.0 => {
-                let gamma = self.damping;
-                let along = d.dot(relative) / len;
-                (-c - gamma * along) / ((1.0 + gamma) * w + self.compliance)
-            }
-            _ => -c / (w + self.compliance),
+        // No direction to push along (coincident ends): nothing.
+        let inv_len = if len > f32::EPSILON * rest.max(1.0) {
+            1.0 / len
+        } else {
+            0.0
         };
-        // The strain limit: what the compliant step leaves past `(1 + limit)·l0`.
-        let max = self.max_stretch * rest;
-        let after = len + w * lambda;
-        if after > max {
-            lambda += (max - after) / w;
-        }
-        Some(lambda)
+        let c = len - rest;
+        let lambda = if damped {
+            let relative = (x[lb] - previous[b]) - (x[la] - previous[a]);
+            (-c - gamma * d.dot(relative) * inv_len) * scale
+        } else {
+            -c * scale
+        };
+        // The strain limit: no longer than `max_stretch · l0` after the step (`inf` for a
+        // family without one: nothing). A held or torn constraint has `w = 0`: no move.
+        let lambda = lambda.min((max_stretch * rest - len) * inv_w);
+        let correction = d * (lambda * inv_len);
+        let (ca, cb) = (correction * wa, correction * wb);
+        x[la] -= ca;
+        x[lb] += cb;
+        dx[la] -= ca;
+        dx[lb] += cb;
     }
 }

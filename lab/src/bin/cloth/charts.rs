@@ -244,7 +244,7 @@ impl Chart for Bench<'_> {
 
 // ----- accuracy -----------------------------------------------------------------------
 
-const ACCURACY_MODELS: [&str; 3] = bevy_cloth_lab::stability::MODELS;
+const ACCURACY_MODELS: [&str; 4] = bevy_cloth_lab::stability::MODELS;
 
 /// `docs/accuracy.png`: one panel per scene, cost (ms per simulated second) against
 /// error, log-log; circles mass-spring, triangles shape matching, squares patches; the
@@ -375,7 +375,7 @@ impl Chart for Accuracy<'_> {
 /// hit their cap (8192; a cross on it when it also failed). The line is the explicit
 /// bound `ω_max·h = 2` with `ω_max = factor·√(k/m)`, `factors` per model as in
 /// [`MODELS`].
-pub fn stability(png: &Path, cells: &[Cell], factors: &[f32; 3]) -> Result<()> {
+pub fn stability(png: &Path, cells: &[Cell], factors: &[f32; 4]) -> Result<()> {
     let columns = [
         (Integrator::Verlet, false, "Verlet, 1 substep"),
         (Integrator::SemiImplicitEuler, false, "Euler, 1 substep"),
@@ -403,7 +403,7 @@ pub fn stability(png: &Path, cells: &[Cell], factors: &[f32; 3]) -> Result<()> {
     let title = "Linear regime: stable (green), failed (red ×), over the substep cap (orange); line: ω_max·h = 2";
     both(
         png,
-        (1500, 1050),
+        (1500, 1400),
         &Stability {
             title,
             panels: &panels,
@@ -432,7 +432,7 @@ pub fn stability_nonlinear(png: &Path, cells: &[Cell]) -> Result<()> {
     let title = "Nonlinear regimes, Verlet, automatic substeps: stable (green), failed (red ×), over the substep cap (orange)";
     both(
         png,
-        (2600, 1000),
+        (2900, 1000),
         &Stability {
             title,
             panels: &panels,

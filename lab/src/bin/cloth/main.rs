@@ -828,7 +828,9 @@ fn stability(args: StabilityArgs) -> Result<(), String> {
             thresholds.push(stability::lattice(k, m, integrator).map_err(|e| e.to_string())?);
         }
     }
-    let factors = [stability::lattice_factor(), 1.0, 1.0];
+    // XPBD's panel shows the mass-spring lattice's explicit bound, which it ignores.
+    let lattice = stability::lattice_factor();
+    let factors = [lattice, 1.0, 1.0, lattice];
     if let Some(chart) = &args.output.chart {
         charts::stability(chart, &cells, &factors)?;
         let stem = chart
