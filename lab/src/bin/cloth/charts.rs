@@ -9,17 +9,18 @@ use bevy_cloth::prelude::Integrator;
 use bevy_cloth_lab::accuracy::Row;
 use bevy_cloth_lab::fps::{AppFrame, SEED_002_FPS};
 use bevy_cloth_lab::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
-use bevy_cloth_lab::{BenchCell, SEED_COUNTS, SEED_MODELS, SEED_MS};
+use bevy_cloth_lab::{BENCH_MODELS, BenchCell, SEED_COUNTS, SEED_MS};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 const FONT: &str = "sans-serif";
-const PALETTE: [RGBColor; 5] = [
+const PALETTE: [RGBColor; 6] = [
     RGBColor(200, 40, 40),
     RGBColor(30, 100, 200),
     RGBColor(30, 150, 60),
     RGBColor(210, 130, 0),
     RGBColor(130, 50, 170),
+    RGBColor(0, 160, 170),
 ];
 
 type Result<T> = std::result::Result<T, String>;
@@ -170,8 +171,9 @@ impl Chart for Bench<'_> {
             "3a patches 2×2",
             "3b patches 4×4",
             "3c patches 8×8",
+            "x XPBD (auto substeps)",
         ];
-        for (m, model) in SEED_MODELS.iter().enumerate() {
+        for (m, model) in BENCH_MODELS.iter().enumerate() {
             let color = PALETTE[m];
             let ours: Vec<(f64, f64)> = cells
                 .iter()
@@ -193,7 +195,7 @@ impl Chart for Bench<'_> {
             // The seed's zeros (under its 1 ms resolution) have no place on a log axis.
             let seed = SEED_COUNTS
                 .iter()
-                .zip(SEED_MS[m])
+                .zip(SEED_MS.get(m).copied().unwrap_or_default())
                 .filter(|(_, ms)| *ms > 0.0)
                 .map(|(&c, ms)| TriangleMarker::new((c as f64, ms), 6, color.stroke_width(2)));
             let series = chart.draw_series(seed).map_err(err)?;

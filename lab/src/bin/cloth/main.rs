@@ -23,7 +23,7 @@ use bevy_cloth_lab::fps::{self, APP_COUNTS};
 use bevy_cloth_lab::stability::{
     self, MASS, MODELS, NONLINEAR_MODELS, NONLINEAR_TIMESTEP, Regime, STIFFNESS, TIMESTEP,
 };
-use bevy_cloth_lab::{self as measure, BenchCell, SEED_COUNTS, SEED_MODELS, SceneRun};
+use bevy_cloth_lab::{self as measure, BENCH_MODELS, BenchCell, SEED_COUNTS, SceneRun};
 
 /// Headless runs and measurements of bevy_cloth.
 #[derive(Parser)]
@@ -88,7 +88,7 @@ struct BenchArgs {
     /// The largest particle count.
     #[arg(long, default_value_t = 65_536)]
     max: usize,
-    /// Slika 23's models, comma separated (all when absent).
+    /// Slika 23's models and `x` (XPBD), comma separated (all when absent).
     #[arg(long, value_delimiter = ',', value_parser = seed_model)]
     models: Vec<&'static str>,
     /// Timed steps per cell (5 from 16,384 particles up).
@@ -190,7 +190,7 @@ fn one_of(text: &str, known: &[&'static str], what: &str) -> Result<&'static str
 }
 
 fn seed_model(text: &str) -> Result<&'static str, String> {
-    one_of(text, &SEED_MODELS, "model")
+    one_of(text, &BENCH_MODELS, "model")
 }
 
 fn stability_model(text: &str) -> Result<&'static str, String> {
@@ -460,9 +460,9 @@ fn print_kernels(kernels: &[bevy_cloth_lab::KernelCosts]) {
 
 fn bench(args: BenchArgs) -> Result<(), String> {
     let (max, repeats) = (args.max, args.repeats);
-    let models = or_all(args.models, &SEED_MODELS);
+    let models = or_all(args.models, &BENCH_MODELS);
     let with_app = args.app || !args.app_models.is_empty();
-    let app_models = or_all(args.app_models, &SEED_MODELS);
+    let app_models = or_all(args.app_models, &BENCH_MODELS);
     let counts: Vec<usize> = SEED_COUNTS.into_iter().filter(|&c| c <= max).collect();
     // The bare kernel first, in this run: the ratios below are to it.
     let bare: Vec<f64> = counts
