@@ -177,3 +177,43 @@ fn one_model_identifier_reads_back_what_it_writes() {
         Err(ClothError::UnknownModel { .. })
     ));
 }
+
+#[test]
+fn xpbd_reads_from_scene_files_and_overrides_and_only_it_takes_an_infinite_stiffness() {
+    let text = "(cloths: [(cloth: (shape: Grid(width: 4, height: 4, spacing: 0.1), params: (\n  model: Xpbd((max_stretch_error: 0.005)),\n  springs: (structural: (enabled: true, stiffness: inf)),\n)))])";
+    let scene = parse(text).unwrap();
+    let params = scene.cloths[0].cloth.params;
+    assert_eq!(
+        params.model,
+        Model::Xpbd(XpbdParams {
+            max_stretch_error: 0.005
+        })
+    );
+    assert_eq!(params.springs.structural.stiffness, f32::INFINITY);
+    // The explicit models refuse it, naming the field and line.
+    let explicit = text.replace(
+        "model: Xpbd((max_stretch_error: 0.005)),",
+        "model: MassSpring,",
+    );
+    match parse(&explicit).unwrap_err() {
+        SceneError::Invalid { field, line, .. } => {
+            assert_eq!(field, "cloths[0].cloth.params.springs.structural.stiffness");
+            assert_eq!(line, 3);
+        }
+        other => panic!("{other:?}"),
+    }
+    let mut curtain = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    curtain.apply_override("cloth.params.model=Xpbd").unwrap();
+    curtain
+        .apply_override("cloth.params.springs.structural.stiffness=inf")
+        .unwrap();
+    assert!(matches!(
+        curtain.cloths[0].cloth.params.model,
+        Model::Xpbd(_)
+    ));
+    let mut explicit = ClothScene::load("assets/scenes/curtain.ron").unwrap();
+    let e = explicit
+        .apply_override("cloth.params.springs.structural.stiffness=inf")
+        .unwrap_err();
+    assert!(matches!(e, SceneError::Override { .. }), "{e}");
+}

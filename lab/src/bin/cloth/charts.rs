@@ -352,15 +352,21 @@ impl Chart for Accuracy<'_> {
                         0 => chart.draw_series(points.iter().map(|&p| Circle::new(p, 5, style))),
                         1 => chart
                             .draw_series(points.iter().map(|&p| TriangleMarker::new(p, 7, style))),
-                        _ => chart.draw_series(points.iter().map(|&p| {
+                        2 => chart.draw_series(points.iter().map(|&p| {
                             EmptyElement::at(p) + Rectangle::new([(-5, -5), (5, 5)], style)
                         })),
+                        _ => chart.draw_series(
+                            points
+                                .iter()
+                                .map(|&p| Cross::new(p, 6, color.stroke_width(3))),
+                        ),
                     }
                     .map_err(err)?;
                 anno.label(*model).legend(move |(x, y)| match m {
                     0 => Circle::new((x + 10, y), 5, style).into_dyn(),
                     1 => TriangleMarker::new((x + 10, y), 7, style).into_dyn(),
-                    _ => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
+                    2 => Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], style).into_dyn(),
+                    _ => Cross::new((x + 10, y), 6, color.stroke_width(3)).into_dyn(),
                 });
             }
             legend(&mut chart, SeriesLabelPosition::LowerLeft, 14)?;
