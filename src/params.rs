@@ -706,16 +706,54 @@ impl Wind {
     /// Wind force on a particle at `position` at simulated time `time`.
     #[inline]
     pub fn force_at(&self, position: Vec3, time: f32) -> Vec3 {
+        self.at_time(time).force_at(position)
+    }
+
+    /// The wind at simulated time `time`, with what does not depend on position worked
+    /// out once (the direction, the side, the gust's phase): the force loops call
+    /// [`WindAt::force_at`] per particle.
+    #[inline]
+    pub fn at_time(&self, time: f32) -> WindAt {
         let d = self.direction.normalize_or_zero();
+        let side = Vec3::Y.cross(d).normalize_or(Vec3::X);
+        let phase = 10.0 * time;
+        WindAt {
+            field: self.field,
+            strength: self.strength,
+            direction: d,
+            side,
+            phase,
+            across: phase.sin(),
+        }
+    }
+}
+
+/// [`Wind`] at one moment (see [`Wind::at_time`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WindAt {
+    field: WindField,
+    strength: f32,
+    /// The normalised direction.
+    direction: Vec3,
+    /// The horizontal direction across it.
+    side: Vec3,
+    /// `10 t`.
+    phase: f32,
+    /// `sin(10 t)`.
+    across: f32,
+}
+
+impl WindAt {
+    /// Wind force on a particle at `position`.
+    #[inline]
+    pub fn force_at(&self, position: Vec3) -> Vec3 {
+        let d = self.direction;
         match self.field {
             WindField::Constant => d * self.strength,
+            // Seed 002 listing 3.3, rotated so that the listing's +z is `d`.
             WindField::Trigonometric => {
-                // Seed 002 listing 3.3, rotated so that the listing's +z is `d`.
-                let side = Vec3::Y.cross(d).normalize_or(Vec3::X);
-                let phase = 10.0 * time;
-                let along = (position.dot(d) + phase).sin().abs();
-                let across = phase.sin();
-                self.strength * (along * d + across * side)
+                let along = (position.dot(d) + self.phase).sin().abs();
+                self.strength * (along * d + self.across * self.side)
             }
         }
     }

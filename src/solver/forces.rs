@@ -24,9 +24,9 @@ impl ClothSolver {
             env.effective_gravity()
         };
         let drag = self.params.drag;
-        let time = self.time;
-        let wind = env.wind;
-        let has_wind = !held && wind.strength > 0.0 && wind.direction != bevy::math::Vec3::ZERO;
+        let has_wind =
+            !held && env.wind.strength > 0.0 && env.wind.direction != bevy::math::Vec3::ZERO;
+        let wind = env.wind.at_time(self.time);
         let p = &mut self.particles;
         let pieces = p.force.chunks_mut(PIECE).zip(
             p.mass
@@ -44,7 +44,7 @@ impl ClothSolver {
                 for (f, ((&mass, &lump), (&v, &x))) in particles {
                     *f = mass * g - drag * lump * v;
                     if has_wind {
-                        *f += wind.force_at(x, time) * lump;
+                        *f += wind.force_at(x) * lump;
                     }
                 }
             },
