@@ -450,7 +450,10 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
         }
     });
     optional(ui, "strain limit", &mut p.strain_limit, 0.1, 0.01..=1.0);
-    ui.add(egui::Slider::new(&mut p.strain_limit_iterations, 0..=16).text("limit sweeps"));
+    // XPBD applies the limit inside its one projection per substep: no sweeps to set.
+    if !matches!(p.model, Model::Xpbd(_)) {
+        ui.add(egui::Slider::new(&mut p.strain_limit_iterations, 0..=16).text("limit sweeps"));
+    }
     optional(ui, "tear ratio", &mut p.tear_ratio, 2.0, 1.05..=10.0);
 }
 
