@@ -7,12 +7,20 @@ use bevy_cloth::solver::ClothSolver;
 const DT: f32 = 0.016;
 
 fn curtain() -> ClothSolver {
+    curtain_of(Model::MassSpring)
+}
+
+fn curtain_of(model: Model) -> ClothSolver {
+    let params = ClothParams {
+        model,
+        ..ClothParams::default()
+    };
     ClothShape::Grid {
         width: 10,
         height: 8,
         spacing: 0.1,
     }
-    .build_solver(&Pins::TopRow, &ClothParams::default(), Affine3A::IDENTITY)
+    .build_solver(&Pins::TopRow, &params, Affine3A::IDENTITY)
     .unwrap()
 }
 
@@ -37,7 +45,14 @@ fn picking_finds_the_particle_under_the_ray() {
 
 #[test]
 fn a_grabbed_particle_follows_the_target_and_pulls_the_cloth() {
-    let mut cloth = curtain();
+    // Mass-spring, and XPBD (its constraints hold the grabbed particle as a pin).
+    for model in [Model::MassSpring, Model::Xpbd(XpbdParams::default())] {
+        grabbed_particle_follows_and_pulls(model);
+    }
+}
+
+fn grabbed_particle_follows_and_pulls(model: Model) {
+    let mut cloth = curtain_of(model);
     let env = Environment::default();
     for _ in 0..60 {
         cloth.step(DT, &env);

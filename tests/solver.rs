@@ -274,8 +274,9 @@ fn damped_cloth_comes_to_rest() {
     assert!(lowest < 1.0 - 0.5, "lowest point {lowest}");
 }
 
-fn tear_test_cloth(tear_ratio: f32, gravity: f32) -> (ClothSolver, Environment) {
+fn tear_test_cloth(model: Model, tear_ratio: f32, gravity: f32) -> (ClothSolver, Environment) {
     let params = ClothParams {
+        model,
         tear_ratio: Some(tear_ratio),
         drag: 1e-3,
         ..conservative(Integrator::Verlet)
@@ -296,8 +297,15 @@ fn tear_test_cloth(tear_ratio: f32, gravity: f32) -> (ClothSolver, Environment) 
 
 #[test]
 fn cloth_tears_past_its_ratio_and_not_below() {
+    // Mass-spring, and XPBD's constraints (a torn one stops acting from the next step).
+    for model in [Model::MassSpring, Model::Xpbd(XpbdParams::default())] {
+        tears_past_its_ratio_and_not_below(model);
+    }
+}
+
+fn tears_past_its_ratio_and_not_below(model: Model) {
     // Under normal gravity the top springs stretch by m g (rows below) / k ≈ 5%.
-    let (mut calm, env) = tear_test_cloth(1.5, 9.81);
+    let (mut calm, env) = tear_test_cloth(model, 1.5, 9.81);
     for _ in 0..300 {
         calm.step(DT, &env);
     }
@@ -305,7 +313,7 @@ fn cloth_tears_past_its_ratio_and_not_below() {
     assert!(calm.triangle_visible().iter().all(|v| *v));
 
     // Under 200 g the same springs would stretch by ~1000%: they tear, faces hide.
-    let (mut pulled, env) = tear_test_cloth(1.5, 200.0 * 9.81);
+    let (mut pulled, env) = tear_test_cloth(model, 1.5, 200.0 * 9.81);
     let mut torn = Vec::new();
     for _ in 0..300 {
         let n = pulled.begin_step(DT);
@@ -321,7 +329,7 @@ fn cloth_tears_past_its_ratio_and_not_below() {
         pulled.triangle_visible().iter().any(|v| !*v),
         "no face was hidden"
     );
-    assert!(pulled.is_finite());
+    assert!(pulled.is_finite(), "{}", model.kind());
 }
 
 /// Seed 002's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
