@@ -46,7 +46,7 @@ pub mod stats;
 pub mod prelude {
     pub use crate::ecs::components::{
         Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation,
-        ClothStats, ClothTorn, ColliderKind, StatSample,
+        ClothSleep, ClothStats, ClothTorn, ClothWake, ColliderKind, StatSample,
     };
     pub use crate::ecs::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::ecs::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};

@@ -172,6 +172,7 @@ fn panel(
         Option<&mut ClothLook>,
         Option<&ClothInvalid>,
         Option<&ClothSimulation>,
+        Option<&mut ClothSleep>,
     )>,
     mut env: ResMut<ClothEnvironment>,
     mut pause: ResMut<ClothPause>,
@@ -217,7 +218,7 @@ fn panel(
                     time.set_timestep_seconds(step_ms as f64 / 1e3);
                 }
                 let step_ms = time.timestep().as_secs_f32() * 1e3;
-                for (n, (entity, name, mut cloth, stats, look, invalid, sim)) in
+                for (n, (entity, name, mut cloth, stats, look, invalid, sim, sleep)) in
                     cloths.iter_mut().enumerate()
                 {
                     ui.separator();
@@ -237,6 +238,13 @@ fn panel(
                             cloth_controls(ui, &mut edited);
                             if edited != *cloth {
                                 *cloth = edited;
+                            }
+                            if let Some(mut sleep) = sleep {
+                                let mut enabled = sleep.enabled;
+                                ui.checkbox(&mut enabled, "may sleep when still (1 mm/s for 1 s)");
+                                if enabled != sleep.enabled {
+                                    sleep.enabled = enabled;
+                                }
                             }
                             if let Some(mut look) = look {
                                 let mut edited = look.clone();
@@ -595,6 +603,10 @@ fn statistics(ui: &mut egui::Ui, stats: &ClothStats, step_ms: f32) {
                 ""
             };
             row("substeps", format!("{}{warn}", stats.substeps));
+            row(
+                "asleep",
+                if stats.asleep { "yes (no step)" } else { "no" }.to_string(),
+            );
             row("max strain", format!("{:.1} %", stats.max_strain * 100.0));
             row("total energy", format!("{:.4} J", stats.energy.total()));
         });

@@ -24,7 +24,7 @@ use crate::solver;
 /// ```
 #[derive(Component, Clone, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
 #[reflect(Component, Default)]
-#[require(Transform, Visibility)]
+#[require(Transform, Visibility, ClothSleep)]
 #[serde(default, deny_unknown_fields)]
 pub struct Cloth {
     /// The initial layout.
@@ -373,6 +373,9 @@ pub struct ClothStats {
     pub substeps: u32,
     /// True when automatic substeps hit their cap: the step may be unstable.
     pub under_resolved: bool,
+    /// True while the cloth sleeps (see [`ClothSleep`]): the other values are those of
+    /// its last step.
+    pub asleep: bool,
     /// Median step time over the last second of wall-clock steps, ms.
     pub step_ms_median: f32,
     /// Largest structural strain.
@@ -424,6 +427,75 @@ impl ClothStats {
         self.step_ms_median = crate::stats::median(&mut self.scratch);
     }
 }
+
+/// Sleeping (issue 16): a cloth whose every free particle moves slower than `speed` for
+/// `after` seconds falls asleep: its step is skipped and its mesh not rewritten. It wakes
+/// within one step on anything that can move it: an edit of its parameters, a change of
+/// gravity or wind (`ClothEnvironment`), its transform moving (the pins), a collider
+/// changing within reach of it, a grab, drag, release, cut or reset (anything that calls
+/// the solver's mutating tools), or a [`ClothWake`] message from the game. Required by
+/// [`Cloth`]; `enabled: false` keeps a cloth always awake.
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Component, Default)]
+pub struct ClothSleep {
+    /// Whether this cloth may fall asleep.
+    pub enabled: bool,
+    /// The speed below which a particle counts as still, m/s.
+    pub speed: f32,
+    /// How long every particle must stay still before the cloth sleeps, s.
+    pub after: f32,
+    /// Whether it sleeps now (set by the plugin).
+    pub asleep: bool,
+    /// Simulated seconds it has been still (set by the plugin).
+    pub still_for: f32,
+}
+
+impl Default for ClothSleep {
+    /// 1 mm/s for 1 s.
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            speed: 1e-3,
+            after: 1.0,
+            asleep: false,
+            still_for: 0.0,
+        }
+    }
+}
+
+impl ClothSleep {
+    /// A cloth that never sleeps.
+    pub fn never() -> Self {
+        Self {
+            enabled: false,
+            ..Self::default()
+        }
+    }
+
+    /// Wakes it (and restarts the stillness count).
+    pub fn wake(&mut self) {
+        self.asleep = false;
+        self.still_for = 0.0;
+    }
+
+    /// Counts a step of `dt` in which the fastest particle moved at `speed`; falls asleep
+    /// once still for long enough. Returns whether it is asleep.
+    pub fn observe(&mut self, speed: f32, dt: f32) -> bool {
+        // A NaN speed counts as moving.
+        let still = speed < self.speed;
+        if !self.enabled || !still {
+            self.wake();
+            return false;
+        }
+        self.still_for += dt;
+        self.asleep = self.still_for >= self.after;
+        self.asleep
+    }
+}
+
+/// Wakes a sleeping cloth (see [`ClothSleep`]): the game's own reason to move it.
+#[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ClothWake(pub Entity);
 
 /// Sent when a spring tears, once per spring.
 #[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]

@@ -25,8 +25,8 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
 use crate::ecs::components::{
-    Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothStats,
-    ClothTorn,
+    Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothSleep,
+    ClothStats, ClothTorn, ClothWake,
 };
 use crate::ecs::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::error::ClothError;
@@ -155,6 +155,8 @@ impl Plugin for ClothPlugin {
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
             .add_message::<ClothTorn>()
+            .add_message::<ClothWake>()
+            .register_type::<ClothSleep>()
             .init_asset::<Garment>()
             .register_asset_loader(GarmentLoader)
             .add_systems(Update, watch_garments);
@@ -190,7 +192,7 @@ impl Plugin for ClothPlugin {
         .add_systems(
             self.schedule,
             (
-                (build_cloths, place_colliders, begin_steps)
+                (build_cloths, place_colliders, wake_cloths, begin_steps)
                     .chain()
                     .in_set(ClothSystems::Prepare),
                 run_substeps.in_set(ClothSystems::Substeps),
@@ -473,13 +475,51 @@ struct StepProgress {
     elapsed: Duration,
 }
 
+/// Wakes the sleeping cloths that something may move (see [`ClothSleep`]): the solver's
+/// own record of outside changes (parameters, frame, colliders within reach, tools), a
+/// change of gravity or wind, a [`ClothWake`] message, or sleeping switched off.
+fn wake_cloths(
+    env: Res<ClothEnvironment>,
+    mut last_env: Local<Option<Environment>>,
+    mut messages: MessageReader<ClothWake>,
+    mut cloths: Query<(
+        Entity,
+        &mut ClothSimulation,
+        &mut ClothSleep,
+        Option<&mut ClothStats>,
+    )>,
+) {
+    let env_changed = last_env.is_some_and(|last| last != **env);
+    *last_env = Some(**env);
+    let woken: Vec<Entity> = messages.read().map(|m| m.0).collect();
+    for (entity, mut sim, mut sleep, stats) in &mut cloths {
+        // Read by every step, so a disturbance is never left over for later.
+        let disturbed = sim.bypass_change_detection().solver.take_disturbed();
+        if !sleep.asleep {
+            continue;
+        }
+        if disturbed || env_changed || !sleep.enabled || woken.contains(&entity) {
+            sleep.wake();
+            if let Some(mut stats) = stats {
+                stats.asleep = false;
+            }
+        }
+    }
+}
+
+#[allow(clippy::type_complexity)]
 fn begin_steps(
     mut commands: Commands,
     time: Res<Time>,
     mut pause: ResMut<ClothPause>,
     mut plan: ResMut<ClothSubstepPlan>,
     mut cloths: Query<
-        (Entity, &mut ClothSimulation, Option<&mut StepProgress>),
+        (
+            Entity,
+            &mut ClothSimulation,
+            Option<&mut StepProgress>,
+            Option<&ClothSleep>,
+        ),
         Without<ClothInvalid>,
     >,
 ) {
@@ -490,9 +530,14 @@ fn begin_steps(
     }
     plan.count = 0;
     plan.index = 0;
-    for (entity, mut sim, progress) in &mut cloths {
+    for (entity, mut sim, progress, sleep) in &mut cloths {
         let start = Instant::now();
-        let substeps = if run { sim.solver.begin_step(dt) } else { 0 };
+        let awake = sleep.is_none_or(|s| !s.asleep);
+        let substeps = if run && awake {
+            sim.solver.begin_step(dt)
+        } else {
+            0
+        };
         let progress_now = StepProgress {
             substeps,
             elapsed: start.elapsed(),
@@ -554,20 +599,23 @@ fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
     for_each_active(&plan, &mut cloths, solver::ClothSolver::constrain);
 }
 
+#[allow(clippy::type_complexity)]
 fn finish_steps(
     mut torn: MessageWriter<ClothTorn>,
     env: Res<ClothEnvironment>,
+    time: Res<Time>,
     mut cloths: Query<
         (
             Entity,
             &mut ClothSimulation,
             &StepProgress,
             Option<&mut ClothStats>,
+            Option<&mut ClothSleep>,
         ),
         Without<ClothInvalid>,
     >,
 ) {
-    for (entity, mut sim, progress, stats) in &mut cloths {
+    for (entity, mut sim, progress, stats, sleep) in &mut cloths {
         if progress.substeps == 0 {
             continue;
         }
@@ -583,10 +631,19 @@ fn finish_steps(
                 particles,
             });
         }
+        let asleep = sleep.is_some_and(|mut sleep| {
+            let speed = if sleep.enabled {
+                sim.solver.max_speed()
+            } else {
+                f32::INFINITY
+            };
+            sleep.observe(speed, time.delta_secs())
+        });
         sim.last_step_ms = (progress.elapsed + start.elapsed()).as_secs_f32() * 1e3;
         sim.mesh_dirty = true;
         if let Some(mut stats) = stats {
             stats.record(&sim.solver, &env, sim.last_step_ms);
+            stats.asleep = asleep;
         }
     }
 }

@@ -58,6 +58,21 @@ pub(super) struct Bounds {
 }
 
 impl Bounds {
+    /// The box around `points` (an empty box for none).
+    pub(super) fn around(points: &[Vec3]) -> Self {
+        let (min, max) = points
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), x| {
+                (lo.min(*x), hi.max(*x))
+            });
+        Self { min, max }
+    }
+
+    /// Whether the two boxes share a point.
+    pub(super) fn overlaps(&self, other: &Bounds) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
+
     /// Whether `x` lies in the box.
     #[inline]
     fn contains(&self, x: Vec3) -> bool {

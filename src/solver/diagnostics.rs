@@ -87,6 +87,20 @@ impl ClothSolver {
         energy
     }
 
+    /// The largest speed of a free particle, m/s (0 for none): what a sleeping cloth's
+    /// stillness is measured by.
+    pub fn max_speed(&self) -> f32 {
+        let p = &self.particles;
+        let fastest = p
+            .velocity
+            .iter()
+            .zip(&p.inv_mass)
+            .filter(|(_, w)| **w > 0.0)
+            .map(|(v, _)| v.length_squared())
+            .fold(0.0f32, f32::max);
+        fastest.sqrt()
+    }
+
     /// Stretch of the whole structural springs.
     pub fn strain(&self) -> Strain {
         let x = &self.particles.position;

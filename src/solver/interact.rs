@@ -49,6 +49,7 @@ impl ClothSolver {
             return false;
         }
         self.release_grab();
+        self.disturbed = true;
         let x = self.particles.position[i as usize];
         self.grab = Some(Grab {
             particle: i,
@@ -64,14 +65,17 @@ impl ClothSolver {
     pub fn drag_grab(&mut self, target: Vec3) {
         if let Some(g) = &mut self.grab
             && target.is_finite()
+            && target != g.target
         {
             g.target = target;
+            self.disturbed = true;
         }
     }
 
     /// Lets go of the grabbed particle; it keeps its velocity.
     pub fn release_grab(&mut self) {
         if let Some(g) = self.grab.take() {
+            self.disturbed = true;
             // A pinned particle stays pinned; a free one takes the current mass.
             self.particles.inv_mass[g.particle as usize] = if g.inv_mass == 0.0 {
                 0.0

@@ -89,11 +89,17 @@ pub struct ClothSolver {
     seam_start: Vec<f32>,
     /// Colliders in world space the particles are kept out of (see `collide.rs`).
     colliders: Vec<Collider>,
+    /// The colliders before the last `set_colliders` (kept to tell a change, and for
+    /// their storage).
+    colliders_spare: Vec<Collider>,
     /// Each collider's bounding box grown by its thickness (`collide.rs`'s broad phase).
     collider_bounds: Vec<collide::Bounds>,
     /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
     /// garments.
     stencil: Option<lattice::Stencil>,
+    /// Set by everything from outside that can move a resting cloth (see
+    /// [`ClothSolver::take_disturbed`]); what a sleeping cloth is woken by.
+    disturbed: bool,
 }
 
 /// The active model's own state: none for mass-spring (or before the first step
@@ -203,8 +209,10 @@ impl ClothSolver {
             },
             seam_start: Vec::new(),
             colliders: Vec::new(),
+            colliders_spare: Vec::new(),
             collider_bounds: Vec::new(),
             stencil,
+            disturbed: true,
         };
         let seams = cloth.springs.ranges[SpringKind::Seam as usize].clone();
         cloth.seam_start = cloth.springs.rest_length[seams].to_vec();
@@ -222,6 +230,7 @@ impl ClothSolver {
     /// Puts every particle back at its rest position in the current frame, at rest, with
     /// every spring whole and the clock at zero.
     pub fn reset(&mut self) {
+        self.disturbed = true;
         self.grab = None;
         match &mut self.model {
             ModelState::ShapeMatching(sm) => sm.reset(),
@@ -277,6 +286,7 @@ impl ClothSolver {
     /// [`ClothSolver::set_params`] for parameters known to be valid for this cloth (the
     /// patch lattice's, derived from the cloth's validated ones).
     pub(crate) fn apply_params(&mut self, params: &ClothParams) {
+        self.disturbed |= *params != self.params;
         if params.node_mass != self.params.node_mass {
             for i in 0..self.particles.len() {
                 self.particles.mass[i] = params.node_mass * self.particles.lump[i];
@@ -296,7 +306,17 @@ impl ClothSolver {
     /// Moves the pins' frame; pinned particles move there over the next step, smoothly
     /// across its substeps, and drag the cloth along.
     pub fn set_frame(&mut self, frame: Affine3A) {
+        self.disturbed |= frame != self.frame;
         self.frame = frame;
+    }
+
+    /// True once after anything from outside could have moved the cloth since the last
+    /// call: new parameters, a moved frame (the pins), a collider that changed within
+    /// reach of the cloth, a grab, a drag or a release, a tear or a cut, a reset, or
+    /// mutable access to the particles. A sleeping cloth (the plugin's `ClothSleep`)
+    /// wakes on it; the step itself never sets it.
+    pub fn take_disturbed(&mut self) -> bool {
+        std::mem::take(&mut self.disturbed)
     }
 
     // ----- the step -------------------------------------------------------------------
@@ -444,6 +464,7 @@ impl ClothSolver {
         if k >= self.springs.len() || !self.springs.alive[k] {
             return false;
         }
+        self.disturbed = true;
         self.springs.alive[k] = false;
         if let Some(stencil) = &mut self.stencil {
             stencil.tear(k);
@@ -576,6 +597,7 @@ impl ClothSolver {
 
     /// Mutable particle state, for tools that move particles (grab) between steps.
     pub fn particles_mut(&mut self) -> &mut Particles {
+        self.disturbed = true;
         &mut self.particles
     }
 
@@ -623,8 +645,21 @@ impl ClothSolver {
     /// Replaces the colliders the particles are kept out of (world space); reuses its
     /// storage, so calling it every step allocates nothing once it has grown.
     pub fn set_colliders(&mut self, colliders: impl IntoIterator<Item = Collider>) {
+        // The last colliders go to the spare list (both keep their storage: no
+        // allocation once grown).
+        std::mem::swap(&mut self.colliders, &mut self.colliders_spare);
         self.colliders.clear();
         self.colliders.extend(colliders);
+        let before = &self.colliders_spare;
+        if *before != self.colliders {
+            // Only a change within reach of the cloth can move it: the boxes of the
+            // colliders that differ against the cloth's.
+            let cloth = collide::Bounds::around(&self.particles.position);
+            let near = |c: &Collider| c.bounds().overlaps(&cloth);
+            let changed = self.colliders.iter().filter(|c| !before.contains(c));
+            let gone = before.iter().filter(|c| !self.colliders.contains(c));
+            self.disturbed |= changed.chain(gone).any(near);
+        }
         self.collider_bounds.clear();
         self.collider_bounds
             .extend(self.colliders.iter().map(Collider::bounds));
