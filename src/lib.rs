@@ -45,8 +45,8 @@ pub mod stats;
 /// The types a user needs to add cloth to an app.
 pub mod prelude {
     pub use crate::ecs::components::{
-        Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation,
-        ClothSleep, ClothStats, ClothTorn, ClothWake, ColliderKind, StatSample,
+        Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothLod, ClothPause,
+        ClothSimulation, ClothSleep, ClothStats, ClothTorn, ClothWake, ColliderKind, StatSample,
     };
     pub use crate::ecs::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::ecs::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};

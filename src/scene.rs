@@ -23,7 +23,7 @@ use bevy::ecs::name::Name;
 use bevy::ecs::system::Commands;
 use bevy::time::{Fixed, Time};
 
-use crate::ecs::components::{Cloth, ClothCollider, ClothEnvironment, ClothStats};
+use crate::ecs::components::{Cloth, ClothCollider, ClothEnvironment, ClothLod, ClothStats};
 use crate::params::Environment;
 
 /// A scene: the cloths, their world and the timestep.
@@ -99,6 +99,10 @@ pub struct SceneCloth {
     /// `color`.
     #[serde(default)]
     pub piece_colors: Vec<[f32; 3]>,
+    /// Level of detail (a grid cloth's model from its size on screen, see
+    /// [`crate::ecs::components::ClothLod`]) with its default thresholds.
+    #[serde(default)]
+    pub lod: bool,
 }
 
 impl SceneCloth {
@@ -193,14 +197,16 @@ impl ClothScene {
             .cloths
             .iter()
             .map(|entry| {
-                commands
-                    .spawn((
-                        entry.cloth.clone(),
-                        ClothStats::default(),
-                        Name::new(entry.name.clone()),
-                        entry.transform(),
-                    ))
-                    .id()
+                let mut cloth = commands.spawn((
+                    entry.cloth.clone(),
+                    ClothStats::default(),
+                    Name::new(entry.name.clone()),
+                    entry.transform(),
+                ));
+                if entry.lod {
+                    cloth.insert(ClothLod::default());
+                }
+                cloth.id()
             })
             .collect();
         SpawnedScene { cloths, colliders }

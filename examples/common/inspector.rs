@@ -173,6 +173,7 @@ fn panel(
         Option<&ClothInvalid>,
         Option<&ClothSimulation>,
         Option<&mut ClothSleep>,
+        Option<&ClothLod>,
     )>,
     mut env: ResMut<ClothEnvironment>,
     mut pause: ResMut<ClothPause>,
@@ -218,7 +219,7 @@ fn panel(
                     time.set_timestep_seconds(step_ms as f64 / 1e3);
                 }
                 let step_ms = time.timestep().as_secs_f32() * 1e3;
-                for (n, (entity, name, mut cloth, stats, look, invalid, sim, sleep)) in
+                for (n, (entity, name, mut cloth, stats, look, invalid, sim, sleep, lod)) in
                     cloths.iter_mut().enumerate()
                 {
                     ui.separator();
@@ -238,6 +239,20 @@ fn panel(
                             cloth_controls(ui, &mut edited);
                             if edited != *cloth {
                                 *cloth = edited;
+                            }
+                            if let Some(lod) = lod {
+                                ui.label(format!(
+                                    "level of detail {} ({}), {:.0}% of the view's height",
+                                    lod.level,
+                                    match lod.level {
+                                        0 => "its own model".to_string(),
+                                        l => {
+                                            let s = ClothLod::PART_SIZES[l - 1];
+                                            format!("patches {s}×{s}")
+                                        }
+                                    },
+                                    lod.screen_fraction * 100.0
+                                ));
                             }
                             if let Some(mut sleep) = sleep {
                                 let mut enabled = sleep.enabled;

@@ -493,6 +493,60 @@ impl ClothSleep {
     }
 }
 
+/// Level of detail (issue 16): the cloth's model follows its size on screen. At level 0
+/// the cloth runs its own model; below each threshold it switches to the patch model with
+/// parts of 2×2, 4×4 and 8×8 particles (seed 000 §3.4: cheaper the larger the parts),
+/// which adopts the running state (no jump), and back as the cloth grows on screen. The
+/// size is the cloth's bounding sphere projected by the active camera, as a fraction of
+/// the view's height. Grid cloths only (the patch model needs a grid): on others it
+/// stays at level 0. While not at level 0 the component owns `Cloth::params.model`
+/// (the cloth's own model is kept and put back).
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Default)]
+pub struct ClothLod {
+    /// The fractions of the view's height below which the cloth goes to parts of 2×2,
+    /// 4×4 and 8×8 (decreasing).
+    pub thresholds: [f32; 3],
+    /// A band of this fraction around each threshold: the cloth goes coarser below
+    /// `t (1 − band)` and finer above `t (1 + band)`, so it does not flicker at one.
+    pub band: f32,
+    /// The current level, 0–3 (set by the plugin).
+    pub level: usize,
+    /// The size on screen last measured (set by the plugin).
+    pub screen_fraction: f32,
+    /// The cloth's own model, kept while the level is not 0.
+    pub(crate) full: Option<crate::params::Model>,
+}
+
+impl Default for ClothLod {
+    fn default() -> Self {
+        Self {
+            thresholds: [0.5, 0.25, 0.12],
+            band: 0.1,
+            level: 0,
+            screen_fraction: 1.0,
+            full: None,
+        }
+    }
+}
+
+impl ClothLod {
+    /// The patch size of each level above 0.
+    pub const PART_SIZES: [u32; 3] = [2, 4, 8];
+
+    /// The level a cloth at `fraction` of the view's height goes to from `level`: one
+    /// level at a time, coarser below a threshold less the band, finer above one plus it.
+    pub fn next_level(&self, level: usize, fraction: f32) -> usize {
+        if level < 3 && fraction < self.thresholds[level] * (1.0 - self.band) {
+            level + 1
+        } else if level > 0 && fraction > self.thresholds[level - 1] * (1.0 + self.band) {
+            level - 1
+        } else {
+            level
+        }
+    }
+}
+
 /// Wakes a sleeping cloth (see [`ClothSleep`]): the game's own reason to move it.
 #[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ClothWake(pub Entity);

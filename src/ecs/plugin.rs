@@ -25,8 +25,8 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
 use crate::ecs::components::{
-    Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, ClothSleep,
-    ClothStats, ClothTorn, ClothWake,
+    Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothLod, ClothPause, ClothSimulation,
+    ClothSleep, ClothStats, ClothTorn, ClothWake,
 };
 use crate::ecs::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::error::ClothError;
@@ -157,6 +157,7 @@ impl Plugin for ClothPlugin {
             .add_message::<ClothTorn>()
             .add_message::<ClothWake>()
             .register_type::<ClothSleep>()
+            .register_type::<ClothLod>()
             .init_asset::<Garment>()
             .register_asset_loader(GarmentLoader)
             .add_systems(Update, watch_garments);
@@ -192,7 +193,13 @@ impl Plugin for ClothPlugin {
         .add_systems(
             self.schedule,
             (
-                (build_cloths, place_colliders, wake_cloths, begin_steps)
+                (
+                    choose_levels,
+                    build_cloths,
+                    place_colliders,
+                    wake_cloths,
+                    begin_steps,
+                )
                     .chain()
                     .in_set(ClothSystems::Prepare),
                 run_substeps.in_set(ClothSystems::Substeps),
@@ -473,6 +480,57 @@ fn place_colliders(
 struct StepProgress {
     substeps: u32,
     elapsed: Duration,
+}
+
+/// Sets each [`ClothLod`] cloth's level from its size on the active camera's view: the
+/// bounding sphere of its particles, `radius / (distance · tan(fov/2))` for a perspective
+/// camera (`radius / half height` for an orthographic one). A new level sets the cloth's
+/// model (its own at 0, patches above), which `build_cloths` then applies.
+fn choose_levels(
+    transforms: TransformHelper,
+    cameras: Query<(Entity, &Camera, &Projection)>,
+    mut cloths: Query<(&mut Cloth, &mut ClothLod, &ClothSimulation)>,
+) {
+    let Some((camera, _, projection)) = cameras.iter().find(|(_, c, _)| c.is_active) else {
+        return;
+    };
+    // Computed here rather than read from `GlobalTransform`, which a headless app
+    // without transform propagation does not update.
+    let Ok(eye) = transforms.compute_global_transform(camera) else {
+        return;
+    };
+    for (mut cloth, mut lod, sim) in &mut cloths {
+        if sim.solver.grid_size().is_none() {
+            continue;
+        }
+        let (centre, radius) = sim.solver.bounding_sphere();
+        let fraction = match projection {
+            Projection::Perspective(p) => {
+                let distance = eye.translation().distance(centre).max(f32::EPSILON);
+                radius / (distance * (p.fov * 0.5).tan())
+            }
+            Projection::Orthographic(o) => radius / (o.area.height() * 0.5).max(f32::EPSILON),
+            Projection::Custom(_) => continue,
+        };
+        let lod = lod.bypass_change_detection();
+        lod.screen_fraction = fraction;
+        let level = lod.next_level(lod.level, fraction);
+        if level == lod.level {
+            continue;
+        }
+        if lod.level == 0 {
+            lod.full = Some(cloth.params.model);
+        }
+        lod.level = level;
+        cloth.params.model = match level {
+            0 => lod.full.take().unwrap_or(cloth.params.model),
+            l => Model::Patches(PatchParams {
+                part_width: ClothLod::PART_SIZES[l - 1],
+                part_height: ClothLod::PART_SIZES[l - 1],
+                ..PatchParams::default()
+            }),
+        };
+    }
 }
 
 /// Wakes the sleeping cloths that something may move (see [`ClothSleep`]): the solver's

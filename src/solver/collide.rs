@@ -68,6 +68,19 @@ impl Bounds {
         Self { min, max }
     }
 
+    /// The centre of the box and its half diagonal: a sphere around it.
+    pub(super) fn sphere(&self) -> (Vec3, f32) {
+        (
+            (self.min + self.max) * 0.5,
+            (self.max - self.min).length() * 0.5,
+        )
+    }
+
+    /// Its size along each axis.
+    pub(super) fn size(&self) -> Vec3 {
+        self.max - self.min
+    }
+
     /// Whether the two boxes share a point.
     pub(super) fn overlaps(&self, other: &Bounds) -> bool {
         self.min.cmple(other.max).all() && other.min.cmple(self.max).all()

@@ -87,6 +87,12 @@ impl ClothSolver {
         energy
     }
 
+    /// The centre and radius of a sphere around every particle (the centre of their
+    /// bounding box and its half diagonal), for level of detail.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        super::collide::Bounds::around(&self.particles.position).sphere()
+    }
+
     /// The largest speed of a free particle, m/s (0 for none): what a sleeping cloth's
     /// stillness is measured by.
     pub fn max_speed(&self) -> f32 {

@@ -96,12 +96,9 @@ impl ClothSolver {
     /// substeps with `h ≤ √(target · L / (2 R g))`.
     pub(super) fn xpbd_substeps(&self, dt: f32, target: f32) -> u32 {
         const G: f32 = 9.81;
-        let (lo, hi) = self.local_rest.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), x| (lo.min(*x), hi.max(*x)),
-        );
+        let size = super::collide::Bounds::around(&self.local_rest).size();
         let l = self.length_scale.max(f32::EPSILON);
-        let across = (hi - lo).max_element().max(l) / l;
+        let across = size.max_element().max(l) / l;
         let h = (target * l / (2.0 * across * G)).sqrt();
         let n = (dt / h).ceil();
         if n.is_finite() { (n as u32).max(1) } else { 1 }
