@@ -281,3 +281,105 @@ fn dumps_are_the_same_bits_on_one_thread_and_on_all() {
     );
     assert!(dumps[0] == dumps[1], "the dumps differ");
 }
+
+/// A small curtain scene for `cloth choose` (8×6, corner pins, no wind).
+const SMALL_SCENE: &str = "(timestep: 0.016, cloths: [(name: \"small curtain\", translation: (0.0, 2.0, 0.0), cloth: (shape: Grid(width: 8, height: 6, spacing: 0.05), pins: TopCorners))])";
+
+/// `cloth choose` on the small scene with `goal` (`--max-error E` or `--budget-ms B`):
+/// its JSON, and the scene it wrote.
+fn choose(goal: [&str; 2], name: &str) -> (serde_json::Value, String) {
+    let scene = temp(&format!("{name}.ron"));
+    std::fs::write(&scene, SMALL_SCENE).unwrap();
+    let written = temp(&format!("{name}_chosen.ron"));
+    let (scene_arg, written_arg) = (scene.display().to_string(), written.display().to_string());
+    let out = run_ok([
+        "choose",
+        &scene_arg,
+        goal[0],
+        goal[1],
+        "--seconds",
+        "0.5",
+        "--repeats",
+        "1",
+        "--json",
+        "--write",
+        &written_arg,
+    ]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let text = std::fs::read_to_string(&written).unwrap();
+    let _ = std::fs::remove_file(&scene);
+    let _ = std::fs::remove_file(&written);
+    (json, text)
+}
+
+/// The measured rows: (ms per simulated second, error), `None` for a failed run.
+fn measured(json: &serde_json::Value) -> Vec<Option<(f64, f64)>> {
+    json["rows"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| Some((r["ms_per_second"].as_f64()?, r["error"].as_f64()?)))
+        .collect()
+}
+
+#[test]
+fn choose_picks_the_cheapest_within_the_error_and_writes_it() {
+    let budget = 0.02;
+    let (json, written) = choose(["--max-error", "0.02"], "error");
+    let rows = measured(&json);
+    let chosen = json["chosen"].as_u64().expect("a choice") as usize;
+    let (cost, error) = rows[chosen].expect("the chosen row was measured");
+    assert!(error <= budget, "chosen error {error}");
+    // Cheaper than every other configuration within the budget (in the table it printed).
+    for (ms, e) in rows.iter().flatten() {
+        assert!(
+            *e > budget || *ms >= cost,
+            "{ms} ms/s at {e} beats the choice"
+        );
+    }
+    // The overrides and the written scene say the same configuration.
+    let mut by_overrides =
+        bevy_cloth::scene::ClothScene::parse(SMALL_SCENE, std::path::Path::new("small.ron"))
+            .unwrap();
+    for o in json["overrides"].as_array().unwrap() {
+        by_overrides.apply_override(o.as_str().unwrap()).unwrap();
+    }
+    let written =
+        bevy_cloth::scene::ClothScene::parse(&written, std::path::Path::new("chosen.ron")).unwrap();
+    assert_eq!(
+        by_overrides.cloths[0].cloth.params,
+        written.cloths[0].cloth.params
+    );
+}
+
+#[test]
+fn choose_picks_the_most_accurate_within_a_cost_and_refuses_an_impossible_goal() {
+    let (json, _) = choose(["--budget-ms", "0.05"], "budget");
+    let rows = measured(&json);
+    let chosen = json["chosen"].as_u64().expect("a choice") as usize;
+    let (cost, error) = rows[chosen].unwrap();
+    let per_step = |ms: f64| ms * 0.016;
+    assert!(per_step(cost) <= 0.05);
+    for (ms, e) in rows.iter().flatten() {
+        assert!(
+            per_step(*ms) > 0.05 || *e >= error,
+            "{e} at {ms} ms/s beats the choice"
+        );
+    }
+    let scene = temp("impossible.ron");
+    std::fs::write(&scene, SMALL_SCENE).unwrap();
+    let out = cloth()
+        .args([
+            "choose",
+            &scene.display().to_string(),
+            "--max-error",
+            "1e-12",
+        ])
+        .args(["--seconds", "0.2", "--repeats", "1"])
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_file(&scene);
+    assert_eq!(out.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("no configuration"), "{stderr}");
+}
