@@ -244,13 +244,7 @@ fn panel(
                                 ui.label(format!(
                                     "level of detail {} ({}), {:.0}% of the view's height",
                                     lod.level,
-                                    match lod.level {
-                                        0 => "its own model".to_string(),
-                                        l => {
-                                            let s = ClothLod::PART_SIZES[l - 1];
-                                            format!("patches {s}×{s}")
-                                        }
-                                    },
+                                    ClothLod::describe(lod.level),
                                     lod.screen_fraction * 100.0
                                 ));
                             }

@@ -20,13 +20,7 @@ fn main() {
         let mut ms: Vec<f32> = runs.iter().map(|r| r.0).collect();
         ms.sort_by(f32::total_cmp);
         let (_, level, fraction) = runs[0];
-        let model = match level {
-            0 => "mass-spring".to_string(),
-            l => {
-                let s = ClothLod::PART_SIZES[l - 1];
-                format!("patches {s}×{s}")
-            }
-        };
+        let model = ClothLod::describe(level);
         println!(
             "| {distance} | {level} | {model} | {:.0}% | {:.3} [{:.3}–{:.3}] |",
             fraction * 100.0,

@@ -79,11 +79,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
                 Integrator::Verlet => "Verlet",
                 Integrator::SemiImplicitEuler => "Euler",
             };
-            let steps = match substeps {
-                Substeps::Fixed(1) => "1 substep".into(),
-                Substeps::Fixed(n) => format!("{n} substeps"),
-                Substeps::Auto { .. } => "auto substeps".into(),
-            };
+            let steps = substeps_label(substeps);
             out.push(Config {
                 model: ModelKind::MassSpring.name(),
                 label: format!("{name}, {steps}"),
@@ -156,10 +152,7 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
     {
         out.push(Config {
             model: ModelKind::Xpbd.name(),
-            label: match substeps {
-                Substeps::Fixed(n) => format!("{n} substeps"),
-                Substeps::Auto { .. } => "auto substeps".into(),
-            },
+            label: substeps_label(substeps),
             params: ClothParams {
                 model: Model::Xpbd(XpbdParams::default()),
                 substeps,
@@ -168,6 +161,15 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
         });
     }
     out
+}
+
+/// `1 substep`, `8 substeps`, `auto substeps`: a configuration's substeps in a label.
+fn substeps_label(substeps: Substeps) -> String {
+    match substeps {
+        Substeps::Fixed(1) => "1 substep".into(),
+        Substeps::Fixed(n) => format!("{n} substeps"),
+        Substeps::Auto { .. } => "auto substeps".into(),
+    }
 }
 
 /// One scene of the accuracy study: `scene` reduced to the cloth measured.

@@ -19,24 +19,31 @@ pub enum Goal {
     BudgetMs(f64),
 }
 
+impl Goal {
+    /// Whether a configuration that costs `ms_per_step` with `error` meets the goal.
+    pub fn admits(self, ms_per_step: f64, error: f64) -> bool {
+        match self {
+            Goal::MaxError(budget) => error <= budget,
+            Goal::BudgetMs(budget) => ms_per_step <= budget,
+        }
+    }
+}
+
 /// The row of `rows` that `goal` picks (`None` when no measured row qualifies); a run
 /// that failed has no time and no error and is never picked. `timestep`: the scene's
 /// step, s, to turn a cost per simulated second into one per step.
 pub fn pick(rows: &[Row], goal: Goal, timestep: f64) -> Option<usize> {
-    let measured = rows
+    let admitted = rows
         .iter()
         .enumerate()
-        .filter_map(|(i, r)| Some((i, r.ms_per_second?, r.error?)));
+        .filter_map(|(i, r)| Some((i, r.ms_per_second? * timestep, r.error?)))
+        .filter(|&(_, ms, error)| goal.admits(ms, error));
+    // Within an error: the cheapest. Within a cost: the most accurate.
     match goal {
-        Goal::MaxError(budget) => measured
-            .filter(|&(_, _, error)| error <= budget)
-            .min_by(|a, b| a.1.total_cmp(&b.1))
-            .map(|(i, _, _)| i),
-        Goal::BudgetMs(budget) => measured
-            .filter(|&(_, ms, _)| ms * timestep <= budget)
-            .min_by(|a, b| a.2.total_cmp(&b.2))
-            .map(|(i, _, _)| i),
+        Goal::MaxError(_) => admitted.min_by(|a, b| a.1.total_cmp(&b.1)),
+        Goal::BudgetMs(_) => admitted.min_by(|a, b| a.2.total_cmp(&b.2)),
     }
+    .map(|(i, _, _)| i)
 }
 
 /// `--set` overrides that turn cloth `index`'s parameters into `chosen`: the model (its

@@ -9,7 +9,7 @@ use std::time::Instant;
 use bevy::mesh::Mesh3d;
 use bevy::prelude::*;
 
-use crate::{BENCH_CHECK_STEPS, BENCH_PINS, grid_for, median, seed_model_params};
+use crate::{BENCH_CHECK_STEPS, BENCH_PINS, bench_params, grid_for, median};
 use bevy_cloth::error::ClothError;
 use bevy_cloth::headless::headless_app;
 use bevy_cloth::prelude::{Cloth, ClothSimulation};
@@ -36,7 +36,7 @@ pub const APP_COUNTS: [usize; 12] = [
 /// One row of the experiment.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct AppFrame {
-    /// Slika 23's model name (see [`seed_model_params`]).
+    /// Slika 23's model name (see [`crate::seed_model_params`]).
     pub model: String,
     /// Masses (particles).
     pub particles: usize,
@@ -62,10 +62,7 @@ pub fn app_frame(
     warmup: usize,
     frames: usize,
 ) -> Result<AppFrame, ClothError> {
-    let params = seed_model_params(model).ok_or_else(|| ClothError::UnknownModel {
-        name: model.to_string(),
-        known: "1, 2, 3a, 3b, 3c",
-    })?;
+    let params = bench_params(model)?;
     let (width, height) = grid_for(count);
     let mut app = headless_app();
     let entity = app

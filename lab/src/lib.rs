@@ -139,11 +139,15 @@ pub const BENCH_PINS: Pins = Pins::TopRow;
 
 /// The timing table's curtain (see [`BENCH_PINS`]).
 pub fn bench_cloth(model: &str, count: usize) -> Result<solver::ClothSolver, ClothError> {
-    let params = seed_model_params(model).ok_or_else(|| ClothError::UnknownModel {
+    bench_cloth_with(&bench_params(model)?, count)
+}
+
+/// [`seed_model_params`], or the error naming the models of the timing table.
+pub fn bench_params(model: &str) -> Result<ClothParams, ClothError> {
+    seed_model_params(model).ok_or_else(|| ClothError::UnknownModel {
         name: model.to_string(),
-        known: "1, 2, 3a, 3b, 3c, x",
-    })?;
-    bench_cloth_with(&params, count)
+        known: "1, 2, 3a, 3b, 3c, x (BENCH_MODELS)",
+    })
 }
 
 /// The timing table's curtain of `count` particles with `params`.

@@ -373,8 +373,8 @@ pub struct ClothStats {
     pub substeps: u32,
     /// True when automatic substeps hit their cap: the step may be unstable.
     pub under_resolved: bool,
-    /// True while the cloth sleeps (see [`ClothSleep`]): the other values are those of
-    /// its last step.
+    /// True when the cloth fell asleep at its last step (see [`ClothSleep`], which says
+    /// whether it sleeps now): the other values are those of that step.
     pub asleep: bool,
     /// Median step time over the last second of wall-clock steps, ms.
     pub step_ms_median: f32,
@@ -533,6 +533,14 @@ impl Default for ClothLod {
 impl ClothLod {
     /// The patch size of each level above 0.
     pub const PART_SIZES: [u32; 3] = [2, 4, 8];
+
+    /// What level `level` runs, in words: `its own model` or `patches 2×2` (…).
+    pub fn describe(level: usize) -> String {
+        match level.checked_sub(1).and_then(|l| Self::PART_SIZES.get(l)) {
+            Some(s) => format!("patches {s}×{s}"),
+            None => "its own model".into(),
+        }
+    }
 
     /// The level a cloth at `fraction` of the view's height goes to from `level`: one
     /// level at a time, coarser below a threshold less the band, finer above one plus it.

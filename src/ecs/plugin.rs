@@ -540,27 +540,20 @@ fn wake_cloths(
     env: Res<ClothEnvironment>,
     mut last_env: Local<Option<Environment>>,
     mut messages: MessageReader<ClothWake>,
-    mut cloths: Query<(
-        Entity,
-        &mut ClothSimulation,
-        &mut ClothSleep,
-        Option<&mut ClothStats>,
-    )>,
+    mut woken: Local<Vec<Entity>>,
+    mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothSleep)>,
 ) {
     let env_changed = last_env.is_some_and(|last| last != **env);
     *last_env = Some(**env);
-    let woken: Vec<Entity> = messages.read().map(|m| m.0).collect();
-    for (entity, mut sim, mut sleep, stats) in &mut cloths {
+    // Kept between steps for its storage: no allocation once grown.
+    woken.clear();
+    woken.extend(messages.read().map(|m| m.0));
+    for (entity, mut sim, mut sleep) in &mut cloths {
         // Read by every step, so a disturbance is never left over for later.
         let disturbed = sim.bypass_change_detection().solver.take_disturbed();
-        if !sleep.asleep {
-            continue;
-        }
-        if disturbed || env_changed || !sleep.enabled || woken.contains(&entity) {
+        if sleep.asleep && (disturbed || env_changed || !sleep.enabled || woken.contains(&entity)) {
+            // `ClothStats::asleep` follows at the step this lets run.
             sleep.wake();
-            if let Some(mut stats) = stats {
-                stats.asleep = false;
-            }
         }
     }
 }

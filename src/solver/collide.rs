@@ -124,23 +124,20 @@ impl Collider {
     /// particles farther away (the most of them, even inside a collider's bounding box).
     #[inline]
     pub(super) fn penetration(&self, x: Vec3) -> Option<(f32, Vec3)> {
-        // A relative margin of 1e-4 leaves the particles near the band's edge (those
-        // pushed out to it rest there) to the exact test, so the result is the same bits.
-        let reach = |radius: f32| (radius + self.thickness).powi(2) * 1.0001;
-        let outside = match self.shape {
-            ColliderShape::Sphere { center, radius } => x.distance_squared(center) >= reach(radius),
-            ColliderShape::Capsule { a, b, radius } => {
-                let axis = b - a;
-                let t = ((x - a).dot(axis) / axis.length_squared().max(f32::MIN_POSITIVE))
-                    .clamp(0.0, 1.0);
-                x.distance_squared(a + axis * t) >= reach(radius)
+        let (d, n) = match self.shape {
+            ColliderShape::Plane { .. } => self.distance(x),
+            _ => {
+                let (offset, radius) = self.off_core(x);
+                // A relative margin of 1e-4 leaves the particles near the band's edge
+                // (those pushed out to it rest there) to the exact test, so the result is
+                // the same bits.
+                let reach = (radius + self.thickness).powi(2) * 1.0001;
+                if offset.length_squared() >= reach {
+                    return None;
+                }
+                self.surface(offset, radius)
             }
-            ColliderShape::Plane { .. } => false,
         };
-        if outside {
-            return None;
-        }
-        let (d, n) = self.distance(x);
         let depth = self.thickness - d;
         (depth > 0.0).then_some((depth, n))
     }
@@ -149,23 +146,39 @@ impl Collider {
     /// closest surface point.
     pub fn distance(&self, x: Vec3) -> (f32, Vec3) {
         match self.shape {
-            ColliderShape::Sphere { center, radius } => {
-                let d = x - center;
-                let len = d.length();
-                (len - radius, d.try_normalize().unwrap_or(Vec3::Y))
+            ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
+            _ => {
+                let (offset, radius) = self.off_core(x);
+                self.surface(offset, radius)
             }
+        }
+    }
+
+    /// `x` less the nearest point of the solid's core (a sphere's centre, a capsule's
+    /// axis segment) and the radius around it. (A plane has no core: its point, 0.)
+    #[inline]
+    fn off_core(&self, x: Vec3) -> (Vec3, f32) {
+        match self.shape {
+            ColliderShape::Sphere { center, radius } => (x - center, radius),
             ColliderShape::Capsule { a, b, radius } => {
                 let axis = b - a;
                 let t = ((x - a).dot(axis) / axis.length_squared().max(f32::MIN_POSITIVE))
                     .clamp(0.0, 1.0);
-                let d = x - (a + axis * t);
-                let normal = d
-                    .try_normalize()
-                    .unwrap_or_else(|| axis.any_orthonormal_vector());
-                (d.length() - radius, normal)
+                (x - (a + axis * t), radius)
             }
-            ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
+            ColliderShape::Plane { point, .. } => (x - point, 0.0),
         }
+    }
+
+    /// Signed distance and outward normal of a sphere's or capsule's surface from
+    /// `offset`, a point less the nearest point of the core (see [`Self::off_core`]).
+    #[inline]
+    fn surface(&self, offset: Vec3, radius: f32) -> (f32, Vec3) {
+        let normal = offset.try_normalize().unwrap_or_else(|| match self.shape {
+            ColliderShape::Capsule { a, b, .. } => (b - a).any_orthonormal_vector(),
+            _ => Vec3::Y,
+        });
+        (offset.length() - radius, normal)
     }
 }
 

@@ -545,11 +545,10 @@ impl ClothSolver {
                     }
                 }
             }
+            // A cloth's springs never change (they only tear): built once per switch.
             Model::Xpbd(_) => {
-                let n = self.particles.len();
-                let current = matches!(&self.model,
-                    ModelState::Xpbd(c) if c.built_for == self.springs.len());
-                if !current {
+                if !matches!(self.model, ModelState::Xpbd(_)) {
+                    let n = self.particles.len();
                     let constraints = xpbd::Constraints::new(&self.springs, n);
                     self.model = ModelState::Xpbd(Box::new(constraints));
                 }
@@ -651,15 +650,16 @@ impl ClothSolver {
         self.colliders.clear();
         self.colliders.extend(colliders);
         let before = &self.colliders_spare;
-        if *before != self.colliders {
-            // Only a change within reach of the cloth can move it: the boxes of the
-            // colliders that differ against the cloth's.
-            let cloth = collide::Bounds::around(&self.particles.position);
-            let near = |c: &Collider| c.bounds().overlaps(&cloth);
-            let changed = self.colliders.iter().filter(|c| !before.contains(c));
-            let gone = before.iter().filter(|c| !self.colliders.contains(c));
-            self.disturbed |= changed.chain(gone).any(near);
+        if *before == self.colliders {
+            return; // the same colliders (the plugin sets them every step): all derived holds
         }
+        // Only a change within reach of the cloth can move it: the boxes of the colliders
+        // that differ against the cloth's.
+        let cloth = collide::Bounds::around(&self.particles.position);
+        let near = |c: &Collider| c.bounds().overlaps(&cloth);
+        let changed = self.colliders.iter().filter(|c| !before.contains(c));
+        let gone = before.iter().filter(|c| !self.colliders.contains(c));
+        self.disturbed |= changed.chain(gone).any(near);
         self.collider_bounds.clear();
         self.collider_bounds
             .extend(self.colliders.iter().map(Collider::bounds));

@@ -63,8 +63,6 @@ pub(super) struct Constraints {
     scaled_for: Option<[Family; 5]>,
     /// The colours, in projection order.
     colours: Vec<Colour>,
-    /// The springs this was built for (a new cloth or layout rebuilds it).
-    pub built_for: usize,
     /// Corrections made in this substep, summed per particle (zero between substeps).
     dx: Vec<Vec3>,
 }
@@ -178,7 +176,6 @@ impl Constraints {
             b,
             spring: order,
             colours,
-            built_for: springs.len(),
             dx: vec![Vec3::ZERO; n],
         };
         debug_assert!(constraints.colours_are_disjoint(n));
@@ -257,7 +254,6 @@ impl Constraints {
             if !family.on {
                 continue;
             }
-            let damped = family.damping > 0.0;
             let piece = |k: usize| {
                 let range = colour.pieces[k].clone();
                 Piece {
@@ -272,7 +268,7 @@ impl Constraints {
             };
             if !colour.windowed || colour.pieces.len() < PARALLEL_PIECES {
                 for k in 0..colour.pieces.len() {
-                    project_piece(piece(k), (&mut *x, &mut *dx, 0), previous, family, damped);
+                    project_piece(piece(k), (&mut *x, &mut *dx, 0), previous, family);
                 }
                 continue;
             }
@@ -286,7 +282,7 @@ impl Constraints {
                 };
                 let pieces = windows.map(|(k, x, dx, offset)| (piece(k), x, dx, offset));
                 parallel::for_each(n, pieces, |(piece, x, dx, offset)| {
-                    project_piece(piece, (x, dx, offset), previous, family, damped);
+                    project_piece(piece, (x, dx, offset), previous, family);
                 });
             }
         }
@@ -393,9 +389,9 @@ fn project_piece(
     (x, dx, offset): (&mut [Vec3], &mut [Vec3], usize),
     previous: &[Vec3],
     family: Family,
-    damped: bool,
 ) {
     let (gamma, max_stretch) = (family.damping, family.max_stretch);
+    let damped = gamma > 0.0;
     let constraints = piece
         .a
         .iter()

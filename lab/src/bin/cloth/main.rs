@@ -1069,11 +1069,7 @@ fn choose(args: ChooseArgs) -> Result<(), String> {
         println!("|---|---|---:|---:|---|");
         for (i, r) in rows.iter().enumerate() {
             let ms = r.ms_per_second.map(|ms| ms * timestep);
-            let within = match (goal, ms, r.error) {
-                (Goal::MaxError(e), Some(_), Some(err)) => err <= e,
-                (Goal::BudgetMs(b), Some(ms), Some(_)) => ms <= b,
-                _ => false,
-            };
+            let within = ms.zip(r.error).is_some_and(|(ms, e)| goal.admits(ms, e));
             println!(
                 "| {} | {} | {} | {} | {}{} |",
                 r.model,
