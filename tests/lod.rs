@@ -121,39 +121,118 @@ fn a_camera_inside_the_band_does_not_make_the_level_flicker() {
     }
 }
 
+/// The scene of [`scene`] with its camera taken through `distances`, each held for 41
+/// frames (past the switch's fade, `EASE_TIME`).
+fn after(distances: &[f32]) -> (App, Entity, Entity) {
+    let (mut app, cloth, camera) = scene(3.0);
+    for &distance in distances {
+        move_camera(&mut app, camera, distance);
+        for _ in 0..41 {
+            app.update();
+        }
+    }
+    (app, cloth, camera)
+}
+
+/// For each switch along `distances`: the level it goes to, the largest move of the
+/// switch step, and that of the same step of a twin with the same history whose camera
+/// stays (what one normal step moves the cloth).
+fn switch_moves(distances: &[f32]) -> Vec<(usize, f32, f32)> {
+    (0..distances.len())
+        .map(|k| {
+            let (mut app, cloth, camera) = after(&distances[..k]);
+            let (mut twin, twin_cloth, _) = after(&distances[..k]);
+            let (a, b) = (positions(&app, cloth), positions(&twin, twin_cloth));
+            let before = level(&app, cloth);
+            move_camera(&mut app, camera, distances[k]);
+            app.update();
+            twin.update();
+            let now = level(&app, cloth);
+            assert_ne!(now, before, "no switch at {} m", distances[k]);
+            assert_eq!(level(&twin, twin_cloth), before);
+            let switch = largest_move(&a, &positions(&app, cloth));
+            let normal = largest_move(&b, &positions(&twin, twin_cloth));
+            (now, switch, normal)
+        })
+        .collect()
+}
+
 #[test]
 fn switching_level_makes_no_jump() {
-    // The largest particle move in the step that switches, against a normal step before
-    // it. The patch model adopts the running state (part centres at their particles'
-    // means, with their velocities), but its lattice, adopted at the hanging cloth's
-    // stretched shape, contracts toward its own equilibrium in the first steps (the
-    // bottom edge goes up 1 cm): measured 5.5 mm in a normal step, 11.0 and 10.3 mm in
-    // the switch step and the next, then 6.9, 4.5, 4.0. The issue asks for no more than
-    // a normal step; this is twice that, and the test holds it there.
-    let (mut app, cloth, camera) = scene(3.0);
-    assert_eq!(level(&app, cloth), 0);
-    let a = positions(&app, cloth);
-    app.update();
-    let b = positions(&app, cloth);
-    let normal = largest_move(&a, &b);
-    move_camera(&mut app, camera, 5.0);
-    app.update();
-    let c = positions(&app, cloth);
-    assert_eq!(level(&app, cloth), 1, "switched");
-    let switch = largest_move(&b, &c);
-    let mut after = Vec::new();
-    let mut last = c.clone();
-    for _ in 0..5 {
-        app.update();
-        let now = positions(&app, cloth);
-        after.push(largest_move(&last, &now));
-        last = now;
+    // Both ways through every level, in wind (the cloth moving 2–6 mm a step). A switch
+    // matches the old model's acceleration and fades the difference out over 0.5 s
+    // (`solver/switch.rs`); before that the switch step moved this curtain 2.0× a normal
+    // step (11.0 mm against 5.5) and a settled one 10–100×.
+    let moves = switch_moves(&[5.0, 10.0, 30.0, 10.0, 5.0, 1.5]);
+    for &(level, switch, normal) in &moves {
+        println!(
+            "to level {level}: {:.2} mm in the switch step, {:.2} mm in the twin's ({:.2}×)",
+            switch * 1e3,
+            normal * 1e3,
+            switch / normal
+        );
     }
-    println!(
-        "largest move: {normal} m in a normal step, {switch} m in the switch step, then {after:?}"
-    );
-    assert!(
-        switch <= normal * 2.5,
-        "a jump: {switch} m against {normal} m"
-    );
+    let levels: Vec<usize> = moves.iter().map(|m| m.0).collect();
+    assert_eq!(levels, [1, 2, 3, 2, 1, 0]);
+    for (level, switch, normal) in moves {
+        assert!(
+            switch <= normal * 1.05,
+            "a jump switching to level {level}: {switch} m against {normal} m"
+        );
+    }
+}
+
+#[test]
+fn a_settled_cloth_switches_without_a_jump() {
+    // Solver level, 10 s of light wind: the cloth moves ~0.1 mm a step, and the models'
+    // equilibria differ by up to 8 mm (8×8 parts against the particles), so an instant
+    // switch moved it 1.6–11 mm in the switch step.
+    let model = |p: u32| match p {
+        0 => Model::MassSpring,
+        p => Model::Patches(PatchParams {
+            part_width: p,
+            part_height: p,
+            ..PatchParams::default()
+        }),
+    };
+    let shape = ClothShape::Grid {
+        width: 24,
+        height: 24,
+        spacing: 0.05,
+    };
+    let mut env = Environment::default();
+    env.wind.strength = 2e-4;
+    let frame = bevy::math::Affine3A::from_translation(Vec3::new(0.0, 2.0, 0.0));
+    for (from, to) in [(0, 2), (2, 4), (4, 8), (8, 4), (4, 2), (2, 0)] {
+        let params = ClothParams {
+            model: model(from),
+            ..ClothParams::default()
+        };
+        let build = || shape.build_solver(&Pins::TopRow, &params, frame).unwrap();
+        let (mut cloth, mut twin) = (build(), build());
+        for _ in 0..600 {
+            cloth.step(0.016, &env);
+            twin.step(0.016, &env);
+        }
+        let (a, b) = (cloth.positions().to_vec(), twin.positions().to_vec());
+        cloth
+            .set_params(&ClothParams {
+                model: model(to),
+                ..params
+            })
+            .unwrap();
+        cloth.step(0.016, &env);
+        twin.step(0.016, &env);
+        let switch = largest_move(&a, cloth.positions());
+        let normal = largest_move(&b, twin.positions());
+        println!(
+            "{from}→{to}: {:.3} mm in the switch step, {:.3} mm in the twin's",
+            switch * 1e3,
+            normal * 1e3
+        );
+        assert!(
+            switch <= normal * 1.05,
+            "{from}→{to}: {switch} m against {normal} m"
+        );
+    }
 }

@@ -7,8 +7,15 @@ use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingPa
 impl ClothSolver {
     /// Clears and accumulates the forces on every free particle: gravity (seed 002
     /// eq. 1.6), wind, linear drag `−c v` (seed 000 eq. 31) and the springs. Reads only the
-    /// old state, so the result does not depend on particle order (seed 000 §3.2).
+    /// old state, so the result does not depend on particle order (seed 000 §3.2). Just
+    /// after a model switch, the force that keeps the switch smooth (`switch.rs`).
     pub fn accumulate_forces(&mut self, env: &Environment) {
+        self.model_forces(env);
+        self.add_switch_force(env);
+    }
+
+    /// [`ClothSolver::accumulate_forces`] of the model alone.
+    fn model_forces(&mut self, env: &Environment) {
         if let Model::Patches(patch) = self.params.model {
             // External forces act on the part centres (one-way coupling, see patches.rs).
             self.pull_forces(env, &patch);

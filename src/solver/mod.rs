@@ -24,6 +24,7 @@ pub mod patches;
 pub mod shape_matching;
 mod state;
 mod substeps;
+mod switch;
 pub mod topology;
 mod xpbd;
 
@@ -100,6 +101,8 @@ pub struct ClothSolver {
     /// Set by everything from outside that can move a resting cloth (see
     /// [`ClothSolver::take_disturbed`]); what a sleeping cloth is woken by.
     disturbed: bool,
+    /// A model switch in progress (`switch.rs`).
+    switch: Option<switch::Switch>,
 }
 
 /// The active model's own state: none for mass-spring (or before the first step
@@ -213,6 +216,7 @@ impl ClothSolver {
             collider_bounds: Vec::new(),
             stencil,
             disturbed: true,
+            switch: None,
         };
         let seams = cloth.springs.ranges[SpringKind::Seam as usize].clone();
         cloth.seam_start = cloth.springs.rest_length[seams].to_vec();
@@ -232,6 +236,7 @@ impl ClothSolver {
     pub fn reset(&mut self) {
         self.disturbed = true;
         self.grab = None;
+        self.switch = None;
         match &mut self.model {
             ModelState::ShapeMatching(sm) => sm.reset(),
             // Rebuilt from the rest state by the next step.
@@ -287,6 +292,7 @@ impl ClothSolver {
     /// patch lattice's, derived from the cloth's validated ones).
     pub(crate) fn apply_params(&mut self, params: &ClothParams) {
         self.disturbed |= *params != self.params;
+        self.begin_switch(params);
         if params.node_mass != self.params.node_mass {
             for i in 0..self.particles.len() {
                 self.particles.mass[i] = params.node_mass * self.particles.lump[i];
@@ -521,7 +527,13 @@ impl ClothSolver {
                             self.frame,
                         )
                     {
-                        patches.adopt_state(&self.particles);
+                        patches.adopt_state(
+                            &self.particles,
+                            &self.pins,
+                            self.last_h,
+                            &patch,
+                            self.time > 0.0,
+                        );
                         patches.parts.set_colliders(self.colliders.iter().copied());
                         self.model = ModelState::Patches(Box::new(patches));
                     }

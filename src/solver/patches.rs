@@ -32,6 +32,9 @@ struct Anchor {
     pin: u32,
     /// Rest distance from the pinned particle to the part's centre.
     length: f32,
+    /// The distance at a switch into this model, faded to `length` with the targets'
+    /// offsets (a hanging cloth's top parts hang up to 5% farther than rest).
+    adopted: f32,
 }
 
 /// One part: a block of the particle grid.
@@ -74,6 +77,23 @@ pub struct Patches {
     /// `(part_width, part_height, targets)` these were built for (the targets decide how
     /// pins hold the lattice).
     pub(super) built_for: (u32, u32, PatchTargets),
+    /// After a switch into this model: each particle's offset from its target at the
+    /// switch, faded out over [`EASE_TIME`] (see [`Patches::adopt_state`]).
+    ease: Vec<Vec3>,
+    /// Seconds of the fade left (0: no offset).
+    ease_left: f32,
+}
+
+/// Seconds over which a cloth switched into the patch model goes from its own shape to
+/// the targets' (level of detail: a settled curtain's particles sit up to 8 mm off the
+/// bilinear shape of 8×8 parts, and the pull closed that in one step).
+pub const EASE_TIME: f32 = 0.5;
+
+/// The share of the switch offset left when `left` of [`EASE_TIME`] remains: smoothstep,
+/// so the targets start and end the fade at rest relative to the parts.
+pub(super) fn ease_share(left: f32) -> f32 {
+    let s = (left / EASE_TIME).clamp(0.0, 1.0);
+    s * s * (3.0 - 2.0 * s)
 }
 
 /// A grid cut into parts of `part_size` particles (smaller at a non-dividing edge), row
@@ -148,6 +168,7 @@ impl PartSplit {
                     part,
                     pin: slot as u32,
                     length: local_rest[k as usize].distance(self.centres[part as usize]),
+                    adopted: 0.0, // the fade's start, set by a switch (`adopt_state`)
                 });
             }
         }
@@ -277,13 +298,31 @@ impl Patches {
             anchors,
             rest_step,
             built_for: (patch.part_width, patch.part_height, patch.targets),
+            ease: Vec::new(),
+            ease_left: 0.0,
         })
     }
 
     /// Puts each part centre at the centre of mass of its particles' current state
     /// (position, previous position, velocity), so switching models mid-motion keeps the
-    /// cloth where it is.
-    pub fn adopt_state(&mut self, particles: &super::Particles) {
+    /// cloth where it is. `h`: the particles' last substep, the time between their
+    /// previous and current positions — Verlet's implicit velocity; the lattice rescales
+    /// it to its own substep in its next step (a switch from 5 to 10 substeps had doubled
+    /// the lattice's velocity: the switch step moved a curtain twice a normal step).
+    ///
+    /// When `ease` (a switch from a running cloth, not a cloth built at rest), the
+    /// targets then start at the particles' own shape and reach the model's over
+    /// [`EASE_TIME`], so the pull does not snap the particles into it in one step; so do
+    /// the pins' rods.
+    pub fn adopt_state(
+        &mut self,
+        particles: &super::Particles,
+        pins: &[u32],
+        h: f32,
+        patch: &PatchParams,
+        ease: bool,
+    ) {
+        self.parts.last_h = h;
         let w = self.grid.0;
         let parts = &mut self.parts.particles;
         for (k, part) in self.layout.iter().enumerate() {
@@ -298,13 +337,42 @@ impl Patches {
         }
         // Until the targets have moved once, each particle moves with its target.
         self.target_velocity.copy_from_slice(&particles.velocity);
+        self.ease_left = 0.0;
+        self.compute_targets(&particles.position, patch);
+        if !ease {
+            return;
+        }
+        self.ease = particles
+            .position
+            .iter()
+            .zip(&self.targets)
+            .map(|(x, t)| *x - *t)
+            .collect();
+        for anchor in &mut self.anchors {
+            let pin = particles.position[pins[anchor.pin as usize] as usize];
+            anchor.adopted = pin.distance(self.parts.particles.position[anchor.part as usize]);
+        }
+        self.ease_left = EASE_TIME;
+        self.add_ease();
+    }
+
+    /// Adds the switch offset's share left to the targets.
+    fn add_ease(&mut self) {
+        if self.ease_left <= 0.0 {
+            return;
+        }
+        let share = ease_share(self.ease_left);
+        for (target, offset) in self.targets.iter_mut().zip(&self.ease) {
+            *target += *offset * share;
+        }
     }
 
     /// Recomputes the targets after a substep of `h` and their velocities `(t' − t)/h`.
     /// Allocates nothing.
     pub fn advance_targets(&mut self, x: &[Vec3], patch: &PatchParams, h: f32) {
         let inv_h = 1.0 / h;
-        if self.bilinear(patch) {
+        self.ease_left = (self.ease_left - h).max(0.0);
+        if self.bilinear(patch) && self.ease_left <= 0.0 {
             // One pass: each new target and its velocity together.
             let c = &self.parts.particles.position;
             let pieces = self
@@ -340,14 +408,16 @@ impl Patches {
     pub fn hold_parts(&mut self, pin_at: impl Fn(usize) -> Vec3, h: f32) {
         const SWEEPS: usize = 4;
         let p = &mut self.parts.particles;
+        let share = ease_share(self.ease_left);
         for _ in 0..SWEEPS {
             for anchor in &self.anchors {
                 let k = anchor.part as usize;
                 let pin = pin_at(anchor.pin as usize);
                 let d = p.position[k] - pin;
                 let len = d.length();
+                let length = anchor.length + (anchor.adopted - anchor.length) * share;
                 let goal = if len > f32::EPSILON {
-                    pin + d * (anchor.length / len)
+                    pin + d * (length / len)
                 } else {
                     pin
                 };
@@ -356,6 +426,15 @@ impl Patches {
                 p.velocity[k] += delta / h;
             }
         }
+    }
+
+    /// `value(i)` summed over each part's particles, per part.
+    pub fn part_sums(&self, value: impl Fn(usize) -> Vec3) -> Vec<Vec3> {
+        let w = self.grid.0;
+        self.layout
+            .iter()
+            .map(|part| part_particles(part, w).map(&value).sum())
+            .collect()
     }
 
     /// The part holding particle `i`.
@@ -403,14 +482,15 @@ impl Patches {
             for (target, stencil) in self.targets.iter_mut().zip(&self.stencil) {
                 *target = bilinear_at(c, stencil);
             }
-            return;
-        }
-        let (nx, ny) = self.part_grid;
-        for py in 0..ny {
-            for px in 0..nx {
-                self.place_part_targets(px, py, x, patch);
+        } else {
+            let (nx, ny) = self.part_grid;
+            for py in 0..ny {
+                for px in 0..nx {
+                    self.place_part_targets(px, py, x, patch);
+                }
             }
         }
+        self.add_ease();
     }
 
     /// The seed's targets (§3.4 pseudocode) of the particles of part `(px, py)`.
