@@ -192,8 +192,13 @@ fn bad_input_exits_2_with_one_line_naming_the_problem() {
 /// rewrites them; the commit then says why.
 #[test]
 fn golden_dumps_of_the_scenes_are_unchanged() {
-    let cases: [(&str, &str, &[&str]); 5] = [
+    let cases: [(&str, &str, &[&str]); 6] = [
         ("curtain", "assets/scenes/curtain.ron", &[]),
+        (
+            "curtain_mass_spring",
+            "assets/scenes/curtain.ron",
+            &["--model", "mass-spring"],
+        ),
         (
             "curtain_patches",
             "assets/scenes/curtain.ron",

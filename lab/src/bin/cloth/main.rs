@@ -1009,16 +1009,13 @@ fn choose(args: ChooseArgs) -> Result<(), String> {
             scene.cloths.len()
         ));
     };
-    // The reference is the cloth's springs as mass-spring, whatever model it runs now.
-    let mut reference_scene = scene.clone();
-    reference_scene.cloths[args.cloth].cloth.params.model = Model::MassSpring;
     let name = if entry.name.is_empty() {
         format!("cloth {}", args.cloth)
     } else {
         entry.name.clone()
     };
-    let case =
-        Case::new(&name, &reference_scene, args.cloth, args.seconds).map_err(|e| e.to_string())?;
+    // The reference is the cloth's springs as mass-spring, whatever model it runs now.
+    let case = Case::new(&name, &scene, args.cloth, args.seconds).map_err(|e| e.to_string())?;
     // Every configuration that applies: the patch model needs a grid.
     let grid = matches!(entry.cloth.shape, ClothShape::Grid { .. });
     let configs: Vec<_> = accuracy::configs(&case.base())
