@@ -213,7 +213,7 @@ fn panel(
                 });
                 let mut step_ms = time.timestep().as_secs_f32() * 1e3;
                 if ui
-                    .add(egui::Slider::new(&mut step_ms, 4.0..=33.0).text("fixed step, ms"))
+                    .add(slider(&mut step_ms, 4.0..=33.0).text("fixed step, ms"))
                     .changed()
                 {
                     time.set_timestep_seconds(step_ms as f64 / 1e3);
@@ -280,14 +280,9 @@ fn panel(
                 }
                 let mut edited = *light;
                 ui.collapsing("Light", |ui| {
-                    ui.add(egui::Slider::new(&mut edited.yaw, -180.0..=180.0).text("direction, °"));
-                    ui.add(
-                        egui::Slider::new(&mut edited.elevation, 5.0..=90.0).text("elevation, °"),
-                    );
-                    ui.add(
-                        egui::Slider::new(&mut edited.illuminance, 0.0..=30_000.0)
-                            .text("intensity, lux"),
-                    );
+                    ui.add(slider(&mut edited.yaw, -180.0..=180.0).text("direction, °"));
+                    ui.add(slider(&mut edited.elevation, 5.0..=90.0).text("elevation, °"));
+                    ui.add(slider(&mut edited.illuminance, 0.0..=30_000.0).text("intensity, lux"));
                 });
                 if edited != *light {
                     *light = edited;
@@ -313,7 +308,7 @@ fn family(ui: &mut egui::Ui, name: &str, family: &mut SpringFamily, rigid: bool)
             return;
         }
         ui.add(
-            egui::Slider::new(&mut family.stiffness, 0.0..=25_000.0)
+            slider(&mut family.stiffness, 0.0..=25_000.0)
                 .logarithmic(true)
                 .text("N/m"),
         );
@@ -325,7 +320,7 @@ fn spring_controls(ui: &mut egui::Ui, springs: &mut SpringParams, rigid: bool) {
     family(ui, "shear", &mut springs.shear, rigid);
     family(ui, "bend", &mut springs.bend, rigid);
     family(ui, "diag. bend", &mut springs.bend_diagonal, rigid);
-    ui.add(egui::Slider::new(&mut springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
+    ui.add(slider(&mut springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
 }
 
 fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
@@ -335,16 +330,16 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
         spacing,
     } = &mut cloth.shape
     {
-        ui.add(egui::Slider::new(width, 2..=256).text("width (rebuilds)"));
-        ui.add(egui::Slider::new(height, 2..=256).text("height (rebuilds)"));
+        ui.add(slider(width, 2..=256).text("width (rebuilds)"));
+        ui.add(slider(height, 2..=256).text("height (rebuilds)"));
         ui.add(
-            egui::Slider::new(spacing, 0.005..=0.5)
+            slider(spacing, 0.005..=0.5)
                 .logarithmic(true)
                 .text("spacing, m"),
         );
     }
     if let ClothShape::Garment { resolution, .. } = &mut cloth.shape {
-        ui.add(egui::Slider::new(resolution, 1..=4).text("resolution (rebuilds)"));
+        ui.add(slider(resolution, 1..=4).text("resolution (rebuilds)"));
     }
     egui::ComboBox::from_label("pins")
         .selected_text(format!("{:?}", cloth.pins))
@@ -356,7 +351,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
     let p = &mut cloth.params;
     let mut grams = p.node_mass * 1e3;
     ui.add(
-        egui::Slider::new(&mut grams, 0.001..=1.0)
+        slider(&mut grams, 0.001..=1.0)
             .logarithmic(true)
             .text("node mass, g"),
     );
@@ -376,7 +371,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
         model @ (Model::MassSpring | Model::Xpbd(_)) => {
             let rigid = if let Model::Xpbd(xpbd) = model {
                 ui.add(
-                    egui::Slider::new(&mut xpbd.max_stretch_error, 0.001..=0.1)
+                    slider(&mut xpbd.max_stretch_error, 0.001..=0.1)
                         .logarithmic(true)
                         .text("stretch error target (auto substeps)"),
                 );
@@ -388,29 +383,25 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             if garment {
                 let s = &mut p.springs;
                 family(ui, "seam", &mut s.seam, rigid);
-                ui.add(
-                    egui::Slider::new(&mut s.seam_rest_length, 0.0..=0.05).text("seam length, m"),
-                );
-                ui.add(egui::Slider::new(&mut s.sew_time, 0.0..=10.0).text("sewing time, s"));
+                ui.add(slider(&mut s.seam_rest_length, 0.0..=0.05).text("seam length, m"));
+                ui.add(slider(&mut s.sew_time, 0.0..=10.0).text("sewing time, s"));
             }
         }
         Model::ShapeMatching(sm) => shape_matching_controls(ui, sm),
         Model::Patches(patch) => {
-            ui.add(egui::Slider::new(&mut patch.part_width, 1..=16).text("part width"));
-            ui.add(egui::Slider::new(&mut patch.part_height, 1..=16).text("part height"));
+            ui.add(slider(&mut patch.part_width, 1..=16).text("part width"));
+            ui.add(slider(&mut patch.part_height, 1..=16).text("part height"));
             ui.add(
-                egui::Slider::new(&mut patch.stiffness, 0.01..=100.0)
+                slider(&mut patch.stiffness, 0.01..=100.0)
                     .logarithmic(true)
                     .text("pull α, N/m"),
             );
-            ui.add(egui::Slider::new(&mut patch.exponent, 0.5..=3.0).text("exponent p"));
+            ui.add(slider(&mut patch.exponent, 0.5..=3.0).text("exponent p"));
             ui.add(
-                egui::Slider::new(&mut patch.particle_damping_ratio, 0.0..=2.0)
+                slider(&mut patch.particle_damping_ratio, 0.0..=2.0)
                     .text("particle damping (× critical)"),
             );
-            ui.add(
-                egui::Slider::new(&mut patch.part_damping, 0.0..=0.01).text("part damping, N·s/m"),
-            );
+            ui.add(slider(&mut patch.part_damping, 0.0..=0.01).text("part damping, N·s/m"));
             egui::ComboBox::from_label("targets")
                 .selected_text(format!("{:?}", patch.targets))
                 .show_ui(ui, |ui| {
@@ -437,7 +428,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             spring_controls(ui, &mut p.springs, false);
         }
     }
-    ui.add(egui::Slider::new(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));
+    ui.add(slider(&mut p.drag, 0.0..=0.01).text("drag, N·s/m"));
     egui::ComboBox::from_label("integrator")
         .selected_text(format!("{:?}", p.integrator))
         .show_ui(ui, |ui| {
@@ -455,21 +446,34 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             (Substeps::Fixed(_), true) => p.substeps = Substeps::default(),
             (Substeps::Auto { .. }, false) => p.substeps = Substeps::Fixed(8),
             (Substeps::Fixed(n), false) => {
-                ui.add(egui::Slider::new(n, 1..=256).logarithmic(true));
+                ui.add(slider(n, 1..=256).logarithmic(true));
             }
             (Substeps::Auto { max }, true) => {
-                ui.add(
-                    egui::Slider::new(max, 1..=16_384)
-                        .logarithmic(true)
-                        .text("max"),
-                );
+                ui.add(slider(max, 1..=16_384).logarithmic(true).text("max"));
             }
         }
     });
     optional(ui, "strain limit", &mut p.strain_limit, 0.1, 0.01..=1.0);
     // XPBD applies the limit inside its one projection per substep: no sweeps to set.
     if !matches!(p.model, Model::Xpbd(_)) {
-        ui.add(egui::Slider::new(&mut p.strain_limit_iterations, 0..=16).text("limit sweeps"));
+        // Fixed sweeps, or sweeps until every spring is within a tolerance of the limit
+        // (at most that many).
+        optional(
+            ui,
+            "sweep until within",
+            &mut p.strain_limit_tolerance,
+            1e-4,
+            1e-6..=1e-2,
+        );
+        let label = match p.strain_limit_tolerance {
+            Some(_) => "most limit sweeps",
+            None => "limit sweeps",
+        };
+        ui.add(
+            slider(&mut p.strain_limit_iterations, 0..=1000)
+                .logarithmic(true)
+                .text(label),
+        );
     }
     optional(ui, "tear ratio", &mut p.tear_ratio, 2.0, 1.05..=10.0);
 }
@@ -502,20 +506,30 @@ fn shape_matching_controls(ui: &mut egui::Ui, sm: &mut ShapeMatchingParams) {
         GoalUpdate::Force => {
             sm.stiffness = sm.stiffness.max(0.0);
             ui.add(
-                egui::Slider::new(&mut sm.stiffness, 0.0..=100.0)
+                slider(&mut sm.stiffness, 0.0..=100.0)
                     .logarithmic(true)
                     .text("α, N/m"),
             );
-            ui.add(egui::Slider::new(&mut sm.exponent, 0.5..=3.0).text("exponent p"));
+            ui.add(slider(&mut sm.exponent, 0.5..=3.0).text("exponent p"));
         }
         GoalUpdate::Velocity => {
             sm.stiffness = sm.stiffness.clamp(0.0, 1.0);
-            ui.add(egui::Slider::new(&mut sm.stiffness, 0.0..=1.0).text("α per substep"));
+            ui.add(slider(&mut sm.stiffness, 0.0..=1.0).text("α per substep"));
         }
     }
-    ui.add(egui::Slider::new(&mut sm.damping, 0.0..=0.001).text("particle damping, N·s/m"));
-    ui.add(egui::Slider::new(&mut sm.beta, 0.0..=1.0).text("β (linear deformation)"));
-    ui.add(egui::Slider::new(&mut sm.clusters, 1..=8).text("clusters k×k"));
+    ui.add(slider(&mut sm.damping, 0.0..=0.001).text("particle damping, N·s/m"));
+    ui.add(slider(&mut sm.beta, 0.0..=1.0).text("β (linear deformation)"));
+    ui.add(slider(&mut sm.clusters, 1..=8).text("clusters k×k"));
+}
+
+/// A slider that keeps a value loaded from outside its range (a scene file's 500 limiter
+/// sweeps) until the user edits it: egui clamps existing values by default, which changed
+/// a scene's parameters just by showing them.
+fn slider<N: egui::emath::Numeric>(
+    value: &mut N,
+    range: std::ops::RangeInclusive<N>,
+) -> egui::Slider<'_> {
+    egui::Slider::new(value, range).clamping(egui::SliderClamping::Edits)
 }
 
 fn optional(
@@ -530,7 +544,7 @@ fn optional(
         ui.checkbox(&mut on, name);
         match (on, value.as_mut()) {
             (true, Some(v)) => {
-                ui.add(egui::Slider::new(v, range));
+                ui.add(slider(v, range).logarithmic(true));
             }
             (true, None) => *value = Some(default),
             (false, _) => *value = None,
@@ -555,8 +569,8 @@ fn look_controls(ui: &mut egui::Ui, look: &mut ClothLook, pieces: &[&str]) {
                 ui.color_edit_button_rgb(color);
             });
         }
-        ui.add(egui::Slider::new(&mut look.diffuse, 0.0..=1.0).text("diffuse k_d"));
-        ui.add(egui::Slider::new(&mut look.specular, 0.0..=1.0).text("specular k_s"));
+        ui.add(slider(&mut look.diffuse, 0.0..=1.0).text("diffuse k_d"));
+        ui.add(slider(&mut look.specular, 0.0..=1.0).text("specular k_s"));
     });
 }
 
@@ -564,13 +578,13 @@ fn environment_controls(ui: &mut egui::Ui, env: &mut Environment) {
     ui.heading("Environment");
     ui.horizontal(|ui| {
         ui.checkbox(&mut env.gravity_enabled, "gravity");
-        ui.add(egui::Slider::new(&mut env.gravity.y, -30.0..=0.0).text("m/s²"));
+        ui.add(slider(&mut env.gravity.y, -30.0..=0.0).text("m/s²"));
     });
     let w = &mut env.wind;
-    ui.add(egui::Slider::new(&mut w.strength, 0.0..=0.02).text("wind, N per particle"));
+    ui.add(slider(&mut w.strength, 0.0..=0.02).text("wind, N per particle"));
     let mut heading = w.direction.x.atan2(w.direction.z).to_degrees();
     if ui
-        .add(egui::Slider::new(&mut heading, -180.0..=180.0).text("wind direction, °"))
+        .add(slider(&mut heading, -180.0..=180.0).text("wind direction, °"))
         .changed()
     {
         let h = heading.to_radians();
