@@ -33,6 +33,21 @@ pub enum ClothError {
         /// The largest particle count allowed.
         limit: usize,
     },
+    /// A step's work (particles × substeps, or × fixed limiter sweeps) over its limit
+    /// (see [`crate::limits`]).
+    #[error(
+        "`{field}`: {particles} particles × {per_particle} per step is over the limit of {limit} (limits.rs; fewer substeps or sweeps, or a smaller cloth)"
+    )]
+    TooMuchWork {
+        /// The field to lower.
+        field: &'static str,
+        /// Particles of the cloth.
+        particles: usize,
+        /// Substeps (or substeps × sweeps) per step.
+        per_particle: u64,
+        /// The limit.
+        limit: u64,
+    },
     /// A pin names a particle that does not exist.
     #[error("pin index {index} is out of range: the cloth has {count} particles")]
     PinOutOfRange {

@@ -37,6 +37,7 @@ pub mod ecs;
 pub mod error;
 pub mod headless;
 pub mod layout;
+pub mod limits;
 pub mod params;
 pub mod scene;
 pub mod solver;

@@ -3,6 +3,7 @@
 //! Everything here is `Reflect` (so the inspector can edit it) and `serde` (so scene
 //! files can hold it). Nothing here knows about the ECS.
 
+use crate::limits::{MAX_LIMITER_SWEEPS, MAX_SUBSTEPS};
 use bevy::math::Vec3;
 use bevy::reflect::Reflect;
 use serde::{Deserialize, Serialize};
@@ -640,7 +641,28 @@ impl ClothParams {
                     expected: "at least 1 substep",
                 });
             }
+            Substeps::Fixed(n) if n > MAX_SUBSTEPS => {
+                return Err(ClothError::InvalidParameter {
+                    field: "substeps",
+                    value: n as f32,
+                    expected: "at most 65,536 substeps (limits::MAX_SUBSTEPS)",
+                });
+            }
+            Substeps::Auto { max } if max > MAX_SUBSTEPS => {
+                return Err(ClothError::InvalidParameter {
+                    field: "substeps.max",
+                    value: max as f32,
+                    expected: "at most 65,536 substeps (limits::MAX_SUBSTEPS)",
+                });
+            }
             _ => {}
+        }
+        if self.strain_limit_iterations > MAX_LIMITER_SWEEPS {
+            return Err(ClothError::InvalidParameter {
+                field: "strain_limit_iterations",
+                value: self.strain_limit_iterations as f32,
+                expected: "at most 1,024 sweeps (limits::MAX_LIMITER_SWEEPS)",
+            });
         }
         if let Some(limit) = self.strain_limit {
             check("strain_limit", limit, limit > 0.0, "a strain limit > 0")?;

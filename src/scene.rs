@@ -217,7 +217,7 @@ impl ClothScene {
     /// Reads and checks a scene file.
     pub fn load(path: impl AsRef<Path>) -> Result<Self, SceneError> {
         let file = path.as_ref().to_path_buf();
-        let text = std::fs::read_to_string(&file).map_err(|source| SceneError::Io {
+        let text = crate::limits::read_text(&file).map_err(|source| SceneError::Io {
             file: file.clone(),
             source,
         })?;
@@ -454,7 +454,7 @@ fn set_by_path(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), 
 fn error_field(e: &crate::error::ClothError) -> &'static str {
     use crate::error::ClothError::*;
     match e {
-        InvalidParameter { field, .. } => field,
+        InvalidParameter { field, .. } | TooMuchWork { field, .. } => field,
         GridTooSmall { .. } | GridTooLarge { .. } => "shape",
         PinOutOfRange { .. } => "pins",
         BadMesh { .. }

@@ -257,6 +257,7 @@ fn broken_garments_name_the_file_and_what_is_wrong() {
     let patterns = |name: &str| match name {
         "a.txt" => Pattern::parse(b"111\n111\n", "a.txt"),
         "bad.txt" => Pattern::parse(b"111\n1x1\n", "bad.txt"),
+        "hole.txt" => Pattern::parse(b"101\n111\n", "hole.txt"),
         _ => Err(Pattern::parse(b"", name).unwrap_err()),
     };
     let garment = |seams: &str, pattern: &str| {
@@ -290,7 +291,21 @@ fn broken_garments_name_the_file_and_what_is_wrong() {
         &ok.replace("(0, 0), to: (2, 0)), b", "(0, 1), to: (2, 3)), b"),
         "a.txt",
     ));
-    assert!(m.contains("is not in the pattern"), "{m}");
+    assert!(
+        m.contains("`to` (2, 3) is outside piece `a` (3×2 nodes"),
+        "{m}"
+    );
+    // A run far outside its piece is refused before its nodes are listed.
+    let m = message(garment(
+        &ok.replace("to: (2, 0)), b", "to: (4294967295, 0)), b"),
+        "a.txt",
+    ));
+    assert!(
+        m.contains("`to` (4294967295, 0) is outside piece `a`"),
+        "{m}"
+    );
+    // Inside the piece but on a 0 of its pattern.
+    assert!(message(garment(ok, "hole.txt")).contains("node (1, 0) of `b` is not in the pattern"));
     let m = message(garment(
         &ok.replace("piece: \"b\"", "piece: \"c\""),
         "a.txt",

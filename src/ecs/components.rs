@@ -74,7 +74,12 @@ impl Cloth {
     /// particle count).
     pub fn validate(&self) -> Result<(), ClothError> {
         self.shape.validate()?;
-        self.params.validate()
+        self.params.validate()?;
+        // A grid's work per step is known from its size (the others' when built).
+        if let ClothShape::Grid { width, height, .. } = self.shape {
+            crate::limits::check_work(width as usize * height as usize, &self.params)?;
+        }
+        Ok(())
     }
 
     /// A garment from a garment file under `assets/` (see [`crate::layout::garment`]), at

@@ -16,8 +16,7 @@ use std::path::Path;
 
 use thiserror::Error;
 
-/// The most grid nodes (present or not) one pattern may have.
-pub const MAX_PATTERN_NODES: usize = 1_000_000;
+pub use crate::limits::MAX_PATTERN_NODES;
 
 /// A garment piece: which nodes of a `width × height` grid carry a mass.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -106,7 +105,7 @@ impl Pattern {
     /// Reads and parses a pattern file.
     pub fn load(path: &Path) -> Result<(Pattern, Vec<PatternWarning>), PatternError> {
         let file = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|e| PatternError {
+        let bytes = crate::limits::read_file(path).map_err(|e| PatternError {
             file: file.clone(),
             line: 1,
             column: 1,

@@ -10,9 +10,7 @@ use bevy::math::Vec3;
 use super::topology::{self, SpringKind};
 use crate::error::ClothError;
 
-/// The most particles one cloth may have (4,194,304): checked before anything of that
-/// size is allocated.
-pub const MAX_PARTICLES: usize = 1 << 22;
+pub use crate::limits::MAX_PARTICLES;
 
 /// Resolved plain data of a cloth, in its own (local) frame.
 #[derive(Clone, Debug, Default, PartialEq)]

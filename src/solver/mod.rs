@@ -171,6 +171,7 @@ impl ClothSolver {
         let pin_indices = pins.to_vec();
         params.validate()?;
         check_model_fits(params, grid)?;
+        crate::limits::check_work(count, params)?;
         let springs = Springs::from_pairs(pairs, &local);
         let stencil =
             grid.and_then(|(w, _)| lattice::Stencil::new(&springs, w as usize, local.len()));
@@ -284,6 +285,7 @@ impl ClothSolver {
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
         check_model_fits(params, self.grid)?;
+        crate::limits::check_work(self.particles.len(), params)?;
         self.apply_params(params);
         Ok(())
     }
@@ -381,8 +383,9 @@ impl ClothSolver {
                 } else {
                     self.refresh_substep_cache(dt)
                 };
-                self.under_resolved = needed > max;
-                needed.clamp(1, max.max(1))
+                let cap = crate::limits::auto_substeps_cap(self.particles.len(), max);
+                self.under_resolved = needed > cap;
+                needed.clamp(1, cap)
             }
         };
         self.substeps = n;

@@ -37,8 +37,7 @@ use crate::solver::{Layout, SpringKind};
 mod asset;
 pub use asset::{Garment, GarmentLoader};
 
-/// The finest resolution a garment may be rescaled to.
-pub const MAX_RESOLUTION: u32 = 64;
+pub use crate::limits::MAX_RESOLUTION;
 
 /// A garment file as written.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -148,7 +147,7 @@ impl GarmentLayout {
     /// divides the spacing by n and keeps the outline, see [`Pattern::rescale`]).
     pub fn load(path: &Path, resolution: u32) -> Result<GarmentLayout, ClothError> {
         let name = path.display().to_string();
-        let text = std::fs::read_to_string(path).map_err(|e| ClothError::Garment {
+        let text = crate::limits::read_text(path).map_err(|e| ClothError::Garment {
             file: name.clone(),
             line: 1,
             column: 1,
@@ -201,9 +200,33 @@ impl GarmentLayout {
             }
             let (pattern, warnings) = read_pattern(&piece.pattern)?;
             layout.warnings.extend(warnings);
+            // The refined grid's size before it is allocated.
+            let refined = |n: u32| (n as u64 - 1) * resolution as u64 + 1;
+            let nodes = refined(pattern.width) * refined(pattern.height);
+            if nodes > crate::limits::MAX_PATTERN_NODES as u64 {
+                return Err(error(
+                    &format!("\"{}\"", piece.name),
+                    format!(
+                        "piece `{}` at resolution {resolution} has {nodes} grid nodes, more than the limit of {} (limits.rs)",
+                        piece.name,
+                        crate::limits::MAX_PATTERN_NODES
+                    ),
+                ));
+            }
             let pattern = pattern.rescale(resolution);
             let start = layout.positions.len() as u32;
             let index = add_piece(&mut layout, &pattern, piece, spacing);
+            if layout.positions.len() > crate::solver::MAX_PARTICLES {
+                return Err(error(
+                    &format!("\"{}\"", piece.name),
+                    format!(
+                        "{} particles up to piece `{}` is more than the limit of {} (limits.rs)",
+                        layout.positions.len(),
+                        piece.name,
+                        crate::solver::MAX_PARTICLES
+                    ),
+                ));
+            }
             layout
                 .pieces
                 .push((piece.name.clone(), start..layout.positions.len() as u32));
@@ -215,15 +238,6 @@ impl GarmentLayout {
                 .springs
                 .extend(pairs.iter().map(|p| (SpringKind::Seam, p[0], p[1])));
             layout.seams.push((seam.name.clone(), pairs));
-        }
-        if layout.positions.len() > crate::solver::MAX_PARTICLES {
-            return Err(error(
-                "pieces",
-                format!(
-                    "{} particles is more than the limit",
-                    layout.positions.len()
-                ),
-            ));
         }
         Ok(layout)
     }
@@ -284,8 +298,8 @@ fn seam_pairs(
             ));
         };
         let (pattern, index) = &grids[p];
-        let nodes =
-            edge_nodes(edge, resolution).map_err(|m| error(&needle, format!("{label}: {m}")))?;
+        let nodes = edge_nodes(edge, resolution, pattern)
+            .map_err(|m| error(&needle, format!("{label}: {m}")))?;
         let mut particles = Vec::with_capacity(nodes.len());
         for (c, r) in nodes {
             if !pattern.has(c as i64, r as i64) {
@@ -396,8 +410,13 @@ fn add_piece(
 }
 
 /// The grid nodes of a seam edge at `resolution`, from `from` to `to` inclusive: a row, a
-/// column or a 45° diagonal.
-fn edge_nodes(edge: &SeamEdge, resolution: u32) -> Result<Vec<(u32, u32)>, String> {
+/// column or a 45° diagonal, both ends inside the (refined) `pattern`'s grid — checked
+/// before the run is listed, so a run cannot be longer than the piece.
+fn edge_nodes(
+    edge: &SeamEdge,
+    resolution: u32,
+    pattern: &Pattern,
+) -> Result<Vec<(u32, u32)>, String> {
     let f = resolution as i64;
     let (c0, r0) = (edge.from.0 as i64 * f, edge.from.1 as i64 * f);
     let (c1, r1) = (edge.to.0 as i64 * f, edge.to.1 as i64 * f);
@@ -407,6 +426,17 @@ fn edge_nodes(edge: &SeamEdge, resolution: u32) -> Result<Vec<(u32, u32)>, Strin
             "edge {:?}→{:?} on `{}` is not along a row, a column or a 45° diagonal",
             edge.from, edge.to, edge.piece
         ));
+    }
+    let inside = |c: i64, r: i64| c < pattern.width as i64 && r < pattern.height as i64;
+    for (end, (c, r), at) in [("from", (c0, r0), edge.from), ("to", (c1, r1), edge.to)] {
+        if !inside(c, r) {
+            return Err(format!(
+                "`{end}` {at:?} is outside piece `{}` ({}×{} nodes at resolution 1)",
+                edge.piece,
+                (pattern.width as i64 - 1) / f + 1,
+                (pattern.height as i64 - 1) / f + 1
+            ));
+        }
     }
     let n = dc.abs().max(dr.abs());
     Ok((0..=n)

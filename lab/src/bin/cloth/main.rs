@@ -6,6 +6,36 @@
 //! draws the chart to a PNG and an SVG beside it. Bad input exits with code 2 and a
 //! one-line message naming the file, line and field; nothing panics on user input.
 
+/// `println!` that exits quietly when stdout is closed (`cloth run … | head -3`) instead
+/// of panicking as std's does; defined before the modules so that they use it too.
+macro_rules! println {
+    () => {
+        crate::out(format_args!("\n"))
+    };
+    ($($arg:tt)*) => {
+        crate::out(format_args!("{}\n", format_args!($($arg)*)))
+    };
+}
+
+/// Writes to stdout; a closed pipe ends the program quietly (exit 0: the reader had what
+/// it wanted), any other failure with exit code 2.
+fn out(args: std::fmt::Arguments) {
+    if let Err(e) = std::io::stdout().write_fmt(args) {
+        if e.kind() == std::io::ErrorKind::BrokenPipe {
+            std::process::exit(0);
+        }
+        eprintln!("error: stdout: {e}");
+        std::process::exit(2);
+    }
+}
+
+/// `print!` through [`out`], as `println!` above.
+macro_rules! print {
+    ($($arg:tt)*) => {
+        crate::out(format_args!($($arg)*))
+    };
+}
+
 mod charts;
 
 use std::io::Write;
@@ -65,11 +95,11 @@ struct ChooseArgs {
     /// The largest cost per step, ms: picks the most accurate configuration within it.
     #[arg(long = "budget-ms", value_parser = positive)]
     budget_ms: Option<f32>,
-    /// Simulated seconds per run.
-    #[arg(long, default_value_t = 3.0, value_parser = positive)]
+    /// Simulated seconds per run (at most 3,600).
+    #[arg(long, default_value_t = 3.0, value_parser = seconds)]
     seconds: f32,
     /// Timed runs per configuration.
-    #[arg(long, default_value_t = 3, value_parser = at_least_one)]
+    #[arg(long, default_value_t = 3, value_parser = repeats)]
     repeats: usize,
     /// Writes a copy of the scene with the chosen configuration to FILE (RON).
     #[arg(long, value_name = "FILE")]
@@ -83,8 +113,8 @@ struct ChooseArgs {
 struct RunArgs {
     /// The scene file (RON).
     scene: String,
-    /// Steps to run.
-    #[arg(long, default_value_t = 300)]
+    /// Steps to run (at most 10,000,000; streamed, nothing is allocated per step).
+    #[arg(long, default_value_t = 300, value_parser = steps)]
     steps: usize,
     /// Replaces every cloth's model: mass-spring, shape-matching, patches or xpbd.
     #[arg(long, value_parser = model_kind)]
@@ -116,14 +146,14 @@ struct Output {
 
 #[derive(Args)]
 struct BenchArgs {
-    /// The largest particle count.
-    #[arg(long, default_value_t = 65_536)]
+    /// The largest particle count (at most 1,048,576).
+    #[arg(long, default_value_t = 65_536, value_parser = particles)]
     max: usize,
     /// Slika 23's models and `x` (XPBD), comma separated (all when absent).
     #[arg(long, value_delimiter = ',', value_parser = seed_model)]
     models: Vec<&'static str>,
     /// Timed steps per cell (5 from 16,384 particles up).
-    #[arg(long, default_value_t = 15, value_parser = at_least_one)]
+    #[arg(long, default_value_t = 15, value_parser = repeats)]
     repeats: usize,
     /// Also runs seed 002's experiment with the full app.
     #[arg(long)]
@@ -144,11 +174,11 @@ struct AccuracyArgs {
     /// The scenes, comma separated: curtain, curtain-wind, card (all when absent).
     #[arg(long, value_delimiter = ',', value_parser = accuracy_scene)]
     scenes: Vec<&'static str>,
-    /// Simulated seconds per run.
-    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true, value_parser = positive)]
+    /// Simulated seconds per run (at most 3,600).
+    #[arg(long, default_value_t = 3.0, allow_negative_numbers = true, value_parser = seconds)]
     seconds: f32,
     /// Timed runs per configuration.
-    #[arg(long, default_value_t = 5, value_parser = at_least_one)]
+    #[arg(long, default_value_t = 5, value_parser = repeats)]
     repeats: usize,
     #[command(flatten)]
     output: Output,
@@ -203,6 +233,38 @@ fn at_least_one(text: &str) -> Result<usize, String> {
         Ok(n) if n >= 1 => Ok(n),
         _ => Err(format!("`{text}` is not a whole number of at least 1")),
     }
+}
+
+/// A whole number from 1 to `limit` (`what` names the limit in `limits.rs`).
+fn count_within(text: &str, limit: usize, what: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if (1..=limit).contains(&n) => Ok(n),
+        _ => Err(format!(
+            "`{text}` is not a whole number from 1 to {limit} (limits::{what})"
+        )),
+    }
+}
+
+fn steps(text: &str) -> Result<usize, String> {
+    count_within(text, bevy_cloth::limits::MAX_STEPS, "MAX_STEPS")
+}
+
+fn repeats(text: &str) -> Result<usize, String> {
+    count_within(text, bevy_cloth::limits::MAX_REPEATS, "MAX_REPEATS")
+}
+
+fn particles(text: &str) -> Result<usize, String> {
+    count_within(text, bevy_cloth::limits::MAX_PARTICLES, "MAX_PARTICLES")
+}
+
+fn seconds(text: &str) -> Result<f32, String> {
+    let (seconds, limit) = (positive(text)?, bevy_cloth::limits::MAX_SECONDS);
+    if seconds > limit {
+        return Err(format!(
+            "`{text}` is more than {limit} s (limits::MAX_SECONDS)"
+        ));
+    }
+    Ok(seconds)
 }
 
 fn positive(text: &str) -> Result<f32, String> {
@@ -282,7 +344,13 @@ fn run(args: RunArgs) -> Result<(), String> {
     for spec in &args.set {
         scene.apply_override(spec).map_err(|e| e.to_string())?;
     }
-    let (steps, every) = (args.steps, args.every);
+    let (steps, every, timestep) = (args.steps, args.every, scene.timestep);
+    // The solver's clock (its substeps' sum); a scene with no cloths has only the steps.
+    let clock = |step: usize, cloths: &[(String, solver::ClothSolver)]| {
+        cloths
+            .first()
+            .map_or(step as f32 * timestep, |(_, cloth)| cloth.time())
+    };
     let mut run = SceneRun::new(&scene).map_err(|e| format!("{scene_path}: {e}"))?;
     let mut dump = match &args.dump {
         Some(path) => Some(Dump::new(path)?),
@@ -296,7 +364,7 @@ fn run(args: RunArgs) -> Result<(), String> {
         if let Some(d) = &mut dump
             && step % every == 0
             && dump_error.is_none()
-            && let Err(e) = d.frame(step, cloths[0].1.time(), cloths)
+            && let Err(e) = d.frame(step, clock(step, cloths), cloths)
         {
             dump_error = Some(e);
         }
@@ -306,6 +374,13 @@ fn run(args: RunArgs) -> Result<(), String> {
     }
     if let Some(d) = dump {
         d.finish()?;
+    }
+    for cloth in summary.cloths.iter().filter(|c| c.under_resolved) {
+        eprintln!(
+            "warning: `{}` needed more automatic substeps than its cap (substeps.max, or \
+             limits::MAX_WORK_PER_STEP for its {} particles): it ran at {} and may be unstable",
+            cloth.name, cloth.particles, cloth.substeps
+        );
     }
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
     println!("{json}");

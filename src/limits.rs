@@ -1,0 +1,113 @@
+//! Every limit on a size, count or repetition that comes from a file, a flag or the
+//! inspector, in one place (README, *Limits*). Each is checked before anything it sizes is
+//! allocated or looped over, so bad input is refused in well under a second with a bounded
+//! amount of memory.
+
+/// Particles in one cloth (a grid, a garment after refinement, a mesh): 1024² (about
+/// 200 MB of solver state).
+pub const MAX_PARTICLES: usize = 1 << 20;
+
+/// Nodes (0s and 1s) in one pattern file, and in one piece after refinement.
+pub const MAX_PATTERN_NODES: usize = 1 << 20;
+
+/// The largest refinement of a garment's patterns (`resolution`).
+pub const MAX_RESOLUTION: u32 = 64;
+
+/// Bytes of one scene, garment or pattern file (read whole).
+pub const MAX_FILE_BYTES: u64 = 16 << 20;
+
+/// Substeps of one step, fixed or the automatic count's cap (`substeps: Auto(max)`): the
+/// accuracy study's references take up to ~20,000.
+pub const MAX_SUBSTEPS: u32 = 1 << 16;
+
+/// Strain-limiter sweeps per substep (fixed, or the cap with a tolerance).
+pub const MAX_LIMITER_SWEEPS: u32 = 1 << 10;
+
+/// Work of one step, particles × substeps: a fixed count over it is refused; an
+/// automatic count is capped at it (and the cloth reports `under_resolved`). At ~50 ns
+/// per particle-substep, about 3 s of one core per step.
+pub const MAX_WORK_PER_STEP: u64 = 1 << 26;
+
+/// Work of one step's fixed limiter sweeps, particles × substeps × sweeps (with a
+/// tolerance the sweeps stop early and only [`MAX_LIMITER_SWEEPS`] applies).
+pub const MAX_SWEEP_WORK_PER_STEP: u64 = 1 << 28;
+
+/// Steps of one headless run (`cloth run --steps`): 44 hours of simulated time at 16 ms.
+pub const MAX_STEPS: usize = 10_000_000;
+
+/// Simulated seconds of one measured run (`cloth accuracy` / `cloth choose --seconds`).
+pub const MAX_SECONDS: f32 = 3_600.0;
+
+/// Cloths in one scene, and colliders.
+pub const MAX_SCENE_ITEMS: usize = 1 << 12;
+
+use std::io::Read;
+
+use crate::error::ClothError;
+
+/// Reads a file whole, refusing one over [`MAX_FILE_BYTES`] without reading more than
+/// that (a device such as `/dev/zero` reports no size and never ends).
+pub fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(MAX_FILE_BYTES + 1)
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > MAX_FILE_BYTES {
+        return Err(std::io::Error::other(format!(
+            "the file is larger than the limit of {MAX_FILE_BYTES} bytes"
+        )));
+    }
+    Ok(bytes)
+}
+
+/// [`read_file`] as UTF-8 text.
+pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+    String::from_utf8(read_file(path)?)
+        .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
+}
+use crate::params::{ClothParams, Model, Substeps};
+
+/// Refuses `params` on a cloth of `particles` when a step's fixed work is over
+/// [`MAX_WORK_PER_STEP`] (particles × fixed substeps) or [`MAX_SWEEP_WORK_PER_STEP`]
+/// (× fixed limiter sweeps). Automatic substeps are capped at the budget instead (see
+/// [`auto_substeps_cap`]).
+pub fn check_work(particles: usize, params: &ClothParams) -> Result<(), ClothError> {
+    let n = particles as u64;
+    let Substeps::Fixed(substeps) = params.substeps else {
+        return Ok(());
+    };
+    let work = n.saturating_mul(substeps as u64);
+    if work > MAX_WORK_PER_STEP {
+        return Err(ClothError::TooMuchWork {
+            field: "substeps",
+            particles,
+            per_particle: substeps as u64,
+            limit: MAX_WORK_PER_STEP,
+        });
+    }
+    let fixed_sweeps = params.strain_limit.is_some()
+        && params.strain_limit_tolerance.is_none()
+        && !matches!(params.model, Model::Xpbd(_));
+    if fixed_sweeps {
+        let per_particle = (substeps as u64).saturating_mul(params.strain_limit_iterations as u64);
+        if n.saturating_mul(per_particle) > MAX_SWEEP_WORK_PER_STEP {
+            return Err(ClothError::TooMuchWork {
+                field: "strain_limit_iterations",
+                particles,
+                per_particle,
+                limit: MAX_SWEEP_WORK_PER_STEP,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// The most automatic substeps a cloth of `particles` may take per step: its `max`,
+/// lowered to keep particles × substeps within [`MAX_WORK_PER_STEP`] (at least 1).
+pub fn auto_substeps_cap(particles: usize, max: u32) -> u32 {
+    let budget = MAX_WORK_PER_STEP / (particles.max(1) as u64);
+    max.min(budget.min(u32::MAX as u64) as u32).max(1)
+}
+
+/// Timed repeats of one measurement (`--repeats`).
+pub const MAX_REPEATS: usize = 1_000;
