@@ -8,6 +8,7 @@ pub mod accuracy;
 pub mod baseline;
 pub mod choose;
 pub mod fps;
+pub mod soak;
 pub mod stability;
 
 use std::time::Instant;

@@ -388,3 +388,193 @@ fn choose_picks_the_most_accurate_within_a_cost_and_refuses_an_impossible_goal()
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("no configuration"), "{stderr}");
 }
+
+/// One bad input: files to write `(name, text)`, the command line, and what its error
+/// must say.
+type BadInput = (Vec<(&'static str, String)>, Vec<&'static str>, &'static str);
+
+/// The inputs that took the program down before issue 17, each in a temporary directory
+/// (`{dir}` in a file stands for it, `{curtain}` in the command line for the shipped
+/// curtain).
+fn issue_17_inputs() -> Vec<BadInput> {
+    let curtain = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../assets/scenes/curtain.ron"
+    ))
+    .unwrap();
+    let garment = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../assets/patterns/tshirt.ron"
+    ))
+    .unwrap();
+    let front = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../assets/patterns/tshirt_front.txt"
+    ))
+    .unwrap();
+    let scene_of = |garment: &str, resolution: u32| {
+        format!(
+            "(cloths: [(cloth: (shape: Garment(file: \"{{dir}}/{garment}\", resolution: {resolution}), pins: None))])"
+        )
+    };
+    let curtain_with = |from: &str, to: &str| {
+        assert!(curtain.contains(from), "{from}");
+        curtain.replace(from, to)
+    };
+    let seam = |from: &str, to: &str| {
+        assert!(garment.contains(from), "{from}");
+        garment
+            .replacen(from, to, 1)
+            .replace("\"tshirt_front.txt\"", "\"front.txt\"")
+            .replace("\"tshirt_back.txt\"", "\"front.txt\"")
+    };
+    let run = |file: &'static str| vec!["run", file, "--steps", "3"];
+    vec![
+        (
+            vec![("empty.ron", "(cloths: [])".into())],
+            vec!["run", "empty.ron", "--dump", "x.csv"],
+            "no cloths",
+        ),
+        (
+            vec![],
+            vec!["run", "{curtain}", "--steps", "18446744073709551615"],
+            "--steps",
+        ),
+        (
+            vec![],
+            vec!["run", "{curtain}", "--steps", "4611686018427387904"],
+            "--steps",
+        ),
+        (
+            vec![],
+            vec!["run", "{curtain}", "--steps", "1000000000"],
+            "--steps",
+        ),
+        (
+            vec![
+                ("front.txt", front.clone()),
+                ("g.ron", seam("to: (11, 0)", "to: (4294967295, 0)")),
+                ("s.ron", scene_of("g.ron", 1)),
+            ],
+            run("s.ron"),
+            "is outside piece `front`",
+        ),
+        (
+            vec![
+                ("front.txt", front.clone()),
+                ("g.ron", seam("from: (0, 0)", "from: (2147483648, 0)")),
+                ("s.ron", scene_of("g.ron", 1)),
+            ],
+            run("s.ron"),
+            "is outside piece `front`",
+        ),
+        (
+            vec![
+                ("front.txt", ("1".repeat(100) + "\n").repeat(100)),
+                ("g.ron", seam("from: (0, 0)", "from: (0, 0)")),
+                ("s.ron", scene_of("g.ron", 64)),
+            ],
+            run("s.ron"),
+            "grid nodes, more than the limit",
+        ),
+        (vec![], vec!["accuracy", "--seconds", "1e30"], "--seconds"),
+        (
+            vec![(
+                "s.ron",
+                curtain_with("substeps: Auto(max: 8192)", "substeps: Fixed(4000000000)"),
+            )],
+            run("s.ron"),
+            "cloths[0].cloth.params.substeps",
+        ),
+        (
+            vec![(
+                "s.ron",
+                curtain_with(
+                    "strain_limit_iterations: 7",
+                    "strain_limit_iterations: 4294967295",
+                ),
+            )],
+            run("s.ron"),
+            "cloths[0].cloth.params.strain_limit_iterations",
+        ),
+        (
+            vec![(
+                "s.ron",
+                curtain_with(
+                    "Grid(width: 40, height: 32, spacing: 0.05)",
+                    "Grid(width: 6, height: 65537, spacing: 0.05)",
+                ),
+            )],
+            run("s.ron"),
+            "cloths[0].cloth.shape",
+        ),
+        (
+            vec![(
+                "s.ron",
+                curtain_with("substeps: Auto(max: 8192)", "substeps: Fixed(60000)"),
+            )],
+            run("s.ron"),
+            "particles × 60000 per step is over the limit",
+        ),
+    ]
+}
+
+#[test]
+fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
+    // Each under `ulimit -v` of 256 MB (a good run of the curtain needs ~20 MB resident):
+    // refused before anything of the asked size is allocated or looped over.
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let curtain = format!("{root}/assets/scenes/curtain.ron");
+    for (k, (files, args, needle)) in issue_17_inputs().into_iter().enumerate() {
+        let dir = temp(&format!("issue17_{k}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let dir_text = dir.display().to_string();
+        for (name, text) in &files {
+            std::fs::write(dir.join(name), text.replace("{dir}", &dir_text)).unwrap();
+        }
+        let args: Vec<String> = args
+            .iter()
+            .map(|a| a.replace("{curtain}", &curtain))
+            .collect();
+        let start = std::time::Instant::now();
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg("ulimit -v 262144 && exec \"$0\" \"$@\"")
+            .arg(env!("CARGO_BIN_EXE_cloth"))
+            .args(&args)
+            .current_dir(&dir)
+            .output()
+            .unwrap();
+        let took = start.elapsed();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && err.contains(needle),
+            "{args:?}: {err}"
+        );
+        assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
+        assert!(took.as_secs_f32() < 1.0, "{args:?}: {took:?}");
+        println!(
+            "{args:?}: {:.0} ms: {}",
+            took.as_secs_f64() * 1e3,
+            err.trim_end()
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}
+
+#[test]
+fn a_summary_into_a_closed_pipe_ends_quietly() {
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg("\"$0\" run assets/scenes/curtain.ron --steps 5 | head -c 10 > /dev/null; exit \"$?\"")
+        .arg(env!("CARGO_BIN_EXE_cloth"))
+        .current_dir(concat!(env!("CARGO_MANIFEST_DIR"), "/.."))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !err.contains("panicked") && !err.contains("Broken pipe"),
+        "{err}"
+    );
+}

@@ -79,6 +79,28 @@ enum Verb {
     /// The cheapest configuration of your scene's cloth within an error, or the most
     /// accurate within a cost per step (the accuracy study on that scene).
     Choose(ChooseArgs),
+    /// Drives a scene's cloth for minutes with gusty wind, grabs, cuts, tearing,
+    /// parameter edits (and refused invalid ones), model switches and resets, checking
+    /// every step for non-finite state and the memory for growth.
+    Soak(SoakArgs),
+}
+
+#[derive(Args)]
+struct SoakArgs {
+    /// The scene file (RON).
+    scene: PathBuf,
+    /// Wall-clock minutes (at most 1,440).
+    #[arg(long, default_value_t = 1.0, value_parser = minutes)]
+    minutes: f32,
+    /// Which of the scene's cloths (its index).
+    #[arg(long, default_value_t = 0)]
+    cloth: usize,
+    /// The random generator's seed (the same seed, the same soak).
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Prints JSON instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args)]
@@ -146,7 +168,7 @@ struct Output {
 
 #[derive(Args)]
 struct BenchArgs {
-    /// The largest particle count (at most 1,048,576).
+    /// The largest particle count (at most 262,144).
     #[arg(long, default_value_t = 65_536, value_parser = particles)]
     max: usize,
     /// Slika 23's models and `x` (XPBD), comma separated (all when absent).
@@ -214,6 +236,7 @@ fn main() -> ExitCode {
         Verb::Accuracy(args) => accuracy(args),
         Verb::Stability(args) => stability(args),
         Verb::Choose(args) => choose(args),
+        Verb::Soak(args) => soak(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -265,6 +288,14 @@ fn seconds(text: &str) -> Result<f32, String> {
         ));
     }
     Ok(seconds)
+}
+
+fn minutes(text: &str) -> Result<f32, String> {
+    let minutes = positive(text)?;
+    if minutes > 1440.0 {
+        return Err(format!("`{text}` is more than a day (1,440 minutes)"));
+    }
+    Ok(minutes)
 }
 
 fn positive(text: &str) -> Result<f32, String> {
@@ -343,6 +374,11 @@ fn run(args: RunArgs) -> Result<(), String> {
     }
     for spec in &args.set {
         scene.apply_override(spec).map_err(|e| e.to_string())?;
+    }
+    if scene.cloths.is_empty() {
+        return Err(format!(
+            "{scene_path}: the scene has no cloths: nothing to run"
+        ));
     }
     let (steps, every, timestep) = (args.steps, args.every, scene.timestep);
     // The solver's clock (its substeps' sum); a scene with no cloths has only the steps.
@@ -1170,5 +1206,80 @@ fn choose(args: ChooseArgs) -> Result<(), String> {
             Goal::MaxError(e) => format!("no configuration is within an error of {e}"),
             Goal::BudgetMs(b) => format!("no configuration costs {b} ms per step or less"),
         }),
+    }
+}
+
+/// `cloth soak`: the soak, a status line a minute on stderr, the summary on stdout; exit
+/// code 1 when it found a bug (non-finite state, an invalid edit accepted, memory growth).
+fn soak(args: SoakArgs) -> Result<(), String> {
+    let scene = ClothScene::load(&args.scene).map_err(|e| e.to_string())?;
+    let duration = std::time::Duration::from_secs_f32(args.minutes * 60.0);
+    let mut next = 60.0;
+    let summary = bevy_cloth_lab::soak::soak(&scene, args.cloth, duration, args.seed, |s| {
+        if s.seconds >= next {
+            next += 60.0;
+            eprintln!(
+                "{:.0} s: {} steps, {} non-finite, {:.1} MB resident",
+                s.seconds,
+                s.steps,
+                s.non_finite_steps,
+                bevy_cloth_lab::soak::resident_mb()
+            );
+        }
+    })?;
+    if args.json {
+        print_json(&summary)?;
+    } else {
+        let s = &summary;
+        println!("| soak of {} | |", args.scene.display());
+        println!("|---|---:|");
+        for (what, value) in [
+            ("wall-clock s", format!("{:.0}", s.seconds)),
+            ("steps", s.steps.to_string()),
+            ("simulated s", format!("{:.0}", s.simulated_seconds)),
+            ("grabs", s.grabs.to_string()),
+            (
+                "cut strokes / springs cut",
+                format!("{} / {}", s.cuts, s.springs_cut),
+            ),
+            ("springs torn by stretching", s.springs_torn.to_string()),
+            (
+                "valid edits / model switches",
+                format!("{} / {}", s.edits, s.model_switches),
+            ),
+            (
+                "invalid edits refused / accepted",
+                format!("{} / {}", s.refused_edits, s.accepted_invalid_edits),
+            ),
+            ("resets", s.resets.to_string()),
+            (
+                "steps with non-finite state",
+                s.non_finite_steps.to_string(),
+            ),
+            (
+                "steps past 100% strain (reset)",
+                s.unstable_steps.to_string(),
+            ),
+            (
+                "resident MB settled / peak / end",
+                format!(
+                    "{:.1} / {:.1} / {:.1}",
+                    s.rss_start_mb, s.rss_peak_mb, s.rss_end_mb
+                ),
+            ),
+            (
+                "step ms median / max",
+                format!("{:.3} / {:.1}", s.median_step_ms, s.max_step_ms),
+            ),
+            ("passed", s.passed().to_string()),
+        ] {
+            println!("| {what} | {value} |");
+        }
+    }
+    if summary.passed() {
+        Ok(())
+    } else {
+        eprintln!("error: the soak found a problem (see the summary)");
+        std::process::exit(1);
     }
 }
