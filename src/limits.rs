@@ -38,6 +38,32 @@ pub const MAX_STEPS: usize = 10_000_000;
 /// Simulated seconds of one measured run (`cloth accuracy` / `cloth choose --seconds`).
 pub const MAX_SECONDS: f32 = 3_600.0;
 
+/// Gravity's magnitude, m/s² (100 g): past it nothing is cloth, and a float overflows
+/// within a few steps.
+pub const MAX_GRAVITY: f32 = 1_000.0;
+
+/// Wind strength, N per particle (a 0.5 g particle then accelerates at 2·10⁶ m/s²).
+pub const MAX_WIND: f32 = 1_000.0;
+
+/// A particle's mass, kg: seed 002's range is 1e-6 to 1e-3; past these, forces and
+/// accelerations leave `f32`'s range within a few steps.
+pub const MIN_NODE_MASS: f32 = 1e-9;
+/// See [`MIN_NODE_MASS`].
+pub const MAX_NODE_MASS: f32 = 1e3;
+
+/// A spring family's (or a pull's) stiffness, N/m (seed 002's stiffest is 25,000; XPBD
+/// also takes `inf`).
+pub const MAX_STIFFNESS: f32 = 1e9;
+
+/// Spring damping and drag, N·s/m.
+pub const MAX_DAMPING: f32 = 1e6;
+
+/// A scene item's distance from the origin, m, and its rotation angles, degrees (finite).
+pub const MAX_POSITION: f32 = 1e5;
+
+/// A grid's or a garment's spacing between neighbouring particles, m.
+pub const MAX_SPACING: f32 = 10.0;
+
 /// Cloths in one scene, and colliders.
 pub const MAX_SCENE_ITEMS: usize = 1 << 12;
 

@@ -3,7 +3,9 @@
 //! Everything here is `Reflect` (so the inspector can edit it) and `serde` (so scene
 //! files can hold it). Nothing here knows about the ECS.
 
-use crate::limits::{MAX_LIMITER_SWEEPS, MAX_SUBSTEPS};
+use crate::limits::{
+    MAX_DAMPING, MAX_LIMITER_SWEEPS, MAX_NODE_MASS, MAX_STIFFNESS, MAX_SUBSTEPS, MIN_NODE_MASS,
+};
 use bevy::math::Vec3;
 use bevy::reflect::Reflect;
 use serde::{Deserialize, Serialize};
@@ -247,8 +249,8 @@ impl ShapeMatchingParams {
         check(
             "model.stiffness",
             self.stiffness,
-            self.stiffness >= 0.0,
-            "a stiffness ≥ 0",
+            (0.0..=MAX_STIFFNESS).contains(&self.stiffness),
+            "a stiffness from 0 to 1e9 (limits::MAX_STIFFNESS)",
         )?;
         if self.update == GoalUpdate::Velocity {
             check(
@@ -262,8 +264,8 @@ impl ShapeMatchingParams {
         check(
             "model.damping",
             self.damping,
-            self.damping >= 0.0,
-            "a damping ≥ 0",
+            (0.0..=MAX_DAMPING).contains(&self.damping),
+            "a damping from 0 to 1e6 (limits::MAX_DAMPING)",
         )?;
         check(
             "model.beta",
@@ -361,21 +363,21 @@ impl PatchParams {
         check(
             "model.stiffness",
             self.stiffness,
-            self.stiffness > 0.0,
-            "a stiffness > 0",
+            self.stiffness > 0.0 && self.stiffness <= MAX_STIFFNESS,
+            "a stiffness from 0 (excluded) to 1e9 (limits::MAX_STIFFNESS)",
         )?;
         check_exponent(self.exponent)?;
         check(
             "model.particle_damping_ratio",
             self.particle_damping_ratio,
-            self.particle_damping_ratio >= 0.0,
-            "a ratio ≥ 0",
+            (0.0..=MAX_DAMPING).contains(&self.particle_damping_ratio),
+            "a ratio from 0 to 1e6 (limits::MAX_DAMPING)",
         )?;
         check(
             "model.part_damping",
             self.part_damping,
-            self.part_damping >= 0.0,
-            "a damping ≥ 0",
+            (0.0..=MAX_DAMPING).contains(&self.part_damping),
+            "a damping from 0 to 1e6 (limits::MAX_DAMPING)",
         )?;
         Ok(())
     }
@@ -583,8 +585,8 @@ impl ClothParams {
         check(
             "node_mass",
             self.node_mass,
-            self.node_mass > 0.0,
-            "a positive mass in kg",
+            (MIN_NODE_MASS..=MAX_NODE_MASS).contains(&self.node_mass),
+            "a mass from 1e-9 to 1,000 kg (limits::MIN_NODE_MASS, MAX_NODE_MASS)",
         )?;
         let s = &self.springs;
         // XPBD takes an infinite stiffness as an inextensible constraint (compliance 0);
@@ -603,15 +605,15 @@ impl ClothParams {
             check(
                 field,
                 family.stiffness,
-                family.stiffness >= 0.0,
-                "a stiffness ≥ 0 N/m (inf only for XPBD)",
+                (0.0..=MAX_STIFFNESS).contains(&family.stiffness),
+                "a stiffness from 0 to 1e9 N/m (limits::MAX_STIFFNESS; inf only for XPBD)",
             )?;
         }
         check(
             "springs.damping",
             s.damping,
-            s.damping >= 0.0,
-            "a damping ≥ 0 N·s/m",
+            (0.0..=MAX_DAMPING).contains(&s.damping),
+            "a damping from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
         )?;
         check(
             "springs.seam_rest_length",
@@ -625,7 +627,12 @@ impl ClothParams {
             s.sew_time >= 0.0,
             "a time ≥ 0 s",
         )?;
-        check("drag", self.drag, self.drag >= 0.0, "a drag ≥ 0 N·s/m")?;
+        check(
+            "drag",
+            self.drag,
+            (0.0..=MAX_DAMPING).contains(&self.drag),
+            "a drag from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
+        )?;
         match self.substeps {
             Substeps::Fixed(0) => {
                 return Err(ClothError::InvalidParameter {
@@ -817,7 +824,12 @@ impl Environment {
     /// Checks gravity and wind for non-finite values.
     pub fn validate(&self) -> Result<(), ClothError> {
         let g = self.gravity;
-        check("gravity", g.length(), g.is_finite(), "a finite vector")?;
+        check(
+            "gravity",
+            g.length(),
+            g.is_finite() && g.length() <= crate::limits::MAX_GRAVITY,
+            "a finite vector of at most 1,000 m/s² (limits::MAX_GRAVITY)",
+        )?;
         let w = &self.wind;
         check(
             "wind.direction",
@@ -828,8 +840,8 @@ impl Environment {
         check(
             "wind.strength",
             w.strength,
-            w.strength >= 0.0,
-            "a strength ≥ 0 N",
+            (0.0..=crate::limits::MAX_WIND).contains(&w.strength),
+            "a strength from 0 to 1,000 N (limits::MAX_WIND)",
         )?;
         Ok(())
     }

@@ -242,7 +242,18 @@ impl ClothScene {
     /// `cloth.params.substeps=auto` or `=8`, `cloth.params.tear_ratio=none` or `=2.5`,
     /// `cloth.shape.width=64`. Keys are reflection paths into [`Environment`] and
     /// [`Cloth`]; the result is checked like a scene file.
+    ///
+    /// A refused override leaves the scene as it was.
     pub fn apply_override(&mut self, spec: &str) -> Result<(), SceneError> {
+        let mut edited = self.clone();
+        edited.apply_override_in_place(spec)?;
+        *self = edited;
+        Ok(())
+    }
+
+    /// [`ClothScene::apply_override`] without the copy: on an error the scene may hold the
+    /// refused value.
+    fn apply_override_in_place(&mut self, spec: &str) -> Result<(), SceneError> {
         let fail = |message: String| SceneError::Override {
             spec: spec.to_string(),
             message,
@@ -256,13 +267,13 @@ impl ClothScene {
                 .parse()
                 .map_err(|_| fail(format!("`{value}` is not a number")))?;
         } else if let Some(path) = key.strip_prefix("environment.") {
-            set_by_path(&mut self.environment, path, value).map_err(fail)?;
+            set_field(&mut self.environment, path, value).map_err(fail)?;
         } else if let Some(path) = key.strip_prefix("cloth.") {
             if self.cloths.is_empty() {
                 return Err(fail("the scene has no cloth".into()));
             }
             for entry in &mut self.cloths {
-                set_by_path(&mut entry.cloth, path, value).map_err(fail)?;
+                set_field(&mut entry.cloth, path, value).map_err(fail)?;
             }
         } else if let Some(rest) = key.strip_prefix("cloths[") {
             let (index, path) = rest
@@ -274,7 +285,7 @@ impl ClothScene {
                 .ok()
                 .and_then(|i| self.cloths.get_mut(i))
                 .ok_or_else(|| fail(format!("no cloth {index}: the scene has {count}")))?;
-            set_by_path(&mut entry.cloth, path, value).map_err(fail)?;
+            set_field(&mut entry.cloth, path, value).map_err(fail)?;
         } else {
             return Err(fail(
                 "keys start with timestep, environment., cloth. or cloths[N].".into(),
@@ -315,6 +326,33 @@ impl ClothScene {
                 e.to_string(),
                 0,
             ));
+        }
+        let placed = |p: Vec3| p.is_finite() && p.length() <= crate::limits::MAX_POSITION;
+        let angle = |a: f32| a.is_finite() && a.abs() <= crate::limits::MAX_POSITION;
+        for (i, entry) in self.cloths.iter().enumerate() {
+            let checks = [
+                ("translation", placed(entry.translation)),
+                ("yaw_degrees", angle(entry.yaw_degrees)),
+            ];
+            if let Some((key, _)) = checks.iter().find(|(_, ok)| !ok) {
+                return Err(invalid(
+                    format!("cloths[{i}].{key}"),
+                    key,
+                    "must be finite and within 1e5 (limits::MAX_POSITION)".into(),
+                    text.find("cloths").unwrap_or(0),
+                ));
+            }
+        }
+        for (i, entry) in self.colliders.iter().enumerate() {
+            let rotation = entry.rotation_degrees;
+            if !placed(entry.translation) || !placed(rotation) {
+                return Err(invalid(
+                    format!("colliders[{i}].translation"),
+                    "translation",
+                    "translation and rotation_degrees must be finite and within 1e5 (limits::MAX_POSITION)".into(),
+                    text.find("colliders").unwrap_or(0),
+                ));
+            }
         }
         let mut search_from = text.find("cloths").unwrap_or(0);
         for (i, entry) in self.cloths.iter().enumerate() {
@@ -369,7 +407,10 @@ impl ClothScene {
 /// Sets the field at a reflection `path` of `target` from text: numbers, booleans,
 /// vectors `x,y,z`, `none` or a number for optional numbers, `auto` or a count for
 /// substeps, and unit variant names for enums (`TopRow`, `Trigonometric`, `Verlet`).
-fn set_by_path(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), String> {
+/// What `--set` and [`ClothScene::apply_override`] use; on a component (a [`Cloth`], an
+/// [`Environment`]) it edits as the inspector does, and the plugin checks the result.
+/// Never panics: a path or value that does not fit is an error naming it.
+pub fn set_field(target: &mut dyn Reflect, path: &str, value: &str) -> Result<(), String> {
     use bevy::reflect::ReflectMut;
     use bevy::reflect::enums::{DynamicEnum, DynamicVariant};
 

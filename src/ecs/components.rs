@@ -217,38 +217,56 @@ impl ClothCollider {
         self
     }
 
-    /// Checks sizes: radius > 0, half-length, thickness and friction ≥ 0, all finite.
+    /// Checks sizes: radius > 0, half-length, thickness and friction ≥ 0, each within
+    /// [`crate::limits::MAX_POSITION`].
     pub fn validate(&self) -> Result<(), ClothError> {
         use crate::params::check;
+        const MAX: f32 = crate::limits::MAX_POSITION;
+        let size = |field, value: f32, least_excluded: bool, expected| {
+            let low = if least_excluded {
+                value > 0.0
+            } else {
+                value >= 0.0
+            };
+            check(field, value, low && value <= MAX, expected)
+        };
         match self.shape {
-            ColliderKind::Sphere { radius } => {
-                check("radius", radius, radius > 0.0, "a radius > 0 m")?
-            }
+            ColliderKind::Sphere { radius } => size(
+                "radius",
+                radius,
+                true,
+                "a radius from 0 (excluded) to 1e5 m",
+            )?,
             ColliderKind::Capsule {
                 radius,
                 half_length,
             } => {
-                check("radius", radius, radius > 0.0, "a radius > 0 m")?;
-                check(
+                size(
+                    "radius",
+                    radius,
+                    true,
+                    "a radius from 0 (excluded) to 1e5 m",
+                )?;
+                size(
                     "half_length",
                     half_length,
-                    half_length >= 0.0,
-                    "a half-length ≥ 0 m",
+                    false,
+                    "a half-length from 0 to 1e5 m",
                 )?;
             }
             ColliderKind::Plane => {}
         }
-        check(
+        size(
             "thickness",
             self.thickness,
-            self.thickness >= 0.0,
-            "a thickness ≥ 0 m",
+            false,
+            "a thickness from 0 to 1e5 m",
         )?;
-        check(
+        size(
             "friction",
             self.friction,
-            self.friction >= 0.0,
-            "a friction coefficient ≥ 0",
+            false,
+            "a friction coefficient from 0 to 1e5",
         )
     }
 

@@ -116,11 +116,11 @@ impl ClothShape {
                     limit: MAX_PARTICLES,
                 });
             }
-            if !(spacing > 0.0 && spacing.is_finite()) {
+            if !(spacing > 0.0 && spacing <= crate::limits::MAX_SPACING) {
                 return Err(ClothError::InvalidParameter {
                     field: "shape.spacing",
                     value: spacing,
-                    expected: "a positive distance in m",
+                    expected: "a distance from 0 (excluded) to 10 m (limits::MAX_SPACING)",
                 });
             }
         }

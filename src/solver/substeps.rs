@@ -336,19 +336,20 @@ pub fn unit_hash(i: usize, axis: u64) -> f32 {
 /// Substeps that keep `h = dt/N` inside the explicit bound `h²ω² + 2hγ < 4` with a safety
 /// factor of 0.8 (see [`ClothSolver::stable_substeps`]).
 fn substeps_for(dt: f32, omega2: f32, gamma: f32) -> u32 {
-    const SAFETY: f32 = 0.8;
-    let h_max = if omega2 > 0.0 {
-        (-gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt()) / omega2
-    } else if gamma > 0.0 {
-        2.0 * SAFETY / gamma
+    const SAFETY: f64 = 0.8;
+    // h_max = (−γ + √(γ² + 4sω²))/ω², written as 4s/(γ + √(γ² + 4sω²)) (the same for
+    // ω² > 0, 2s/γ for ω² = 0) and in f64: the first form cancels to 0 for a large γ and
+    // overflows past γ ~ 1e19, and both had turned an unbounded need into 1 substep.
+    let (omega2, gamma) = (omega2.max(0.0) as f64, gamma.max(0.0) as f64);
+    let denominator = gamma + (gamma * gamma + 4.0 * SAFETY * omega2).sqrt();
+    if denominator == 0.0 {
+        return 1; // no stiffness, no damping: any step is stable
+    }
+    let n = (dt as f64 * denominator / (4.0 * SAFETY)).ceil();
+    if n.is_nan() {
+        u32::MAX // a NaN stiffness is refused by validation; never 1 by accident
     } else {
-        f32::INFINITY
-    };
-    let n = (dt / h_max).ceil();
-    if n.is_finite() && n >= 1.0 {
-        n.min(u32::MAX as f32) as u32
-    } else {
-        1
+        n.clamp(1.0, u32::MAX as f64) as u32
     }
 }
 

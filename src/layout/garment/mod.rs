@@ -249,11 +249,11 @@ fn check_header(
     resolution: u32,
     error: &dyn Fn(&str, String) -> ClothError,
 ) -> Result<(), ClothError> {
-    if !(desc.spacing > 0.0 && desc.spacing.is_finite()) {
+    if !(desc.spacing > 0.0 && desc.spacing <= crate::limits::MAX_SPACING) {
         return Err(error(
             "spacing",
             format!(
-                "`spacing` must be a positive distance in m, got {}",
+                "`spacing` must be a distance from 0 (excluded) to 10 m (limits::MAX_SPACING), got {}",
                 desc.spacing
             ),
         ));

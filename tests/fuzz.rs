@@ -1,0 +1,458 @@
+//! Fuzzing (issue 17): random and mutated scene, garment and pattern text and `--set`
+//! pairs through the loaders and a few steps, and random edits of a running cloth through
+//! reflection in a headless App, as the inspector makes them. Each case must end in a
+//! clean error or a finite result; a panic fails the test. A seeded generator on stable
+//! Rust, so a failure is repeatable: the message names the case's seed.
+//!
+//! `FUZZ_CASES=N` runs N cases per family (default 1,000: 5,000 in all, well under a
+//! minute); `FUZZ_SEED=S` starts elsewhere.
+
+use std::path::Path;
+
+use bevy::math::Affine3A;
+use bevy::prelude::*;
+use bevy_cloth::layout::garment::GarmentLayout;
+use bevy_cloth::layout::pattern::Pattern;
+use bevy_cloth::prelude::*;
+use bevy_cloth::scene::set_field;
+use bevy_cloth::solver::ClothSolver;
+
+/// xorshift64*: the same seed, the same cases.
+struct Rng(u64);
+
+impl Rng {
+    fn new(seed: u64) -> Self {
+        Rng(seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) | 1)
+    }
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_F491_4F6C_DD1D)
+    }
+    fn below(&mut self, n: usize) -> usize {
+        if n == 0 {
+            0
+        } else {
+            (self.next() % n as u64) as usize
+        }
+    }
+    fn pick<'a, T>(&mut self, items: &'a [T]) -> &'a T {
+        &items[self.below(items.len())]
+    }
+}
+
+fn cases() -> usize {
+    std::env::var("FUZZ_CASES")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(1_000)
+}
+
+fn first_seed() -> u64 {
+    std::env::var("FUZZ_SEED")
+        .ok()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or(17)
+}
+
+/// Numbers that break careless code.
+const EXTREMES: [&str; 22] = [
+    "0",
+    "-1",
+    "1",
+    "2",
+    "65537",
+    "4294967295",
+    "4294967296",
+    "2147483648",
+    "18446744073709551615",
+    "-0.0",
+    "1e30",
+    "-1e30",
+    "1e-30",
+    "NaN",
+    "inf",
+    "-inf",
+    "0.5",
+    "3.4e38",
+    "99999999",
+    "\"\"",
+    "[]",
+    "()",
+];
+
+fn asset(name: &str) -> String {
+    std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("assets")
+            .join(name),
+    )
+    .unwrap()
+}
+
+/// One mutation of `text`: a number replaced by an extreme, a line deleted or doubled, a
+/// span deleted, random bytes, a bracket changed, or the text cut short.
+fn mutate(text: &str, rng: &mut Rng) -> String {
+    let mut s = text.to_string();
+    for _ in 0..1 + rng.below(3) {
+        let len = s.len();
+        if len == 0 {
+            return s;
+        }
+        let at = floor_char(&s, rng.below(len));
+        s = match rng.below(7) {
+            0 | 1 => {
+                // A number (a run of digits, '.', '-', 'e') replaced by an extreme.
+                let starts: Vec<usize> = s
+                    .char_indices()
+                    .filter(|(_, c)| c.is_ascii_digit())
+                    .map(|(i, _)| i)
+                    .collect();
+                if starts.is_empty() {
+                    s
+                } else {
+                    let start = *rng.pick(&starts);
+                    let end = s[start..]
+                        .find(|c: char| !(c.is_ascii_digit() || matches!(c, '.' | 'e' | '-')))
+                        .map_or(s.len(), |e| start + e);
+                    format!("{}{}{}", &s[..start], rng.pick(&EXTREMES), &s[end..])
+                }
+            }
+            2 => {
+                let lines: Vec<&str> = s.lines().collect();
+                let k = rng.below(lines.len());
+                let mut out: Vec<&str> = lines.clone();
+                if rng.below(2) == 0 {
+                    out.remove(k);
+                } else {
+                    out.insert(k, lines[k]);
+                }
+                out.join("\n")
+            }
+            3 => {
+                let end = floor_char(&s, (at + 1 + rng.below(40)).min(len));
+                format!("{}{}", &s[..at], &s[end..])
+            }
+            4 => {
+                let junk: String = (0..1 + rng.below(8))
+                    .map(|_| {
+                        *rng.pick(&['(', ')', '[', ']', ',', ':', '"', '0', '1', '\n', 'x', '#'])
+                    })
+                    .collect();
+                format!("{}{}{}", &s[..at], junk, &s[at..])
+            }
+            5 => {
+                const FROM: [&str; 5] = ["(", ")", "[", "]", ":"];
+                const TO: [&str; 5] = ["[", "]", "(", ")", ""];
+                let (from, to) = (FROM[rng.below(5)], TO[rng.below(5)]);
+                s.replacen(from, to, 1)
+            }
+            _ => s[..at].to_string(),
+        };
+    }
+    s
+}
+
+fn floor_char(s: &str, mut i: usize) -> usize {
+    while i > 0 && !s.is_char_boundary(i) {
+        i -= 1;
+    }
+    i
+}
+
+/// Steps a solver three times if its work is small (the limits themselves are tested in
+/// `lab/tests/cli.rs`; here the point is panics and non-finite state, not cost), and
+/// asserts a finite result unless its fixed substeps are below its stable count (an
+/// explicit method past its bound may blow up: a measured failure, not a bug).
+fn step_a_few(cloth: &mut ClothSolver, env: &Environment, dt: f32, case: &str) {
+    let substeps = match cloth.params().substeps {
+        Substeps::Fixed(n) => n as usize,
+        Substeps::Auto { .. } => cloth.stable_substeps(dt) as usize,
+    };
+    if cloth.particle_count().saturating_mul(substeps.max(1)) > 200_000 {
+        return;
+    }
+    for _ in 0..3 {
+        cloth.step(dt, env);
+    }
+    let explicit_past_bound = (matches!(cloth.params().substeps, Substeps::Fixed(n) if n < cloth.stable_substeps(dt))
+        || cloth.under_resolved())
+        && !matches!(cloth.params().model, Model::Xpbd(_));
+    assert!(
+        cloth.is_finite() || explicit_past_bound,
+        "{case}: not finite after 3 steps ({:?})",
+        cloth.params()
+    );
+}
+
+fn run_scene(scene: &ClothScene, case: &str) {
+    let big = scene.cloths.iter().any(|c| match c.cloth.shape {
+        ClothShape::Grid { width, height, .. } => width as usize * height as usize > 20_000,
+        _ => false,
+    });
+    if big {
+        return;
+    }
+    if let Ok(mut run) = SceneRun::new(scene) {
+        let (env, dt) = (run.environment, run.timestep);
+        for (_, cloth) in &mut run.cloths {
+            step_a_few(cloth, &env, dt, case);
+        }
+    }
+}
+
+#[test]
+fn mutated_scene_files_load_cleanly_or_fail_cleanly() {
+    let sources = ["curtain", "card", "tshirt", "curtains_lod"]
+        .map(|name| asset(&format!("scenes/{name}.ron")));
+    let (mut errors, mut loaded) = (0, 0);
+    for k in 0..cases() {
+        let seed = first_seed() + k as u64;
+        let mut rng = Rng::new(seed);
+        let source: &String = rng.pick(&sources);
+        let text = mutate(source, &mut rng);
+        // The case names its seed and the first line the mutation changed.
+        let changed: Vec<&str> = text
+            .lines()
+            .zip(source.lines())
+            .filter(|(a, b)| a != b)
+            .map(|(a, _)| a.trim())
+            .take(4)
+            .collect();
+        let changed = changed.join(" | ");
+        let case = format!("scene case seed {seed} ({changed})");
+        match ClothScene::parse(&text, Path::new("fuzz.ron")) {
+            Err(e) => {
+                let message = e.to_string();
+                assert!(
+                    !message.is_empty() && !message.contains('\n'),
+                    "{case}: {message}"
+                );
+                errors += 1;
+            }
+            Ok(scene) => {
+                loaded += 1;
+                run_scene(&scene, &case);
+            }
+        }
+    }
+    println!("scenes: {loaded} loaded and stepped, {errors} refused");
+    assert!(errors > 0 && loaded > 0, "the mutations test nothing");
+}
+
+#[test]
+fn mutated_garments_and_patterns_load_cleanly_or_fail_cleanly() {
+    let garment = asset("patterns/tshirt.ron");
+    let front = asset("patterns/tshirt_front.txt");
+    let back = asset("patterns/tshirt_back.txt");
+    let (mut errors, mut loaded) = (0, 0);
+    for k in 0..cases() {
+        let seed = first_seed() + k as u64;
+        let mut rng = Rng::new(seed);
+        let case = format!("garment case seed {seed}");
+        // Mutate one of the three files (or none), at resolution 1–3.
+        let which = rng.below(4);
+        let text = if which == 0 {
+            mutate(&garment, &mut rng)
+        } else {
+            garment.clone()
+        };
+        let front = if which == 1 {
+            mutate(&front, &mut rng)
+        } else {
+            front.clone()
+        };
+        let back = if which == 2 {
+            mutate(&back, &mut rng)
+        } else {
+            back.clone()
+        };
+        let resolution = 1 + rng.below(3) as u32;
+        let read = |name: &str| match name {
+            "tshirt_front.txt" => Pattern::parse(front.as_bytes(), name),
+            "tshirt_back.txt" => Pattern::parse(back.as_bytes(), name),
+            other => Pattern::parse(b"", other),
+        };
+        match GarmentLayout::parse(&text, "fuzz.ron", resolution, read) {
+            Err(e) => {
+                assert!(!e.to_string().contains('\n'), "{case}: {e}");
+                errors += 1;
+            }
+            Ok(layout) => {
+                loaded += 1;
+                let params = ClothParams::default();
+                if let Ok(mut cloth) =
+                    ClothSolver::new(layout.into_layout(), &[], &params, Affine3A::IDENTITY)
+                {
+                    step_a_few(&mut cloth, &Environment::default(), 0.016, &case);
+                }
+            }
+        }
+        // The pattern parser alone on random bytes.
+        let bytes: Vec<u8> = (0..rng.below(64))
+            .map(|_| *rng.pick(b"0011\n \t#x\xff\r"))
+            .collect();
+        let _ = Pattern::parse(&bytes, "random.txt");
+    }
+    println!("garments: {loaded} laid out and stepped, {errors} refused");
+    assert!(errors > 0 && loaded > 0, "the mutations test nothing");
+}
+
+/// Keys of every kind of field `--set` reaches.
+const KEYS: [&str; 24] = [
+    "timestep",
+    "environment.gravity",
+    "environment.wind.strength",
+    "environment.wind.direction",
+    "environment.wind.field",
+    "cloth.shape.width",
+    "cloth.shape.height",
+    "cloth.shape.spacing",
+    "cloth.pins",
+    "cloth.params.model",
+    "cloth.params.model.0.part_width",
+    "cloth.params.model.0.clusters",
+    "cloth.params.model.0.stiffness",
+    "cloth.params.node_mass",
+    "cloth.params.springs.structural.stiffness",
+    "cloth.params.springs.structural.enabled",
+    "cloth.params.springs.damping",
+    "cloth.params.drag",
+    "cloth.params.integrator",
+    "cloth.params.substeps",
+    "cloth.params.strain_limit",
+    "cloth.params.strain_limit_iterations",
+    "cloth.params.tear_ratio",
+    "cloths[7].params.drag",
+];
+
+/// Values for them: the extremes, and the words the keys take.
+fn value(rng: &mut Rng) -> String {
+    let words = [
+        "auto",
+        "none",
+        "true",
+        "false",
+        "Patches",
+        "Xpbd",
+        "ShapeMatching",
+        "MassSpring",
+        "TopRow",
+        "None",
+        "Verlet",
+        "Trigonometric",
+        "1,2,3",
+        "0,0,0",
+        "1,2",
+        "NaN,0,0",
+        "8",
+        "40",
+        "0.001",
+    ];
+    if rng.below(2) == 0 {
+        rng.pick(&EXTREMES).to_string()
+    } else {
+        rng.pick(&words).to_string()
+    }
+}
+
+#[test]
+fn random_set_pairs_apply_cleanly_or_fail_cleanly() {
+    let curtain =
+        ClothScene::parse(&asset("scenes/curtain.ron"), Path::new("curtain.ron")).unwrap();
+    let (mut errors, mut applied) = (0, 0);
+    for k in 0..cases() {
+        let seed = first_seed() + k as u64;
+        let mut rng = Rng::new(seed);
+        let mut case = format!("--set case seed {seed}:");
+        let mut scene = curtain.clone();
+        for _ in 0..1 + rng.below(3) {
+            let spec = format!("{}={}", rng.pick(&KEYS), value(&mut rng));
+            case += &format!(" {spec}");
+            match scene.apply_override(&spec) {
+                Err(e) => {
+                    assert!(!e.to_string().contains('\n'), "{case}: {e}");
+                    errors += 1;
+                }
+                Ok(()) => applied += 1,
+            }
+        }
+        run_scene(&scene, &case);
+    }
+    println!("--set: {applied} applied, {errors} refused");
+    assert!(errors > 0 && applied > 0, "the pairs test nothing");
+}
+
+#[test]
+fn random_edits_of_a_running_cloth_never_panic_and_invalid_ones_recover() {
+    // As the inspector edits: reflection on the live `Cloth` and `ClothEnvironment`.
+    let mut app = bevy_cloth::headless::headless_app();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(12, 10, 0.05).with_pins(Pins::TopRow),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+        ))
+        .id();
+    let good = app.world().get::<Cloth>(cloth).unwrap().clone();
+    let good_env = *app.world().resource::<ClothEnvironment>();
+    let (mut refused, mut invalid_seen, mut ran) = (0, 0, 0);
+    let edits = cases() / 4;
+    for k in 0..edits {
+        let seed = first_seed() + k as u64;
+        let mut rng = Rng::new(seed);
+        let key = rng.pick(&KEYS);
+        let v = value(&mut rng);
+        if let Some(path) = key.strip_prefix("environment.") {
+            let mut env = app.world_mut().resource_mut::<ClothEnvironment>();
+            if set_field(&mut env.0, path, &v).is_err() {
+                refused += 1;
+            }
+        } else if let Some(path) = key.strip_prefix("cloth.") {
+            let mut c = app.world_mut().get_mut::<Cloth>(cloth).unwrap();
+            if set_field(c.as_mut(), path, &v).is_err() {
+                refused += 1;
+            }
+        }
+        // A shape or work too large to step here is put back (refused by the limits, and
+        // measured in the CLI test); the rest runs two frames.
+        let sizes_ok = {
+            let c = app.world().get::<Cloth>(cloth).unwrap();
+            match c.shape {
+                ClothShape::Grid { width, height, .. } => {
+                    (width as usize) * (height as usize) <= 4_096
+                }
+                _ => true,
+            }
+        };
+        if !sizes_ok {
+            *app.world_mut().get_mut::<Cloth>(cloth).unwrap() = good.clone();
+        }
+        app.update();
+        app.update();
+        ran += 1;
+        if app.world().get::<ClothInvalid>(cloth).is_some() {
+            invalid_seen += 1;
+            // Valid again: it recovers (rebuilt or resumed) within two frames.
+            *app.world_mut().get_mut::<Cloth>(cloth).unwrap() = good.clone();
+            *app.world_mut().resource_mut::<ClothEnvironment>() = good_env;
+            app.update();
+            app.update();
+            assert!(
+                app.world().get::<ClothInvalid>(cloth).is_none(),
+                "edit seed {seed}: did not recover"
+            );
+            assert!(app.world().get::<ClothSimulation>(cloth).is_some());
+        }
+        if rng.below(8) == 0 {
+            // Now and then back to the good cloth, so edits do not pile up forever.
+            *app.world_mut().get_mut::<Cloth>(cloth).unwrap() = good.clone();
+            *app.world_mut().resource_mut::<ClothEnvironment>() = good_env;
+        }
+    }
+    println!(
+        "plugin: {ran} edits run, {refused} refused by the path or value, {invalid_seen} made the cloth invalid and recovered"
+    );
+    assert!(invalid_seen > 0 && refused > 0, "the edits test nothing");
+}
