@@ -238,14 +238,19 @@ fn mutated_scene_files_load_cleanly_or_fail_cleanly() {
         }
     }
     println!("scenes: {loaded} loaded and stepped, {errors} refused");
-    assert!(errors > 0 && loaded > 0, "the mutations test nothing");
+    assert!(
+        cases() < 100 || (errors > 0 && loaded > 0),
+        "the mutations test nothing"
+    );
 }
 
 #[test]
 fn mutated_garments_and_patterns_load_cleanly_or_fail_cleanly() {
     let garment = asset("patterns/tshirt.ron");
-    let front = asset("patterns/tshirt_front.txt");
-    let back = asset("patterns/tshirt_back.txt");
+    let (front_0, back_0) = (
+        asset("patterns/tshirt_front.txt"),
+        asset("patterns/tshirt_back.txt"),
+    );
     let (mut errors, mut loaded) = (0, 0);
     for k in 0..cases() {
         let seed = first_seed() + k as u64;
@@ -259,16 +264,31 @@ fn mutated_garments_and_patterns_load_cleanly_or_fail_cleanly() {
             garment.clone()
         };
         let front = if which == 1 {
-            mutate(&front, &mut rng)
+            mutate(&front_0, &mut rng)
         } else {
-            front.clone()
+            front_0.clone()
         };
         let back = if which == 2 {
-            mutate(&back, &mut rng)
+            mutate(&back_0, &mut rng)
         } else {
-            back.clone()
+            back_0.clone()
         };
         let resolution = 1 + rng.below(3) as u32;
+        let changed: Vec<String> = [(&text, &garment), (&front, &front_0), (&back, &back_0)]
+            .iter()
+            .flat_map(|(a, b)| {
+                a.lines()
+                    .zip(b.lines())
+                    .filter(|(x, y)| x != y)
+                    .map(|(x, _)| x.trim().to_string())
+                    .take(3)
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        let case = format!(
+            "{case} at resolution {resolution} ({})",
+            changed.join(" | ")
+        );
         let read = |name: &str| match name {
             "tshirt_front.txt" => Pattern::parse(front.as_bytes(), name),
             "tshirt_back.txt" => Pattern::parse(back.as_bytes(), name),
@@ -296,7 +316,10 @@ fn mutated_garments_and_patterns_load_cleanly_or_fail_cleanly() {
         let _ = Pattern::parse(&bytes, "random.txt");
     }
     println!("garments: {loaded} laid out and stepped, {errors} refused");
-    assert!(errors > 0 && loaded > 0, "the mutations test nothing");
+    assert!(
+        cases() < 100 || (errors > 0 && loaded > 0),
+        "the mutations test nothing"
+    );
 }
 
 /// Keys of every kind of field `--set` reaches.
@@ -381,7 +404,10 @@ fn random_set_pairs_apply_cleanly_or_fail_cleanly() {
         run_scene(&scene, &case);
     }
     println!("--set: {applied} applied, {errors} refused");
-    assert!(errors > 0 && applied > 0, "the pairs test nothing");
+    assert!(
+        cases() < 100 || (errors > 0 && applied > 0),
+        "the pairs test nothing"
+    );
 }
 
 #[test]
@@ -454,5 +480,8 @@ fn random_edits_of_a_running_cloth_never_panic_and_invalid_ones_recover() {
     println!(
         "plugin: {ran} edits run, {refused} refused by the path or value, {invalid_seen} made the cloth invalid and recovered"
     );
-    assert!(invalid_seen > 0 && refused > 0, "the edits test nothing");
+    assert!(
+        cases() < 400 || (invalid_seen > 0 && refused > 0),
+        "the edits test nothing"
+    );
 }

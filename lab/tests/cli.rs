@@ -578,3 +578,20 @@ fn a_summary_into_a_closed_pipe_ends_quietly() {
         "{err}"
     );
 }
+
+#[test]
+fn a_short_soak_finds_nothing() {
+    // The soak's CI variant: 3 s of the curtain with every kind of disturbance (the hour
+    // run is in the README).
+    let out = run_ok([
+        "soak",
+        "assets/scenes/curtain.ron",
+        "--minutes",
+        "0.05",
+        "--json",
+    ]);
+    let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(summary["steps"].as_u64().unwrap() > 100, "{summary}");
+    assert_eq!(summary["non_finite_steps"], 0, "{summary}");
+    assert_eq!(summary["accepted_invalid_edits"], 0, "{summary}");
+}

@@ -267,6 +267,22 @@ fn check_header(
     if desc.pieces.is_empty() {
         return Err(error("pieces", "a garment needs at least one piece".into()));
     }
+    let limit = crate::limits::MAX_POSITION;
+    for piece in &desc.pieces {
+        let placed = piece.translation.is_finite()
+            && piece.translation.length() <= limit
+            && piece.yaw_degrees.is_finite()
+            && piece.yaw_degrees.abs() <= limit;
+        if !placed {
+            return Err(error(
+                &format!("\"{}\"", piece.name),
+                format!(
+                    "piece `{}`: translation and yaw_degrees must be finite and within 1e5 (limits::MAX_POSITION)",
+                    piece.name
+                ),
+            ));
+        }
+    }
     Ok(())
 }
 
