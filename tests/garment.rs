@@ -340,7 +340,7 @@ fn drop_particle(start: Vec3, collider: Collider, seconds: f32) -> ClothSolver {
 }
 
 #[test]
-fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_and_a_plane() {
+fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_a_box_and_a_plane() {
     let thickness = 0.01;
     let collider = |shape| Collider {
         shape,
@@ -378,6 +378,17 @@ fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_and_a_plane() {
             Vec3::new(0.0, 0.6 + thickness, 0.0),
         ),
         (
+            // An axis-aligned box: the particle rests on its top face.
+            "box, top face",
+            collider(ColliderShape::Cuboid {
+                center: Vec3::new(0.0, 0.5, 0.0),
+                axes: [Vec3::X, Vec3::Y, Vec3::Z],
+                half_extents: Vec3::new(0.3, 0.2, 0.1),
+            }),
+            Vec3::new(0.1, 1.5, 0.05),
+            Vec3::new(0.1, 0.7 + thickness, 0.05),
+        ),
+        (
             "plane",
             collider(ColliderShape::Plane {
                 point: Vec3::new(0.0, 0.25, 0.0),
@@ -401,6 +412,41 @@ fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_and_a_plane() {
         // The analytic signed distance is the thickness.
         assert!((c.distance(x).0 - thickness).abs() < 1e-4, "{name}");
     }
+}
+
+#[test]
+fn a_particle_rests_on_a_turned_box_at_the_thickness_from_its_top_face() {
+    // A box turned 20° about z (tan 20° = 0.36 < μ = 0.5: the particle sticks where it
+    // lands). The box's own signed distance is the analytic answer: the thickness, on the
+    // face whose normal is the box's turned +y.
+    let turn = bevy::math::Quat::from_rotation_z(20f32.to_radians());
+    let axes = [turn * Vec3::X, turn * Vec3::Y, turn * Vec3::Z];
+    let c = Collider {
+        shape: ColliderShape::Cuboid {
+            center: Vec3::new(0.0, 0.5, 0.0),
+            axes,
+            half_extents: Vec3::new(0.4, 0.1, 0.2),
+        },
+        thickness: 0.01,
+        friction: 0.5,
+    };
+    let cloth = drop_particle(Vec3::new(0.05, 1.2, 0.0), c, 2.0);
+    let x = cloth.positions()[0];
+    let (d, n) = c.distance(x);
+    assert!((d - 0.01).abs() < 1e-4, "rests {d} m from the surface");
+    assert!(n.distance(axes[1]) < 1e-5, "on the top face: normal {n}");
+    assert!(cloth.particles().velocity[0].length() < 1e-3, "still moves");
+    // Inside, the nearest face: 0.02 m under the top face, 0.08 m above the bottom one.
+    let inside = Vec3::new(0.0, 0.5, 0.0) + axes[1] * 0.08;
+    let (d, n) = c.distance(inside);
+    assert!(
+        (d + 0.02).abs() < 1e-6 && n.distance(axes[1]) < 1e-6,
+        "{d} {n}"
+    );
+    // Off a corner: the distance to the corner point.
+    let corner = Vec3::new(0.0, 0.5, 0.0) + axes[0] * 0.4 + axes[1] * 0.1 + axes[2] * 0.2;
+    let out = corner + (axes[0] + axes[1] + axes[2]).normalize() * 0.3;
+    assert!((c.distance(out).0 - 0.3).abs() < 1e-5);
 }
 
 #[test]

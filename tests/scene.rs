@@ -2,6 +2,7 @@
 
 use std::path::Path;
 
+use bevy::prelude::{GlobalTransform, Vec3};
 use bevy_cloth::prelude::*;
 
 #[test]
@@ -216,4 +217,33 @@ fn xpbd_reads_from_scene_files_and_overrides_and_only_it_takes_an_infinite_stiff
         .apply_override("cloth.params.springs.structural.stiffness=inf")
         .unwrap_err();
     assert!(matches!(e, SceneError::Override { .. }), "{e}");
+}
+
+#[test]
+fn a_box_collider_reads_from_a_scene_and_scales_with_its_transform() {
+    let text = "(cloths: [(cloth: (shape: Grid(width: 4, height: 4, spacing: 0.1)))],
+        colliders: [(translation: (1.0, 0.0, 0.0),
+                     collider: (shape: Cuboid(half_extents: (0.1, 0.2, 0.3)), thickness: 0.01, friction: 0.3))])";
+    let scene = ClothScene::parse(text, std::path::Path::new("box.ron")).unwrap();
+    let collider = &scene.colliders[0];
+    let transform = collider.transform().with_scale(Vec3::new(2.0, 1.0, 1.0));
+    match collider
+        .collider
+        .to_world(&GlobalTransform::from(transform))
+        .shape
+    {
+        bevy_cloth::solver::ColliderShape::Cuboid {
+            center,
+            half_extents,
+            ..
+        } => {
+            assert_eq!(center, Vec3::new(1.0, 0.0, 0.0));
+            assert_eq!(half_extents, Vec3::new(0.2, 0.2, 0.3));
+        }
+        other => panic!("{other:?}"),
+    }
+    // A flat box is refused, naming the field.
+    let flat = text.replace("(0.1, 0.2, 0.3)", "(0.1, 0.0, 0.3)");
+    let e = ClothScene::parse(&flat, std::path::Path::new("box.ron")).unwrap_err();
+    assert!(e.to_string().contains("half_extents.y"), "{e}");
 }

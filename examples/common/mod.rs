@@ -184,6 +184,9 @@ pub fn spawn_scene(
                     radius,
                     half_length,
                 } => Capsule3d::new(radius, 2.0 * half_length).mesh().build(),
+                ColliderKind::Cuboid { half_extents: h } => {
+                    Cuboid::new(2.0 * h.x, 2.0 * h.y, 2.0 * h.z).mesh().build()
+                }
                 ColliderKind::Plane => Plane3d::default().mesh().size(4.0, 4.0).build(),
             };
             commands.entity(entity).insert((

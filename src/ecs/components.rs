@@ -168,6 +168,13 @@ pub enum ColliderKind {
         /// Half the length of the axis segment (without the caps), m.
         half_length: f32,
     },
+    /// A box about the origin, `half_extents` along local x, y and z (scaled per axis by
+    /// the transform).
+    Cuboid {
+        /// Half its size along local x, y, z, m.
+        #[serde(with = "crate::params::vec3_serde")]
+        half_extents: Vec3,
+    },
     /// The half-space below the local xz plane (normal +y): a ground or a wall.
     Plane,
 }
@@ -198,6 +205,11 @@ impl ClothCollider {
             radius,
             half_length,
         })
+    }
+
+    /// A box of `half_extents` m along local x, y and z.
+    pub fn cuboid(half_extents: Vec3) -> Self {
+        Self::new(ColliderKind::Cuboid { half_extents })
     }
 
     /// A plane through the origin with normal +y.
@@ -254,6 +266,20 @@ impl ClothCollider {
                     "a half-length from 0 to 1e5 m",
                 )?;
             }
+            ColliderKind::Cuboid { half_extents: h } => {
+                for (field, value) in [
+                    ("half_extents.x", h.x),
+                    ("half_extents.y", h.y),
+                    ("half_extents.z", h.z),
+                ] {
+                    size(
+                        field,
+                        value,
+                        true,
+                        "a half-extent from 0 (excluded) to 1e5 m",
+                    )?;
+                }
+            }
             ColliderKind::Plane => {}
         }
         size(
@@ -288,6 +314,14 @@ impl ClothCollider {
                 b: transform.transform_point(Vec3::new(0.0, half_length.max(0.0), 0.0)),
                 radius: radius.max(0.0) * scale,
             },
+            ColliderKind::Cuboid { half_extents } => {
+                let rotation = transform.rotation();
+                ColliderShape::Cuboid {
+                    center: transform.translation(),
+                    axes: [rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z],
+                    half_extents: half_extents.max(Vec3::ZERO) * transform.scale().abs(),
+                }
+            }
             ColliderKind::Plane => ColliderShape::Plane {
                 point: transform.translation(),
                 normal: transform.rotation() * Vec3::Y,

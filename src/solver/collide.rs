@@ -1,4 +1,4 @@
-//! Colliders: spheres, capsules and planes the particles are kept out of, every substep,
+//! Colliders: spheres, capsules, boxes and planes the particles are kept out of, every substep,
 //! with a thickness and Coulomb friction (position-based, as in Macklin et al. 2014,
 //! "Unified particle physics for real-time applications", §6.1).
 
@@ -24,6 +24,15 @@ pub enum ColliderShape {
         b: Vec3,
         /// Radius, m.
         radius: f32,
+    },
+    /// A box: `center` plus up to `half_extents` along each of its unit `axes`.
+    Cuboid {
+        /// Centre, m.
+        center: Vec3,
+        /// Its three axes, unit and orthogonal (the columns of its rotation).
+        axes: [Vec3; 3],
+        /// Half its size along each axis, m.
+        half_extents: Vec3,
     },
     /// The half-space behind a plane (a ground).
     Plane {
@@ -111,6 +120,18 @@ impl Collider {
             ColliderShape::Capsule { a, b, radius } => {
                 around(a.min(b), a.max(b), radius + self.thickness)
             }
+            ColliderShape::Cuboid {
+                center,
+                axes,
+                half_extents,
+            } => {
+                // The box's extent along each world axis: Σ |axis_k| h_k.
+                let extent = axes[0].abs() * half_extents.x
+                    + axes[1].abs() * half_extents.y
+                    + axes[2].abs() * half_extents.z;
+                let reach = self.thickness;
+                around(center - extent, center + extent, reach)
+            }
             ColliderShape::Plane { .. } => Bounds {
                 min: Vec3::NEG_INFINITY,
                 max: Vec3::INFINITY,
@@ -125,7 +146,7 @@ impl Collider {
     #[inline]
     pub(super) fn penetration(&self, x: Vec3) -> Option<(f32, Vec3)> {
         let (d, n) = match self.shape {
-            ColliderShape::Plane { .. } => self.distance(x),
+            ColliderShape::Plane { .. } | ColliderShape::Cuboid { .. } => self.distance(x),
             _ => {
                 let (offset, radius) = self.off_core(x);
                 // A relative margin of 1e-4 leaves the particles near the band's edge
@@ -147,6 +168,11 @@ impl Collider {
     pub fn distance(&self, x: Vec3) -> (f32, Vec3) {
         match self.shape {
             ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
+            ColliderShape::Cuboid {
+                center,
+                axes,
+                half_extents,
+            } => box_distance(x - center, axes, half_extents),
             _ => {
                 let (offset, radius) = self.off_core(x);
                 self.surface(offset, radius)
@@ -167,6 +193,7 @@ impl Collider {
                 (x - (a + axis * t), radius)
             }
             ColliderShape::Plane { point, .. } => (x - point, 0.0),
+            ColliderShape::Cuboid { center, .. } => (x - center, 0.0),
         }
     }
 
@@ -179,6 +206,36 @@ impl Collider {
             _ => Vec3::Y,
         });
         (offset.length() - radius, normal)
+    }
+}
+
+/// Signed distance from a box's surface and the outward normal at the nearest surface
+/// point, for `offset` from its centre: outside, the distance to the nearest point of the
+/// box; inside, minus the distance to the nearest face, whose normal it takes.
+fn box_distance(offset: Vec3, axes: [Vec3; 3], half: Vec3) -> (f32, Vec3) {
+    let local = Vec3::new(
+        offset.dot(axes[0]),
+        offset.dot(axes[1]),
+        offset.dot(axes[2]),
+    );
+    let q = local.abs() - half;
+    let world = |v: Vec3| axes[0] * v.x + axes[1] * v.y + axes[2] * v.z;
+    if q.max_element() > 0.0 {
+        let outside = q.max(Vec3::ZERO) * local.signum();
+        let length = outside.length();
+        (length, world(outside / length))
+    } else {
+        // The face nearest: the axis with the largest (least negative) q.
+        let k = if q.x >= q.y && q.x >= q.z {
+            0
+        } else if q.y >= q.z {
+            1
+        } else {
+            2
+        };
+        let mut n = Vec3::ZERO;
+        n[k] = if local[k] >= 0.0 { 1.0 } else { -1.0 };
+        (q[k], world(n))
     }
 }
 
