@@ -46,8 +46,9 @@ pub mod stats;
 /// The types a user needs to add cloth to an app.
 pub mod prelude {
     pub use crate::ecs::components::{
-        Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothLod, ClothPause,
-        ClothSimulation, ClothSleep, ClothStats, ClothTorn, ClothWake, ColliderKind, StatSample,
+        AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothCollider, ClothEnvironment,
+        ClothInvalid, ClothLod, ClothPause, ClothSimulation, ClothSleep, ClothStats, ClothTorn,
+        ClothWake, ColliderKind, StatSample,
     };
     pub use crate::ecs::controls::{ClothControls, ClothControlsPlugin};
     pub use crate::ecs::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};

@@ -621,3 +621,76 @@ fn a_hidden_cloth_steps_but_writes_its_mesh_only_when_shown() {
         "written when shown"
     );
 }
+
+#[test]
+fn an_attached_cloth_follows_its_moving_entity_with_no_lag_beyond_a_step() {
+    // A cape-like cloth hanging from a "shoulder" entity that walks along x and turns:
+    // its two top corners, attached, are where the entity puts them at the end of every
+    // step (the solver reaches the target over the step's substeps, as pins do).
+    let mut app = app();
+    let shoulder = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
+        .id();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 6, 0.05).with_pins(Pins::None),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+            ClothAttachments(vec![
+                ClothAttachment::indices(shoulder, vec![0]),
+                ClothAttachment::nearest(shoulder, Vec3::new(0.175, 0.0, 0.0), 1),
+            ]),
+        ))
+        .id();
+    // Built in the first frame (by command), attached from the second.
+    app.update();
+    app.update();
+    let held: Vec<(u32, Vec3)> = app
+        .world()
+        .get::<ClothAttachments>(cloth)
+        .unwrap()
+        .0
+        .iter()
+        .flat_map(|a| a.held().to_vec())
+        .collect();
+    assert_eq!(held.iter().map(|h| h.0).collect::<Vec<_>>(), [0, 7]);
+    for frame in 1..=60 {
+        {
+            let mut t = app.world_mut().get_mut::<Transform>(shoulder).unwrap();
+            t.translation.x += 0.02;
+            t.rotate_y(0.01);
+        }
+        app.update();
+        let t = *app.world().get::<Transform>(shoulder).unwrap();
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        for &(i, local) in &held {
+            let want = t.transform_point(local);
+            let got = sim.solver.positions()[i as usize];
+            assert!(
+                got.distance(want) < 1e-5,
+                "frame {frame}: particle {i} at {got}, the shoulder puts it at {want}"
+            );
+        }
+        // The rest of the cloth hangs below and follows (a sheet 0.25 m long).
+        let lowest = sim
+            .solver
+            .positions()
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::MAX, f32::min);
+        assert!(
+            lowest < 2.0 && lowest > 1.6,
+            "frame {frame}: lowest {lowest}"
+        );
+        assert!(sim.solver.is_stable());
+    }
+    // The entity gone: the cloth is let go and falls.
+    app.world_mut().despawn(shoulder);
+    for _ in 0..30 {
+        app.update();
+    }
+    let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+    assert!(sim.solver.attached().is_empty());
+    assert!(sim.solver.positions()[0].y < 1.0);
+}

@@ -955,3 +955,54 @@ fn the_power_iteration_finds_the_lattice_eigenvalue() {
         );
     }
 }
+
+#[test]
+fn an_attached_particle_reaches_its_target_every_step_and_falls_when_let_go() {
+    // Every model: the attached corner is at its target at the end of each step, the
+    // cloth hangs from it, and once detached it falls freely.
+    for model in [
+        Model::MassSpring,
+        Model::Xpbd(XpbdParams::default()),
+        Model::Patches(PatchParams {
+            part_width: 2,
+            part_height: 2,
+            ..PatchParams::default()
+        }),
+    ] {
+        let params = ClothParams {
+            model,
+            ..ClothParams::default()
+        };
+        let mut cloth = ClothShape::Grid {
+            width: 6,
+            height: 6,
+            spacing: 0.05,
+        }
+        .build_solver(&Pins::None, &params, Affine3A::IDENTITY)
+        .unwrap();
+        let env = Environment::default();
+        for step in 0..60 {
+            let target = Vec3::new(0.01 * step as f32, 0.0, 0.0);
+            cloth.attach(0, target).unwrap();
+            cloth.step(DT, &env);
+            assert!(
+                cloth.positions()[0].distance(target) < 1e-5,
+                "{model:?} step {step}"
+            );
+        }
+        assert_eq!(cloth.attached(), [0]);
+        let hanging = cloth.positions()[35].y;
+        assert!(hanging < -0.2, "{model:?}: hangs to {hanging}");
+        assert!(cloth.detach(0));
+        let y0 = cloth.positions()[0].y;
+        for _ in 0..10 {
+            cloth.step(DT, &env);
+        }
+        assert!(
+            cloth.positions()[0].y < y0 - 0.05,
+            "{model:?}: let go, falls"
+        );
+        assert!(cloth.attach(99, Vec3::ZERO).is_err());
+        assert!(cloth.attach(1, Vec3::splat(f32::NAN)).is_err());
+    }
+}

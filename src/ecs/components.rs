@@ -612,6 +612,64 @@ impl ClothLod {
     }
 }
 
+/// Attaches particles of this cloth to other entities (a cape to a character's
+/// shoulders, a flag to a mast): each attached particle follows its entity's global
+/// transform every step, interpolated over the substeps as pins are, at the point it had
+/// in that entity's frame when first attached.
+#[derive(Component, Clone, Debug, Default)]
+pub struct ClothAttachments(pub Vec<ClothAttachment>);
+
+/// One entity and the particles held to it (see [`ClothAttachments`]).
+#[derive(Clone, Debug)]
+pub struct ClothAttachment {
+    /// The entity followed.
+    pub target: Entity,
+    /// Which particles.
+    pub particles: AttachParticles,
+    /// Each particle and its point in the target's frame, fixed when first attached.
+    pub(crate) held: Vec<(u32, Vec3)>,
+}
+
+/// Which particles an attachment holds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum AttachParticles {
+    /// By index (`j·width + i` for a grid); indices past the cloth are skipped.
+    Indices(Vec<u32>),
+    /// The `count` particles nearest `point`, a point in the target's frame (a shoulder).
+    Nearest {
+        /// The point, in the target entity's frame.
+        point: Vec3,
+        /// How many particles.
+        count: u32,
+    },
+}
+
+impl ClothAttachment {
+    /// Particles `indices` held to `target`.
+    pub fn indices(target: Entity, indices: Vec<u32>) -> Self {
+        Self {
+            target,
+            particles: AttachParticles::Indices(indices),
+            held: Vec::new(),
+        }
+    }
+
+    /// The `count` particles nearest `point` (in `target`'s frame) held to `target`.
+    pub fn nearest(target: Entity, point: Vec3, count: u32) -> Self {
+        Self {
+            target,
+            particles: AttachParticles::Nearest { point, count },
+            held: Vec::new(),
+        }
+    }
+
+    /// The particles held and their points in the target's frame (empty until the first
+    /// step after the cloth is built).
+    pub fn held(&self) -> &[(u32, Vec3)] {
+        &self.held
+    }
+}
+
 /// Wakes a sleeping cloth (see [`ClothSleep`]): the game's own reason to move it.
 #[derive(Message, Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ClothWake(pub Entity);

@@ -25,8 +25,8 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
 use crate::ecs::components::{
-    Cloth, ClothCollider, ClothEnvironment, ClothInvalid, ClothLod, ClothPause, ClothSimulation,
-    ClothSleep, ClothStats, ClothTorn, ClothWake,
+    AttachParticles, Cloth, ClothAttachments, ClothCollider, ClothEnvironment, ClothInvalid,
+    ClothLod, ClothPause, ClothSimulation, ClothSleep, ClothStats, ClothTorn, ClothWake,
 };
 use crate::ecs::mesh::{MeshSource, cloth_mesh, mesh_triangles, write_mesh};
 use crate::error::ClothError;
@@ -196,6 +196,7 @@ impl Plugin for ClothPlugin {
                 (
                     choose_levels,
                     build_cloths,
+                    attach_cloths,
                     place_colliders,
                     wake_cloths,
                     begin_steps,
@@ -471,6 +472,58 @@ fn place_colliders(
     for mut sim in &mut cloths {
         if !(world_colliders.is_empty() && sim.solver.colliders().is_empty()) {
             sim.solver.set_colliders(world_colliders.iter().copied());
+        }
+    }
+}
+
+/// Holds each [`ClothAttachments`] cloth's particles at their entities' global
+/// transforms for this step (the solver reaches them over its substeps). The particles and
+/// their points in the target's frame are fixed the first time; a target without a
+/// transform (despawned) lets its particles go.
+fn attach_cloths(
+    transforms: TransformHelper,
+    mut cloths: Query<(&mut ClothSimulation, &mut ClothAttachments)>,
+) {
+    for (mut sim, mut attachments) in &mut cloths {
+        let solver = &mut sim.solver;
+        for attachment in &mut attachments.0 {
+            let Ok(frame) = transforms.compute_global_transform(attachment.target) else {
+                for &(i, _) in &attachment.held {
+                    solver.detach(i);
+                }
+                continue;
+            };
+            if attachment.held.is_empty() {
+                let x = solver.positions();
+                let chosen: Vec<u32> = match &attachment.particles {
+                    AttachParticles::Indices(list) => list
+                        .iter()
+                        .copied()
+                        .filter(|&i| (i as usize) < x.len())
+                        .collect(),
+                    AttachParticles::Nearest { point, count } => {
+                        let at = frame.transform_point(*point);
+                        let mut order: Vec<u32> = (0..x.len() as u32).collect();
+                        order.sort_by(|&a, &b| {
+                            x[a as usize]
+                                .distance_squared(at)
+                                .total_cmp(&x[b as usize].distance_squared(at))
+                        });
+                        order.truncate(*count as usize);
+                        order
+                    }
+                };
+                let to_local = frame.affine().inverse();
+                attachment.held = chosen
+                    .into_iter()
+                    .map(|i| (i, to_local.transform_point3(x[i as usize])))
+                    .collect();
+            }
+            for &(i, local) in &attachment.held {
+                if let Err(e) = solver.attach(i, frame.transform_point(local)) {
+                    warn!("cloth attachment: {e}");
+                }
+            }
         }
     }
 }

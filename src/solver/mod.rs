@@ -62,7 +62,13 @@ pub struct ClothSolver {
     vertex_faces: topology::VertexFaces,
     faces_changed: bool,
     params: ClothParams,
+    /// Pinned particles: the layout's (the first `fixed_pins`), then the attached ones
+    /// (`drivers.rs`).
     pins: Vec<u32>,
+    /// Each pin's world target when set from outside (an attachment), `None` for a pin
+    /// that follows the frame.
+    pin_goal: Vec<Option<Vec3>>,
+    fixed_pins: usize,
     pin_from: Vec<Vec3>,
     pin_to: Vec<Vec3>,
     frame: Affine3A,
@@ -193,6 +199,8 @@ impl ClothSolver {
             params: *params,
             pin_from: Vec::with_capacity(pin_indices.len()),
             pin_to: Vec::with_capacity(pin_indices.len()),
+            pin_goal: vec![None; pin_indices.len()],
+            fixed_pins: pin_indices.len(),
             pins: pin_indices,
             frame,
             time: 0.0,
@@ -244,6 +252,10 @@ impl ClothSolver {
             ModelState::Patches(_) => self.model = ModelState::None,
             ModelState::None | ModelState::Xpbd(_) => {}
         }
+        // Attachments are dropped (their owner attaches again on its next step).
+        self.pins.truncate(self.fixed_pins);
+        self.pin_goal.clear();
+        self.pin_goal.resize(self.fixed_pins, None);
         let mass = self.params.node_mass;
         let p = &mut self.particles;
         for (i, local) in self.local_rest.iter().enumerate() {
@@ -405,7 +417,8 @@ impl ClothSolver {
         // Pins move from where they are to where the frame puts them, over the substeps.
         std::mem::swap(&mut self.pin_from, &mut self.pin_to);
         for (k, &i) in self.pins.iter().enumerate() {
-            self.pin_to[k] = self.frame.transform_point3(self.local_rest[i as usize]);
+            self.pin_to[k] = self.pin_goal[k]
+                .unwrap_or_else(|| self.frame.transform_point3(self.local_rest[i as usize]));
             self.pin_from[k] = self.particles.position[i as usize];
         }
         if let Some(g) = &mut self.grab {
