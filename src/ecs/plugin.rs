@@ -519,10 +519,14 @@ fn attach_cloths(
                     .map(|i| (i, to_local.transform_point3(x[i as usize])))
                     .collect();
             }
-            for &(i, local) in &attachment.held {
-                if let Err(e) = solver.attach(i, frame.transform_point(local)) {
-                    warn!("cloth attachment: {e}");
-                }
+            let attached = attachment
+                .held
+                .iter()
+                .try_for_each(|&(i, local)| solver.attach(i, frame.transform_point(local)));
+            if let Err(e) = attached {
+                // A rebuilt cloth with fewer particles: chosen again next step.
+                warn!("cloth attachment: {e}; choosing its particles again");
+                attachment.held.clear();
             }
         }
     }
