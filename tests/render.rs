@@ -1,6 +1,6 @@
-//! The render test: the curtain example under Xvfb with Mesa's software Vulkan, two
-//! screenshots, and checks from the pixels that the cloth is drawn where the camera looks
-//! and that it moved between them. Catches a black window, a mesh that is not updated and
+//! The render test: each example (curtain, card, T-shirt, flag) under Xvfb with Mesa's
+//! software Vulkan, two screenshots, and checks from the pixels that the cloth is drawn
+//! where the camera looks and that it moved between them. Catches a black window, a mesh that is not updated and
 //! a frozen simulation.
 //!
 //! Needs `Xvfb` and a Vulkan driver (`apt-get install xvfb mesa-vulkan-drivers`; `.ci/run`
@@ -199,4 +199,11 @@ fn tshirt_renders_and_moves() {
         (40, 120),
         0.02..0.5,
     );
+}
+
+#[test]
+fn flag_renders_and_moves() {
+    // The textured flag on its pole, carried round a circle: its coloured bands are the
+    // cloth's pixels, and it moves with the pole (issue 18's attachment and texture).
+    renders_and_moves("flag", &[], (40, 120), 0.005..0.4);
 }
