@@ -2,6 +2,8 @@
 //! the render mesh written in place, and the opt-in keyboard controls. It owns each
 //! solver inside a component and knows nothing of how a layout is made.
 
+#[cfg(feature = "avian")]
+pub mod avian;
 pub mod components;
 pub mod controls;
 pub mod mesh;

@@ -461,6 +461,14 @@ fn invalidate(commands: &mut Commands, entity: Entity, error: ClothError) {
 fn place_colliders(
     transforms: TransformHelper,
     colliders: Query<(Entity, &ClothCollider)>,
+    #[cfg(feature = "avian")] avian_colliders: Query<
+        (
+            Entity,
+            &avian3d::prelude::Collider,
+            Option<&avian3d::prelude::Friction>,
+        ),
+        Without<ClothCollider>,
+    >,
     mut cloths: Query<&mut ClothSimulation>,
     mut world_colliders: Local<Vec<solver::Collider>>,
 ) {
@@ -469,6 +477,16 @@ fn place_colliders(
         let transform = transforms.compute_global_transform(entity).ok()?;
         Some(collider.to_world(&transform))
     }));
+    // avian bodies' colliders (`ecs/avian.rs`), unless the entity has its own.
+    #[cfg(feature = "avian")]
+    world_colliders.extend(
+        avian_colliders
+            .iter()
+            .filter_map(|(entity, collider, friction)| {
+                let transform = transforms.compute_global_transform(entity).ok()?;
+                crate::ecs::avian::to_solver_collider(collider, &transform, friction)
+            }),
+    );
     for mut sim in &mut cloths {
         if !(world_colliders.is_empty() && sim.solver.colliders().is_empty()) {
             sim.solver.set_colliders(world_colliders.iter().copied());
