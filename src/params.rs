@@ -347,6 +347,12 @@ impl Default for PatchParams {
 }
 
 impl PatchParams {
+    /// What the part lattice is built from (part width, part height, targets): a change
+    /// of these rebuilds it, and is a model switch; the other fields are only parameters.
+    pub fn lattice_key(&self) -> (u32, u32, PatchTargets) {
+        (self.part_width, self.part_height, self.targets)
+    }
+
     fn validate(&self) -> Result<(), ClothError> {
         for (field, size) in [
             ("model.part_width", self.part_width),

@@ -529,8 +529,8 @@ impl ClothSolver {
                 }
             }
             Model::Patches(patch) => {
-                let size = (patch.part_width, patch.part_height, patch.targets);
-                let built = self.model.patches().is_none_or(|p| p.built_for != size);
+                let key = patch.lattice_key();
+                let built = self.model.patches().is_none_or(|p| p.built_for != key);
                 if built {
                     self.model = ModelState::None;
                     if let Some(grid) = self.grid

@@ -297,7 +297,7 @@ impl Patches {
             stencil,
             anchors,
             rest_step,
-            built_for: (patch.part_width, patch.part_height, patch.targets),
+            built_for: patch.lattice_key(),
             ease: Vec::new(),
             ease_left: 0.0,
         })

@@ -108,9 +108,7 @@ impl ClothSolver {
 /// the patch model at another part size).
 fn changes_model(from: Model, to: Model) -> bool {
     match (from, to) {
-        (Model::Patches(a), Model::Patches(b)) => {
-            (a.part_width, a.part_height, a.targets) != (b.part_width, b.part_height, b.targets)
-        }
+        (Model::Patches(a), Model::Patches(b)) => a.lattice_key() != b.lattice_key(),
         (a, b) => std::mem::discriminant(&a) != std::mem::discriminant(&b),
     }
 }
