@@ -346,6 +346,7 @@ fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_a_box_and_a_plane() {
         shape,
         thickness,
         friction: 0.5,
+        motion: bevy_cloth::solver::Motion::NONE,
     };
     let cases = [
         (
@@ -429,6 +430,7 @@ fn a_particle_rests_on_a_turned_box_at_the_thickness_from_its_top_face() {
         },
         thickness: 0.01,
         friction: 0.5,
+        motion: bevy_cloth::solver::Motion::NONE,
     };
     let cloth = drop_particle(Vec3::new(0.05, 1.2, 0.0), c, 2.0);
     let x = cloth.positions()[0];
@@ -461,6 +463,7 @@ fn friction_holds_on_a_slope_below_its_angle_and_lets_go_above() {
         },
         thickness: 0.0,
         friction,
+        motion: bevy_cloth::solver::Motion::NONE,
     };
     // Start on the surface at rest.
     let start = Vec3::ZERO;
@@ -714,4 +717,195 @@ fn the_plugin_loads_garments_as_assets_and_rebuilds_them_when_a_file_changes() {
     );
     assert!(update_until(&mut app, 10.0, |app| built(app) == Some(Ok(16))));
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// A cloth of 6 × 6 particles 4 cm apart lying flat (in xz) with its middle at `centre`.
+fn flat_cloth(centre: Vec3) -> ClothSolver {
+    let frame = Affine3A::from_rotation_translation(
+        bevy::math::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        centre,
+    );
+    let mut cloth = Cloth::grid(6, 6, 0.04)
+        .with_pins(Pins::None)
+        .build(frame)
+        .expect("builds");
+    let mean = cloth.positions().iter().sum::<Vec3>() / 36.0;
+    let y = cloth.positions().iter().map(|x| (x.y - mean.y).abs());
+    assert!(y.fold(0.0, f32::max) < 1e-5, "lies flat");
+    cloth
+        .set_params(&ClothParams {
+            drag: 0.0,
+            ..cloth.params().clone()
+        })
+        .unwrap();
+    cloth
+}
+
+fn centroid(cloth: &ClothSolver) -> Vec3 {
+    cloth.positions().iter().sum::<Vec3>() / cloth.positions().len() as f32
+}
+
+#[test]
+fn friction_against_a_moving_box_carries_the_cloth_along() {
+    // A 2 × 0.2 × 2 m box (top at y = 0.1) slides along x at 0.5 m/s under a cloth
+    // lying on it, μ = 0.8. With the box's motion the cloth is carried: after 1 s it has
+    // moved with the box, less the few cm it slipped while friction (μg = 7.8 m/s²) took
+    // it to the box's speed (v²/2μg = 1.6 cm). Without it, friction holds the cloth to
+    // the world and the box slides away under it.
+    let (dt, steps, speed) = (0.016, 62, 0.5);
+    let box_at = |t: f32, motion| Collider {
+        shape: ColliderShape::Cuboid {
+            center: Vec3::new(speed * t, 0.0, 0.0),
+            axes: [Vec3::X, Vec3::Y, Vec3::Z],
+            half_extents: Vec3::new(1.0, 0.1, 1.0),
+        },
+        thickness: 0.005,
+        friction: 0.8,
+        motion,
+    };
+    let env = Environment::default();
+    let run = |moving: bool| {
+        let mut cloth = flat_cloth(Vec3::new(0.0, 0.106, 0.0));
+        let start = centroid(&cloth);
+        for k in 1..=steps {
+            let t = k as f32 * dt;
+            let motion = if moving {
+                bevy_cloth::solver::Motion {
+                    linear: Vec3::X * speed,
+                    angular: Vec3::ZERO,
+                    pivot: Vec3::new(speed * t, 0.0, 0.0),
+                }
+            } else {
+                bevy_cloth::solver::Motion::NONE
+            };
+            cloth.set_colliders([box_at(t, motion)]);
+            cloth.step(dt, &env);
+        }
+        let v = cloth.particles().velocity.iter().sum::<Vec3>() / 36.0;
+        (centroid(&cloth) - start, v)
+    };
+    let travelled = speed * steps as f32 * dt;
+    let (carried, velocity) = run(true);
+    eprintln!("carried {carried} at {velocity} (the box {travelled} m)");
+    assert!(
+        (carried.x - travelled).abs() < 0.03 && carried.x < travelled,
+        "carried {carried}, the box moved {travelled}"
+    );
+    assert!((velocity.x - speed).abs() < 0.01, "moves at {velocity}");
+    assert!(carried.y.abs() < 2e-3, "stays on the top: {carried}");
+    let (held, _) = run(false);
+    eprintln!("without the box's motion: {held}");
+    assert!(held.x.abs() < 0.01, "without the motion it stays: {held}");
+}
+
+#[test]
+fn a_moving_ball_pushes_a_particle_at_its_own_speed() {
+    // No gravity: a ball of radius 0.2 at 2 m/s along x meets a particle at rest 0.5 m
+    // ahead. Swept through each step, it pushes the particle to its front and on at its
+    // own speed; placed only where each step ends, it would throw it ahead at the 16 ms
+    // step's jump over one of the 8 substeps (12.5 m/s, measured).
+    let speed = 2.0;
+    let mut cloth = drop_particle(Vec3::new(0.5, 0.0, 0.0), plane_far(), 0.0);
+    cloth
+        .set_params(&ClothParams {
+            substeps: bevy_cloth::params::Substeps::Fixed(8),
+            ..cloth.params().clone()
+        })
+        .unwrap();
+
+    let env = Environment {
+        gravity_enabled: false,
+        ..Environment::default()
+    };
+    let (dt, steps) = (0.016, 40);
+    for k in 1..=steps {
+        let centre = Vec3::X * speed * k as f32 * dt;
+        cloth.set_colliders([Collider {
+            shape: ColliderShape::Sphere {
+                center: centre,
+                radius: 0.2,
+            },
+            thickness: 0.005,
+            friction: 0.3,
+            motion: bevy_cloth::solver::Motion {
+                linear: Vec3::X * speed,
+                angular: Vec3::ZERO,
+                pivot: centre,
+            },
+        }]);
+        cloth.step(dt, &env);
+    }
+    let ball = speed * steps as f32 * dt;
+    let (x, v) = (cloth.positions()[0], cloth.particles().velocity[0]);
+    eprintln!("particle at {x}, {v}; the ball's front at {}", ball + 0.205);
+    assert!((x.x - (ball + 0.205)).abs() < 2e-3, "at {x}");
+    assert!((v.x - speed).abs() < 0.02 * speed, "moves at {v}");
+}
+
+/// A plane far below, for a particle that should meet nothing else.
+fn plane_far() -> Collider {
+    Collider {
+        shape: ColliderShape::Plane {
+            point: Vec3::new(0.0, -100.0, 0.0),
+            normal: Vec3::Y,
+        },
+        thickness: 0.0,
+        friction: 0.0,
+        motion: bevy_cloth::solver::Motion::NONE,
+    }
+}
+
+#[test]
+fn a_turntable_carries_a_particle_round_and_a_cylinder_is_exact() {
+    // A flat cylinder (radius 0.5, 0.1 high, top at y = 0.05) turning about y at 1 rad/s,
+    // μ = 1: a particle put on it 0.3 m from the axis goes round with it, at that radius.
+    let omega = 1.0;
+    // (A cylinder about its own axis is the same at every angle: only its motion turns.)
+    let table = || Collider {
+        shape: ColliderShape::Cylinder {
+            center: Vec3::ZERO,
+            axis: Vec3::Y,
+            half_height: 0.05,
+            radius: 0.5,
+        },
+        thickness: 0.005,
+        friction: 1.0,
+        motion: bevy_cloth::solver::Motion {
+            linear: Vec3::ZERO,
+            angular: Vec3::Y * omega,
+            pivot: Vec3::ZERO,
+        },
+    };
+    let mut cloth = drop_particle(Vec3::new(0.3, 0.055, 0.0), table(), 0.0);
+    let (dt, steps) = (0.016, 100);
+    for _ in 0..steps {
+        cloth.set_colliders([table()]);
+        cloth.step(dt, &Environment::default());
+    }
+    let x = cloth.positions()[0];
+    let turned = steps as f32 * dt * omega;
+    let angle = (-x.z).atan2(x.x);
+    let radius = Vec3::new(x.x, 0.0, x.z).length();
+    eprintln!(
+        "turned {angle} rad (the table {turned}), radius {radius}, height {}",
+        x.y
+    );
+    assert!(
+        (angle - turned).abs() < 0.02,
+        "turned {angle}, the table {turned}"
+    );
+    assert!((radius - 0.3).abs() < 5e-3, "radius {radius}");
+    assert!((x.y - 0.055).abs() < 1e-4, "height {}", x.y);
+
+    // Distances: inside nearest the side and the top, beyond the side, the top and the rim.
+    let c = table();
+    let d = |x: Vec3| c.distance(x);
+    let close =
+        |a: (f32, Vec3), b: (f32, Vec3)| (a.0 - b.0).abs() < 1e-6 && a.1.distance(b.1) < 1e-6;
+    assert!(close(d(Vec3::new(0.47, 0.0, 0.0)), (-0.03, Vec3::X)));
+    assert!(close(d(Vec3::new(0.1, 0.04, 0.0)), (-0.01, Vec3::Y)));
+    assert!(close(d(Vec3::new(0.0, 0.0, -0.8)), (0.3, Vec3::NEG_Z)));
+    assert!(close(d(Vec3::new(0.2, -0.25, 0.0)), (0.2, Vec3::NEG_Y)));
+    let rim = d(Vec3::new(0.8, 0.45, 0.0));
+    assert!(close(rim, (0.5, Vec3::new(0.6, 0.8, 0.0))), "{rim:?}");
 }

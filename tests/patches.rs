@@ -596,6 +596,7 @@ fn part_centres_meet_the_colliders() {
         },
         thickness: 0.01,
         friction: 0.5,
+        motion: bevy_cloth::solver::Motion::NONE,
     }]);
     let env = Environment::default();
     for _ in 0..125 {

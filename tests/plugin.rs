@@ -694,3 +694,65 @@ fn an_attached_cloth_follows_its_moving_entity_with_no_lag_beyond_a_step() {
     assert!(sim.solver.attached().is_empty());
     assert!(sim.solver.positions()[0].y < 1.0);
 }
+
+#[test]
+fn a_cloth_lying_on_a_moving_collider_entity_is_carried_along() {
+    // A box entity moved by its Transform 8 mm each 16 ms frame (0.5 m/s along x), a
+    // cloth lying on it (μ = 0.8): the plugin gives the box its motion from the change of
+    // its transform, and friction carries the cloth with it (less the ~1.6 cm it slips
+    // while getting up to speed, v²/2μg).
+    let mut app = app();
+    let platform = app
+        .world_mut()
+        .spawn((
+            ClothCollider::cuboid(Vec3::new(1.0, 0.1, 1.0)).with_friction(0.8),
+            Transform::default(),
+        ))
+        .id();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(6, 6, 0.04)
+                .with_pins(Pins::None)
+                .with_params(ClothParams {
+                    drag: 0.0,
+                    ..default()
+                }),
+            Transform::from_xyz(0.0, 0.106, 0.0)
+                .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        ))
+        .id();
+    app.update();
+    app.update();
+    let centroid = |app: &App| {
+        let x = app
+            .world()
+            .get::<ClothSimulation>(cloth)
+            .unwrap()
+            .solver
+            .positions();
+        x.iter().sum::<Vec3>() / x.len() as f32
+    };
+    let start = centroid(&app);
+    for _ in 0..60 {
+        app.world_mut()
+            .get_mut::<Transform>(platform)
+            .unwrap()
+            .translation
+            .x += 0.008;
+        app.update();
+    }
+    let moved = centroid(&app) - start;
+    let platform_x = app
+        .world()
+        .get::<Transform>(platform)
+        .unwrap()
+        .translation
+        .x;
+    eprintln!("the cloth moved {moved}, the box {platform_x}");
+    assert!(
+        moved.x > platform_x - 0.03 && moved.x < platform_x,
+        "the cloth moved {moved}, the box {platform_x}"
+    );
+    assert!(moved.y.abs() < 3e-3, "stays on top: {moved}");
+}

@@ -187,6 +187,10 @@ pub fn spawn_scene(
                 ColliderKind::Cuboid { half_extents: h } => {
                     Cuboid::new(2.0 * h.x, 2.0 * h.y, 2.0 * h.z).mesh().build()
                 }
+                ColliderKind::Cylinder {
+                    radius,
+                    half_height,
+                } => Cylinder::new(radius, 2.0 * half_height).mesh().build(),
                 ColliderKind::Plane => Plane3d::default().mesh().size(4.0, 4.0).build(),
             };
             commands.entity(entity).insert((

@@ -1,8 +1,9 @@
 //! Colliders from avian3d (the `avian` feature): the cloth is kept out of avian bodies'
-//! colliders — balls, capsules, cuboids and half-spaces — placed by their entities' global
-//! transforms, with avian's `Friction` (its dynamic coefficient) when the entity has one.
-//! An entity with a `ClothCollider` of its own uses that instead. Other shapes (cylinders,
-//! convex hulls, meshes) are not collided with yet.
+//! colliders — balls, capsules, cuboids, cylinders and half-spaces — placed by their
+//! entities' global transforms, with avian's `Friction` (its dynamic coefficient) when the
+//! entity has one; a moving body sweeps through the step and carries the cloth by friction
+//! (the plugin gives every collider its motion). An entity with a `ClothCollider` of its own
+//! uses that instead. Other shapes (convex hulls, meshes, compounds) are not collided with.
 
 use avian3d::prelude::{Collider, Friction};
 use bevy::prelude::*;
@@ -43,6 +44,13 @@ pub fn to_solver_collider(
             axes: [rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z],
             half_extents: cuboid.half_extents,
         }
+    } else if let Some(cylinder) = shape.as_cylinder() {
+        ColliderShape::Cylinder {
+            center: translation,
+            axis: rotation * Vec3::Y,
+            half_height: cylinder.half_height,
+            radius: cylinder.radius,
+        }
     } else if let Some(half_space) = shape.as_halfspace() {
         ColliderShape::Plane {
             point: translation,
@@ -55,5 +63,6 @@ pub fn to_solver_collider(
         shape,
         thickness: THICKNESS,
         friction: friction.map_or(0.3, |f| f.dynamic_coefficient.max(0.0)),
+        motion: solver::Motion::NONE,
     })
 }

@@ -175,6 +175,14 @@ pub enum ColliderKind {
         #[serde(with = "crate::params::vec3_serde")]
         half_extents: Vec3,
     },
+    /// A cylinder along local y about the origin, `radius` from its axis and
+    /// `half_height` up and down it (Bevy's `Cylinder`).
+    Cylinder {
+        /// Radius, m.
+        radius: f32,
+        /// Half its height, m.
+        half_height: f32,
+    },
     /// The half-space below the local xz plane (normal +y): a ground or a wall.
     Plane,
 }
@@ -210,6 +218,14 @@ impl ClothCollider {
     /// A box of `half_extents` m along local x, y and z.
     pub fn cuboid(half_extents: Vec3) -> Self {
         Self::new(ColliderKind::Cuboid { half_extents })
+    }
+
+    /// A cylinder along local y of `radius` m and height `2·half_height` m.
+    pub fn cylinder(radius: f32, half_height: f32) -> Self {
+        Self::new(ColliderKind::Cylinder {
+            radius,
+            half_height,
+        })
     }
 
     /// A plane through the origin with normal +y.
@@ -280,6 +296,23 @@ impl ClothCollider {
                     )?;
                 }
             }
+            ColliderKind::Cylinder {
+                radius,
+                half_height,
+            } => {
+                size(
+                    "radius",
+                    radius,
+                    true,
+                    "a radius from 0 (excluded) to 1e5 m",
+                )?;
+                size(
+                    "half_height",
+                    half_height,
+                    true,
+                    "a half-height from 0 (excluded) to 1e5 m",
+                )?;
+            }
             ColliderKind::Plane => {}
         }
         size(
@@ -322,6 +355,19 @@ impl ClothCollider {
                     half_extents: half_extents.max(Vec3::ZERO) * transform.scale().abs(),
                 }
             }
+            ColliderKind::Cylinder {
+                radius,
+                half_height,
+            } => {
+                // Its height scales with y, its radius with the larger of x and z.
+                let s = transform.scale().abs();
+                ColliderShape::Cylinder {
+                    center: transform.translation(),
+                    axis: transform.rotation() * Vec3::Y,
+                    half_height: half_height.max(0.0) * s.y,
+                    radius: radius.max(0.0) * s.x.max(s.z),
+                }
+            }
             ColliderKind::Plane => ColliderShape::Plane {
                 point: transform.translation(),
                 normal: transform.rotation() * Vec3::Y,
@@ -331,6 +377,7 @@ impl ClothCollider {
             shape,
             thickness: self.thickness.max(0.0),
             friction: self.friction.max(0.0),
+            motion: solver::Motion::NONE,
         }
     }
 }

@@ -456,9 +456,47 @@ fn invalidate(commands: &mut Commands, entity: Entity, error: ClothError) {
         .remove::<ClothSimulation>();
 }
 
-/// Gives every cloth the colliders where their entities are now: each collider's world
-/// placement is computed once per step, then copied to every cloth.
+/// A collider entity moving faster than this (m/s), or turning more than a quarter turn in
+/// a step, is taken to have jumped there (a respawn, a teleport): it gets no motion.
+pub const TELEPORT_SPEED: f32 = 100.0;
+
+/// Each collider entity's pose (rotation, translation) at the last step, from which the
+/// next step takes its motion.
+#[derive(Default)]
+struct ColliderPoses {
+    before: bevy::ecs::entity::EntityHashMap<(Quat, Vec3)>,
+    now: bevy::ecs::entity::EntityHashMap<(Quat, Vec3)>,
+}
+
+impl ColliderPoses {
+    /// The motion of `entity` from its last pose to `transform` over `dt` (none the first
+    /// time it is seen, or after a jump); remembers `transform` for the next step.
+    fn motion(&mut self, entity: Entity, transform: &GlobalTransform, dt: f32) -> solver::Motion {
+        let (_, rotation, translation) = transform.to_scale_rotation_translation();
+        self.now.insert(entity, (rotation, translation));
+        let Some(&before) = self.before.get(&entity) else {
+            return solver::Motion::NONE;
+        };
+        let motion = solver::Motion::between(before, (rotation, translation), dt);
+        let jumped = motion.linear.length() > TELEPORT_SPEED
+            || motion.angular.length() * dt > std::f32::consts::FRAC_PI_2;
+        if jumped { solver::Motion::NONE } else { motion }
+    }
+
+    /// Ends a step: its poses are the next step's `before`.
+    fn end_step(&mut self) {
+        std::mem::swap(&mut self.before, &mut self.now);
+        self.now.clear();
+    }
+}
+
+/// Gives every cloth the colliders where their entities are now, each with its motion
+/// since the last step (so the solver sweeps it through the step and friction carries the
+/// cloth along): each collider's world placement is computed once per step, then copied to
+/// every cloth.
+#[allow(clippy::too_many_arguments)]
 fn place_colliders(
+    time: Res<Time>,
     transforms: TransformHelper,
     colliders: Query<(Entity, &ClothCollider)>,
     #[cfg(feature = "avian")] avian_colliders: Query<
@@ -471,22 +509,33 @@ fn place_colliders(
     >,
     mut cloths: Query<&mut ClothSimulation>,
     mut world_colliders: Local<Vec<solver::Collider>>,
+    mut poses: Local<ColliderPoses>,
 ) {
+    let dt = time.delta_secs();
     world_colliders.clear();
-    world_colliders.extend(colliders.iter().filter_map(|(entity, collider)| {
-        let transform = transforms.compute_global_transform(entity).ok()?;
-        Some(collider.to_world(&transform))
-    }));
+    for (entity, collider) in &colliders {
+        let Ok(transform) = transforms.compute_global_transform(entity) else {
+            continue;
+        };
+        world_colliders.push(solver::Collider {
+            motion: poses.motion(entity, &transform, dt),
+            ..collider.to_world(&transform)
+        });
+    }
     // avian bodies' colliders (`ecs/avian.rs`), unless the entity has its own.
     #[cfg(feature = "avian")]
-    world_colliders.extend(
-        avian_colliders
-            .iter()
-            .filter_map(|(entity, collider, friction)| {
-                let transform = transforms.compute_global_transform(entity).ok()?;
-                crate::ecs::avian::to_solver_collider(collider, &transform, friction)
-            }),
-    );
+    for (entity, collider, friction) in &avian_colliders {
+        let Ok(transform) = transforms.compute_global_transform(entity) else {
+            continue;
+        };
+        if let Some(c) = crate::ecs::avian::to_solver_collider(collider, &transform, friction) {
+            world_colliders.push(solver::Collider {
+                motion: poses.motion(entity, &transform, dt),
+                ..c
+            });
+        }
+    }
+    poses.end_step();
     for mut sim in &mut cloths {
         if !(world_colliders.is_empty() && sim.solver.colliders().is_empty()) {
             sim.solver.set_colliders(world_colliders.iter().copied());

@@ -1,8 +1,11 @@
-//! Colliders: spheres, capsules, boxes and planes the particles are kept out of, every substep,
-//! with a thickness and Coulomb friction (position-based, as in Macklin et al. 2014,
-//! "Unified particle physics for real-time applications", §6.1).
+//! Colliders: spheres, capsules, boxes, cylinders and planes the particles are kept out of,
+//! every substep, with a thickness and Coulomb friction (position-based, as in Macklin et
+//! al. 2014, "Unified particle physics for real-time applications", §6.1). A moving
+//! collider carries its rigid [`Motion`]: within a step it is swept from where it was to
+//! where it is, substep by substep, and friction acts on the particles' motion relative to
+//! its surface, so a moving body pushes the cloth at its own speed and carries it along.
 
-use bevy::math::Vec3;
+use bevy::math::{Quat, Vec3};
 
 use super::ClothSolver;
 
@@ -34,6 +37,18 @@ pub enum ColliderShape {
         /// Half its size along each axis, m.
         half_extents: Vec3,
     },
+    /// A cylinder: `center` plus up to `half_height` along its unit `axis`, within `radius`
+    /// of the axis.
+    Cylinder {
+        /// Centre, m.
+        center: Vec3,
+        /// Unit axis.
+        axis: Vec3,
+        /// Half its length along the axis, m.
+        half_height: f32,
+        /// Radius, m.
+        radius: f32,
+    },
     /// The half-space behind a plane (a ground).
     Plane {
         /// A point on the plane, m.
@@ -56,6 +71,74 @@ pub struct Collider {
     /// correction δ loses up to μ·δ of its tangential motion in that substep, so it sticks
     /// on a slope while tan θ ≤ μ.
     pub friction: f32,
+    /// How the solid moves over the step it is set for ([`Motion::NONE`] for a still one).
+    pub motion: Motion,
+}
+
+/// A collider's rigid motion over a step: its velocity when the step ends. The solver
+/// sweeps the collider back along it to where it was at each substep, and takes friction
+/// against the surface's velocity there, `linear + angular × (x − pivot)`.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Motion {
+    /// Velocity of `pivot`, m/s.
+    pub linear: Vec3,
+    /// Angular velocity about `pivot`, rad/s.
+    pub angular: Vec3,
+    /// The point of the body `linear` is the velocity of, where it is at the step's end, m.
+    pub pivot: Vec3,
+}
+
+impl Motion {
+    /// A still collider.
+    pub const NONE: Self = Self {
+        linear: Vec3::ZERO,
+        angular: Vec3::ZERO,
+        pivot: Vec3::ZERO,
+    };
+
+    /// The motion that carries a body from pose `before` to pose `after` (rotation,
+    /// translation) in `dt` seconds, about `after`'s translation: sweeping back by `dt`
+    /// gives `before` exactly. `NONE` for a `dt` that is not positive or poses that are
+    /// not finite.
+    pub fn between(before: (Quat, Vec3), after: (Quat, Vec3), dt: f32) -> Self {
+        let turn = (after.0 * before.0.inverse()).normalize();
+        let motion = Self {
+            linear: (after.1 - before.1) / dt,
+            angular: turn.to_scaled_axis() / dt,
+            pivot: after.1,
+        };
+        let finite = motion.linear.is_finite() && motion.angular.is_finite();
+        if dt > 0.0 && finite {
+            motion
+        } else {
+            Self::NONE
+        }
+    }
+
+    /// Whether the collider does not move.
+    pub fn is_still(&self) -> bool {
+        self.linear == Vec3::ZERO && self.angular == Vec3::ZERO
+    }
+
+    /// The velocity of the body's point at `x`, m/s.
+    #[inline]
+    pub fn velocity_at(&self, x: Vec3) -> Vec3 {
+        self.linear + self.angular.cross(x - self.pivot)
+    }
+
+    /// How far the body's point at `x` moves over the `h` seconds that end now, `turn`
+    /// being its rotation over them (`Quat::from_scaled_axis(angular·h)`): the exact rigid
+    /// motion, so a point carried round a turntable stays on its circle.
+    #[inline]
+    fn carry(&self, turn: Quat, h: f32, x: Vec3) -> Vec3 {
+        let start = self.pivot - self.linear * h;
+        self.pivot + turn * (x - start) - x
+    }
+
+    /// Where the body's point now at `x` was `tau` seconds before.
+    fn back(&self, turn_back: Quat, tau: f32, x: Vec3) -> Vec3 {
+        self.pivot - self.linear * tau + turn_back * (x - self.pivot)
+    }
 }
 
 /// An axis-aligned box a collider's reach lies in: a particle outside it is farther than
@@ -132,10 +215,73 @@ impl Collider {
                 let reach = self.thickness;
                 around(center - extent, center + extent, reach)
             }
+            ColliderShape::Cylinder {
+                center,
+                axis,
+                half_height,
+                radius,
+            } => {
+                // Along world axis i: h |a_i| from the axis, r √(1 − a_i²) from the discs.
+                let extent = axis.abs() * half_height
+                    + (Vec3::ONE - axis * axis).max(Vec3::ZERO).sqrt() * radius;
+                around(center - extent, center + extent, self.thickness)
+            }
             ColliderShape::Plane { .. } => Bounds {
                 min: Vec3::NEG_INFINITY,
                 max: Vec3::INFINITY,
             },
+        }
+    }
+
+    /// The collider where it was `tau` seconds before the step's end, swept back along
+    /// its motion.
+    pub fn swept_back(&self, tau: f32) -> Self {
+        let m = self.motion;
+        let turn = Quat::from_scaled_axis(-m.angular * tau);
+        let point = |x: Vec3| m.back(turn, tau, x);
+        let shape = match self.shape {
+            ColliderShape::Sphere { center, radius } => ColliderShape::Sphere {
+                center: point(center),
+                radius,
+            },
+            ColliderShape::Capsule { a, b, radius } => ColliderShape::Capsule {
+                a: point(a),
+                b: point(b),
+                radius,
+            },
+            ColliderShape::Cuboid {
+                center,
+                axes,
+                half_extents,
+            } => ColliderShape::Cuboid {
+                center: point(center),
+                axes: axes.map(|a| turn * a),
+                half_extents,
+            },
+            ColliderShape::Cylinder {
+                center,
+                axis,
+                half_height,
+                radius,
+            } => ColliderShape::Cylinder {
+                center: point(center),
+                axis: turn * axis,
+                half_height,
+                radius,
+            },
+            ColliderShape::Plane { point: p, normal } => ColliderShape::Plane {
+                point: point(p),
+                normal: turn * normal,
+            },
+        };
+        let motion = Motion {
+            pivot: m.pivot - m.linear * tau,
+            ..m
+        };
+        Self {
+            shape,
+            motion,
+            ..*self
         }
     }
 
@@ -146,7 +292,9 @@ impl Collider {
     #[inline]
     pub(super) fn penetration(&self, x: Vec3) -> Option<(f32, Vec3)> {
         let (d, n) = match self.shape {
-            ColliderShape::Plane { .. } | ColliderShape::Cuboid { .. } => self.distance(x),
+            ColliderShape::Plane { .. }
+            | ColliderShape::Cuboid { .. }
+            | ColliderShape::Cylinder { .. } => self.distance(x),
             _ => {
                 let (offset, radius) = self.off_core(x);
                 // A relative margin of 1e-4 leaves the particles near the band's edge
@@ -173,6 +321,12 @@ impl Collider {
                 axes,
                 half_extents,
             } => box_distance(x - center, axes, half_extents),
+            ColliderShape::Cylinder {
+                center,
+                axis,
+                half_height,
+                radius,
+            } => cylinder_distance(x - center, axis, half_height, radius),
             _ => {
                 let (offset, radius) = self.off_core(x);
                 self.surface(offset, radius)
@@ -193,7 +347,9 @@ impl Collider {
                 (x - (a + axis * t), radius)
             }
             ColliderShape::Plane { point, .. } => (x - point, 0.0),
-            ColliderShape::Cuboid { center, .. } => (x - center, 0.0),
+            ColliderShape::Cuboid { center, .. } | ColliderShape::Cylinder { center, .. } => {
+                (x - center, 0.0)
+            }
         }
     }
 
@@ -239,6 +395,30 @@ fn box_distance(offset: Vec3, axes: [Vec3; 3], half: Vec3) -> (f32, Vec3) {
     }
 }
 
+/// Signed distance from a cylinder's surface and the outward normal at the nearest surface
+/// point, for `offset` from its centre: the 2D box distance in (distance from the axis,
+/// height along it).
+fn cylinder_distance(offset: Vec3, axis: Vec3, half_height: f32, radius: f32) -> (f32, Vec3) {
+    let along = offset.dot(axis);
+    let radial = offset - axis * along;
+    let rho = radial.length();
+    let out = radial
+        .try_normalize()
+        .unwrap_or_else(|| axis.any_orthonormal_vector());
+    let cap = if along >= 0.0 { axis } else { -axis };
+    let (dr, dh) = (rho - radius, along.abs() - half_height);
+    if dr > 0.0 && dh > 0.0 {
+        // Beyond the rim: the nearest point is on its circle.
+        let v = out * dr + cap * dh;
+        let length = v.length();
+        (length, v / length)
+    } else if dr >= dh {
+        (dr, out)
+    } else {
+        (dh, cap)
+    }
+}
+
 impl ClothSolver {
     /// Pushes every free particle out of every collider to `thickness` outside its surface,
     /// then removes tangential motion of this substep up to `friction × push` (Coulomb).
@@ -248,6 +428,34 @@ impl ClothSolver {
             return;
         }
         let h = self.h;
+        // Moving colliders are where they were at this substep's end: swept back by the
+        // time left in the step (the step's colliders are where it ends).
+        if self.colliders_move {
+            let tau = self.substeps.saturating_sub(self.substep_index) as f32 * h;
+            self.colliders_now.clear();
+            self.colliders_now.extend(self.colliders.iter().map(|c| {
+                if c.motion.is_still() {
+                    *c
+                } else {
+                    c.swept_back(tau)
+                }
+            }));
+            self.bounds_now.clear();
+            self.bounds_now
+                .extend(self.colliders_now.iter().map(Collider::bounds));
+            self.turns_now.clear();
+            self.turns_now.extend(
+                self.colliders_now
+                    .iter()
+                    .map(|c| Quat::from_scaled_axis(c.motion.angular * h)),
+            );
+        }
+        let (colliders, bounds) = if self.colliders_move {
+            (&self.colliders_now, &self.bounds_now)
+        } else {
+            (&self.colliders, &self.collider_bounds)
+        };
+        let turns = &self.turns_now;
         let p = &mut self.particles;
         for i in 0..p.position.len() {
             if p.inv_mass[i] == 0.0 {
@@ -255,7 +463,7 @@ impl ClothSolver {
             }
             let mut x = p.position[i];
             let mut touched = false;
-            for (c, bounds) in self.colliders.iter().zip(&self.collider_bounds) {
+            for (k, (c, bounds)) in colliders.iter().zip(bounds).enumerate() {
                 if !bounds.contains(x) {
                     continue; // farther than the thickness: the distance would say so
                 }
@@ -263,7 +471,12 @@ impl ClothSolver {
                     continue;
                 };
                 x += n * depth;
-                let moved = x - p.previous[i];
+                // Friction acts on the motion relative to the surface under the particle:
+                // a particle that sticks moves with the body's point where it was.
+                let mut moved = x - p.previous[i];
+                if !c.motion.is_still() {
+                    moved -= c.motion.carry(turns[k], h, p.previous[i]);
+                }
                 let tangential = moved - n * moved.dot(n);
                 let slide = tangential.length();
                 let grip = c.friction * depth;

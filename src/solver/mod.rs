@@ -28,7 +28,7 @@ mod switch;
 pub mod topology;
 mod xpbd;
 
-pub use collide::{Collider, ColliderShape};
+pub use collide::{Collider, ColliderShape, Motion};
 pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
@@ -101,6 +101,13 @@ pub struct ClothSolver {
     colliders_spare: Vec<Collider>,
     /// Each collider's bounding box grown by its thickness (`collide.rs`'s broad phase).
     collider_bounds: Vec<collide::Bounds>,
+    /// Whether any collider moves (then each substep places them in `colliders_now`).
+    colliders_move: bool,
+    /// The moving colliders where they are at the current substep, and their boxes.
+    colliders_now: Vec<Collider>,
+    bounds_now: Vec<collide::Bounds>,
+    /// Each moving collider's turn over the current substep.
+    turns_now: Vec<bevy::math::Quat>,
     /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
     /// garments.
     stencil: Option<lattice::Stencil>,
@@ -223,6 +230,10 @@ impl ClothSolver {
             colliders: Vec::new(),
             colliders_spare: Vec::new(),
             collider_bounds: Vec::new(),
+            colliders_move: false,
+            colliders_now: Vec::new(),
+            bounds_now: Vec::new(),
+            turns_now: Vec::new(),
             stencil,
             disturbed: true,
             switch: None,
@@ -691,6 +702,7 @@ impl ClothSolver {
         self.collider_bounds.clear();
         self.collider_bounds
             .extend(self.colliders.iter().map(Collider::bounds));
+        self.colliders_move = self.colliders.iter().any(|c| !c.motion.is_still());
         // The part centres meet the colliders too: otherwise the targets sink into a
         // collider and pull the particles in after it.
         if let Some(patches) = self.model.patches_mut() {
