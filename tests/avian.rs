@@ -1,5 +1,5 @@
 //! avian3d colliders (the `avian` feature): a particle dropped on an avian ball, capsule,
-//! cuboid and half-space comes to rest at the collider's thickness from the analytic
+//! cuboid, cylinder and half-space comes to rest at the collider's thickness from the analytic
 //! surface. `cargo test --features avian --test avian`.
 #![cfg(feature = "avian")]
 
@@ -60,6 +60,25 @@ fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
             Vec3::new(0.1, 1.5, 0.05),
             Vec3::new(0.1, 0.7 + THICKNESS, 0.05),
         ),
+        // An upright cylinder of radius 0.2 and height 0.6 at y = 0.5: its top disc at 0.8.
+        (
+            "cylinder",
+            Collider::cylinder(0.2, 0.6),
+            at(0.0, 0.5, 0.0),
+            Vec3::new(0.1, 1.5, -0.05),
+            Vec3::new(0.1, 0.8 + THICKNESS, -0.05),
+        ),
+        // The same lying along z (turned 90° about x): its round side 0.2 above its axis.
+        (
+            "lying cylinder",
+            Collider::cylinder(0.2, 0.6),
+            GlobalTransform::from(
+                Transform::from_xyz(0.0, 0.5, 0.0)
+                    .with_rotation(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)),
+            ),
+            Vec3::new(0.0, 1.5, 0.2),
+            Vec3::new(0.0, 0.7 + THICKNESS, 0.2),
+        ),
         // The ground at y = 0.25.
         (
             "half-space",
@@ -80,6 +99,109 @@ fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
         );
         assert!((c.distance(x).0 - THICKNESS).abs() < 1e-4, "{name}");
     }
-    // A shape the cloth does not collide with yet.
-    assert!(to_solver_collider(&Collider::cylinder(0.1, 1.0), &at(0.0, 0.0, 0.0), None).is_none());
+    // A shape the cloth does not collide with.
+    assert!(to_solver_collider(&Collider::cone(0.1, 1.0), &at(0.0, 0.0, 0.0), None).is_none());
+}
+
+/// Distance from `x` to the segment `a–b`.
+fn from_segment(x: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let t = ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+    x.distance(a + (b - a) * t)
+}
+
+#[test]
+fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
+    use avian3d::prelude::{LinearVelocity, LockedAxes, PhysicsPlugins, RigidBody, Rotation};
+    use bevy::prelude::*;
+    // avian's physics running beside the cloth: a capsule body (radius 0.3, 1.6 m tall)
+    // on a half-space ground, driven by setting its velocity; a cape attached by its top
+    // edge just behind its shoulders. It runs 1.5 s along −z at 3 m/s, stops dead for 1 s
+    // (the cape swings forward into its back), then turns to face +x over 0.2 s and runs
+    // that way for 0.8 s (the cape swings round its side). Every step every cape particle
+    // stays outside the body, and while running the cape trails behind it.
+    let mut app = bevy_cloth::headless::headless_app();
+    app.add_plugins((TransformPlugin, PhysicsPlugins::default()));
+    // As `App::run` does (avian sets up some of its resources there).
+    app.finish();
+    app.cleanup();
+    app.world_mut().spawn((
+        RigidBody::Static,
+        Collider::half_space(Vec3::Y),
+        Transform::default(),
+    ));
+    let (radius, half_length) = (0.3, 0.5);
+    let body = app
+        .world_mut()
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::capsule(radius, 2.0 * half_length),
+            LockedAxes::ROTATION_LOCKED,
+            Friction::new(0.0),
+            Transform::from_xyz(0.0, radius + half_length, 0.0),
+        ))
+        .id();
+    let (width, height) = (12, 14);
+    let cape = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(width, height, 0.05).with_pins(Pins::None),
+            // The grid hangs from the middle of its top edge, here 2 cm behind the back.
+            Transform::from_xyz(0.0, 1.25, radius + 0.02),
+            ClothAttachments(vec![ClothAttachment::indices(body, (0..width).collect())]),
+        ))
+        .id();
+    let mut closest = f32::MAX;
+    let mut trail = Vec::new();
+    for frame in 0..220 {
+        let velocity = match frame {
+            0..94 => Vec3::new(0.0, 0.0, -3.0),
+            94..156 => Vec3::ZERO,
+            _ => Vec3::new(3.0, 0.0, 0.0),
+        };
+        if let Some(mut v) = app.world_mut().get_mut::<LinearVelocity>(body) {
+            v.0.x = velocity.x;
+            v.0.z = velocity.z;
+        }
+        // Facing −z, then turning a quarter to face +x (locked axes keep the solver from
+        // turning it; a game turns its character itself).
+        let turn = ((frame as f32 - 156.0) / 12.0).clamp(0.0, 1.0);
+        if let Some(mut r) = app.world_mut().get_mut::<Rotation>(body) {
+            r.0 = Quat::from_rotation_y(-std::f32::consts::FRAC_PI_2 * turn);
+        }
+        app.update();
+        let Some(sim) = app.world().get::<ClothSimulation>(cape) else {
+            continue;
+        };
+        let centre = app.world().get::<Transform>(body).unwrap().translation;
+        let up = app.world().get::<Transform>(body).unwrap().rotation * Vec3::Y;
+        let (a, b) = (centre - up * half_length, centre + up * half_length);
+        for &x in sim.solver.positions() {
+            closest = closest.min(from_segment(x, a, b));
+        }
+        assert!(sim.solver.is_stable(), "frame {frame}");
+        if frame == 90 || frame == 215 {
+            let mean = sim.solver.positions().iter().sum::<Vec3>() / (width * height) as f32;
+            trail.push((mean - centre, centre));
+        }
+    }
+    eprintln!("closest particle to the body's axis: {closest} m (radius {radius}); {trail:?}");
+    assert!(
+        closest > radius,
+        "a particle went {} m into the body",
+        radius - closest
+    );
+    // Running along −z, the cape's middle is behind (+z) the body; along +x, behind (−x).
+    let ((along_z, at_z), (along_x, at_x)) = (trail[0], trail[1]);
+    assert!(
+        at_z.z < -3.0 && at_x.x > 1.5,
+        "the body ran: {at_z}, {at_x}"
+    );
+    assert!(
+        along_z.z > radius + 0.1,
+        "running along −z: the cape at {along_z}"
+    );
+    assert!(
+        along_x.x < -(radius + 0.1),
+        "running along +x: the cape at {along_x}"
+    );
 }

@@ -735,7 +735,7 @@ fn flat_cloth(centre: Vec3) -> ClothSolver {
     cloth
         .set_params(&ClothParams {
             drag: 0.0,
-            ..cloth.params().clone()
+            ..*cloth.params()
         })
         .unwrap();
     cloth
@@ -809,7 +809,7 @@ fn a_moving_ball_pushes_a_particle_at_its_own_speed() {
     cloth
         .set_params(&ClothParams {
             substeps: bevy_cloth::params::Substeps::Fixed(8),
-            ..cloth.params().clone()
+            ..*cloth.params()
         })
         .unwrap();
 

@@ -1,7 +1,7 @@
-//! The render test: each example (curtain, card, T-shirt, flag) under Xvfb with Mesa's
-//! software Vulkan, two screenshots, and checks from the pixels that the cloth is drawn
-//! where the camera looks and that it moved between them. Catches a black window, a mesh that is not updated and
-//! a frozen simulation.
+//! The render test: each example (curtain, card, T-shirt, flag; the cape with `--features
+//! avian`) under Xvfb with Mesa's software Vulkan, two screenshots, and checks from the
+//! pixels that the cloth is drawn where the camera looks and that it moved between them.
+//! Catches a black window, a mesh that is not updated and a frozen simulation.
 //!
 //! Needs `Xvfb` and a Vulkan driver (`apt-get install xvfb mesa-vulkan-drivers`; `.ci/run`
 //! installs them). Without Xvfb the test says so and passes, except under CI (`CI` set),
@@ -206,4 +206,13 @@ fn flag_renders_and_moves() {
     // The textured flag on its pole, carried round a circle: its coloured bands are the
     // cloth's pixels, and it moves with the pole (issue 18's attachment and texture).
     renders_and_moves("flag", &[], (40, 120), 0.005..0.4);
+}
+
+#[cfg(feature = "avian")]
+#[test]
+fn cape_renders_and_moves() {
+    // The cape on the running avian character (`--features avian`; `.ci/run` builds the
+    // example first): the red cape is the cloth's pixels (the character, the obstacles and
+    // the ground are grey), drawn where the following camera looks, and it moves.
+    renders_and_moves("cape", &[], (40, 120), 0.005..0.4);
 }

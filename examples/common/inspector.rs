@@ -93,6 +93,7 @@ impl Plugin for InspectorPlugin {
     fn build(&self, app: &mut App) {
         app.init_resource::<ShowWorldInspector>()
             .init_resource::<LightControls>()
+            .init_resource::<Help>()
             .add_plugins(WorldInspectorPlugin::new().run_if(|show: Res<ShowWorldInspector>| show.0))
             .add_systems(EguiPrimaryContextPass, panel)
             .add_systems(Update, (apply_looks, apply_piece_colors, apply_light));
@@ -158,8 +159,19 @@ fn apply_light(
     }
 }
 
-const HELP: &str = "W/A/S/D/Q/E rotate · keypad +/− zoom · O/P wind · keypad 2/4/6/8 wind direction · \
-G gravity · Space pause · N step · R reset · left-drag grab · right-drag cut · Esc quit";
+/// The keys and mouse buttons, shown along the bottom of the window (an example with
+/// other keys inserts its own).
+#[derive(Resource)]
+pub struct Help(pub &'static str);
+
+impl Default for Help {
+    fn default() -> Self {
+        Self(
+            "W/A/S/D/Q/E rotate · keypad +/− zoom · O/P wind · keypad 2/4/6/8 wind direction · \
+G gravity · Space pause · N step · R reset · left-drag grab · right-drag cut · Esc quit",
+        )
+    }
+}
 
 #[allow(clippy::too_many_arguments, clippy::type_complexity)]
 fn panel(
@@ -180,6 +192,7 @@ fn panel(
     mut light: ResMut<LightControls>,
     mut show_world: ResMut<ShowWorldInspector>,
     mut time: ResMut<Time<Fixed>>,
+    help: Res<Help>,
 ) -> Result {
     let ctx = contexts.ctx_mut()?;
     let mut viewport = egui::Ui::new(
@@ -190,7 +203,7 @@ fn panel(
             .max_rect(ctx.viewport_rect()),
     );
     egui::Panel::bottom("help").show_inside(&mut viewport, |ui| {
-        ui.label(HELP);
+        ui.label(help.0);
     });
     egui::Panel::left("inspector")
         .default_size(300.0)

@@ -101,9 +101,17 @@ pub struct ClothPlugin {
 }
 
 impl Default for ClothPlugin {
+    /// Steps in `FixedUpdate` every 16 ms; with the `avian` feature in `FixedPostUpdate`
+    /// after avian's physics step, so the cloth meets the bodies (and follows the
+    /// attachments) where that step put them, where they are drawn.
     fn default() -> Self {
+        let schedule = if cfg!(feature = "avian") {
+            FixedPostUpdate.intern()
+        } else {
+            FixedUpdate.intern()
+        };
         Self {
-            schedule: FixedUpdate.intern(),
+            schedule,
             timestep: Some(Duration::from_millis(16)),
         }
     }
@@ -130,6 +138,12 @@ impl Plugin for ClothPlugin {
         if let Some(step) = self.timestep {
             app.insert_resource(Time::<Fixed>::from_duration(step));
         }
+        // In avian's schedule, after its step (see `Default`).
+        #[cfg(feature = "avian")]
+        app.configure_sets(
+            self.schedule,
+            ClothSystems::Prepare.after(avian3d::prelude::PhysicsSystems::Last),
+        );
         app.register_type::<Cloth>()
             .register_type::<ClothShape>()
             .register_type::<Pins>()
