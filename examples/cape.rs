@@ -30,6 +30,8 @@ const SPEED: f32 = 3.5;
 const TURN_RATE: f32 = 6.0;
 /// The scripted loop: a circle of this radius (m) round the origin.
 const LOOP_RADIUS: f32 = 3.2;
+/// Half the arena's side (m): the walls round it.
+const ARENA: f32 = 10.0;
 /// Seconds without input before the character runs its loop again.
 const SCRIPT_AFTER: f32 = 2.0;
 /// The camera looks from this angle (radians) round from straight behind the character.
@@ -97,11 +99,19 @@ fn setup(
         5.0,
         heading + CAMERA_YAW,
     );
+    // The arena: the ground drawn wider than the stage's, and low walls round it that
+    // avian keeps the character inside.
     commands.spawn((
         RigidBody::Static,
         Collider::half_space(Vec3::Y),
-        Transform::default(),
-        Name::new("ground collider"),
+        Transform::from_xyz(0.0, -0.001, 0.0),
+        Mesh3d(meshes.add(Plane3d::default().mesh().size(2.0 * ARENA, 2.0 * ARENA))),
+        MeshMaterial3d(materials.add(StandardMaterial {
+            base_color: Color::srgb(0.42, 0.45, 0.40),
+            perceptual_roughness: 0.95,
+            ..default()
+        })),
+        Name::new("arena ground"),
     ));
     // Obstacles: boxes and pillars inside and outside the loop (run into them with the
     // keys: avian stops the character, the cape drapes over them).
@@ -123,6 +133,27 @@ fn setup(
             Mesh3d(meshes.add(Cuboid::from_size(size))),
             MeshMaterial3d(stone.clone()),
             Name::new("box"),
+        ));
+    }
+    for (at, size) in [
+        (
+            Vec3::new(0.0, 0.3, -ARENA),
+            Vec3::new(2.0 * ARENA, 0.6, 0.3),
+        ),
+        (Vec3::new(0.0, 0.3, ARENA), Vec3::new(2.0 * ARENA, 0.6, 0.3)),
+        (
+            Vec3::new(-ARENA, 0.3, 0.0),
+            Vec3::new(0.3, 0.6, 2.0 * ARENA),
+        ),
+        (Vec3::new(ARENA, 0.3, 0.0), Vec3::new(0.3, 0.6, 2.0 * ARENA)),
+    ] {
+        commands.spawn((
+            RigidBody::Static,
+            Collider::cuboid(size.x, size.y, size.z),
+            Transform::from_translation(at),
+            Mesh3d(meshes.add(Cuboid::from_size(size))),
+            MeshMaterial3d(stone.clone()),
+            Name::new("wall"),
         ));
     }
     for at in [Vec3::new(1.6, 0.9, -1.4), Vec3::new(-2.0, 0.9, 4.5)] {
