@@ -909,3 +909,85 @@ fn a_turntable_carries_a_particle_round_and_a_cylinder_is_exact() {
     let rim = d(Vec3::new(0.8, 0.45, 0.0));
     assert!(close(rim, (0.5, Vec3::new(0.6, 0.8, 0.0))), "{rim:?}");
 }
+
+#[test]
+fn named_runs_list_their_particles_and_bad_ones_are_refused() {
+    // The T-shirt's runs: the front's shoulders, row 0, columns 6–11 and 18–23 — the
+    // particles at those nodes, in order (the front piece is first; its row 0 holds
+    // columns 0–11 and 18–29, so column c is particle c, or c − 6 past the neck).
+    for resolution in [1, 2] {
+        let layout = tshirt(resolution);
+        let f = resolution;
+        let run = |name: &str| {
+            layout
+                .runs
+                .iter()
+                .find(|(n, _)| n == name)
+                .unwrap_or_else(|| panic!("{name}"))
+                .1
+                .clone()
+        };
+        let (right, left) = (run("right shoulder"), run("left shoulder"));
+        assert_eq!(right.len() as u32, 5 * f + 1);
+        assert_eq!(left.len() as u32, 5 * f + 1);
+        // Along the top row of the front piece: all at its top (y = 0), spacing apart.
+        let spacing = 0.034 / f as f32;
+        for particles in [&right, &left] {
+            for pair in particles.windows(2) {
+                let (a, b) = (
+                    layout.positions[pair[0] as usize],
+                    layout.positions[pair[1] as usize],
+                );
+                assert!(a.y.abs() < 1e-6 && b.y.abs() < 1e-6);
+                assert!((b.x - a.x - spacing).abs() < 1e-6, "{a} → {b}");
+                assert!((a.z - 0.17).abs() < 1e-6, "on the front piece: {a}");
+            }
+        }
+        assert_eq!(right[0], 6 * f, "front row 0, column 6");
+        // The solver keeps them by name.
+        let solver = ClothSolver::new(
+            layout.clone().into_layout(),
+            &[],
+            &ClothParams::default(),
+            Affine3A::IDENTITY,
+        )
+        .unwrap();
+        assert_eq!(solver.run("left shoulder"), Some(left.as_slice()));
+        assert_eq!(solver.run("collar"), None);
+    }
+    // Refused, with the file and the line of the run.
+    let patterns = |name: &str| match name {
+        "a.txt" => Pattern::parse(b"111\n101\n", "a.txt"),
+        _ => Err(Pattern::parse(b"", name).unwrap_err()),
+    };
+    let garment = |runs: &str| {
+        let text = format!(
+            "(spacing: 0.1, pieces: [(name: \"a\", pattern: \"a.txt\")],\n runs: [{runs}])"
+        );
+        GarmentLayout::parse(&text, "g.ron", 1, patterns).map(|l| l.runs)
+    };
+    assert_eq!(
+        garment("(name: \"top\", nodes: (piece: \"a\", from: (0, 0), to: (2, 0)))"),
+        Ok(vec![("top".to_string(), vec![0, 1, 2])])
+    );
+    for (runs, expected) in [
+        (
+            "(name: \"r\", nodes: (piece: \"b\", from: (0, 0), to: (2, 0)))",
+            "g.ron:2:16: run `r`: no piece is named `b`",
+        ),
+        (
+            "(name: \"r\", nodes: (piece: \"a\", from: (0, 0), to: (3, 0)))",
+            "g.ron:2:16: run `r`: `to` (3, 0) is outside piece `a` (3×2 nodes at resolution 1)",
+        ),
+        (
+            "(name: \"r\", nodes: (piece: \"a\", from: (0, 1), to: (2, 1)))",
+            "g.ron:2:16: run `r`: node (1, 1) of `a` is not in the pattern",
+        ),
+        (
+            "(name: \"r\", nodes: (piece: \"a\", from: (0, 0), to: (0, 1))), (name: \"r\", nodes: (piece: \"a\", from: (2, 0), to: (2, 1)))",
+            "g.ron:2:16: two runs are named `r`",
+        ),
+    ] {
+        assert_eq!(garment(runs).unwrap_err().to_string(), expected, "{runs}");
+    }
+}

@@ -756,3 +756,73 @@ fn a_cloth_lying_on_a_moving_collider_entity_is_carried_along() {
     );
     assert!(moved.y.abs() < 3e-3, "stays on top: {moved}");
 }
+
+#[test]
+fn a_garment_hangs_from_its_named_runs_on_a_moving_hanger() {
+    // The T-shirt held by its file's two shoulder runs to a "hanger" entity that moves
+    // and turns: every run particle is where the hanger puts it each frame, and the shirt
+    // hangs below; a run that does not exist attaches nothing (and the cloth runs on).
+    let mut app = app();
+    let hanger = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 1.5, 0.0))
+        .id();
+    let shirt = app
+        .world_mut()
+        .spawn((
+            Cloth::garment("patterns/tshirt.ron"),
+            Transform::from_xyz(0.0, 1.5, 0.0),
+            ClothAttachments(vec![
+                ClothAttachment::run(hanger, "right shoulder"),
+                ClothAttachment::run(hanger, "left shoulder"),
+                ClothAttachment::run(hanger, "collar"),
+            ]),
+        ))
+        .id();
+    // The garment loads through the asset server: a few frames until it is built and held.
+    let mut held = Vec::new();
+    for _ in 0..200 {
+        app.update();
+        held = app
+            .world()
+            .get::<ClothAttachments>(shirt)
+            .map_or(Vec::new(), |a| {
+                a.0.iter().flat_map(|a| a.held().to_vec()).collect()
+            });
+        if !held.is_empty() {
+            break;
+        }
+    }
+    assert_eq!(held.len(), 12, "two runs of 6 nodes, none for `collar`");
+    for frame in 1..=90 {
+        {
+            let mut t = app.world_mut().get_mut::<Transform>(hanger).unwrap();
+            t.translation.x += 0.01;
+            t.rotate_y(0.01);
+        }
+        app.update();
+        let t = *app.world().get::<Transform>(hanger).unwrap();
+        let sim = app.world().get::<ClothSimulation>(shirt).unwrap();
+        for &(i, local) in &held {
+            let got = sim.solver.positions()[i as usize];
+            let want = t.transform_point(local);
+            assert!(
+                got.distance(want) < 1e-5,
+                "frame {frame}: particle {i} at {got}, the hanger puts it at {want}"
+            );
+        }
+        assert!(sim.solver.is_stable());
+    }
+    // After the sewing (1 s, no gravity) the shirt drops and hangs from the shoulders.
+    let sim = app.world().get::<ClothSimulation>(shirt).unwrap();
+    let lowest = sim
+        .solver
+        .positions()
+        .iter()
+        .map(|x| x.y)
+        .fold(f32::MAX, f32::min);
+    assert!(
+        lowest < 1.5 - 0.6,
+        "hangs below the hanger: lowest {lowest}"
+    );
+}

@@ -689,9 +689,21 @@ pub enum AttachParticles {
         /// How many particles.
         count: u32,
     },
+    /// A garment's named run of nodes (its file's `runs`, e.g. a collar).
+    Run(String),
 }
 
 impl ClothAttachment {
+    /// The garment run `name` (its file's `runs`) held to `target`; a cloth without such a
+    /// run logs an error and attaches nothing.
+    pub fn run(target: Entity, name: impl Into<String>) -> Self {
+        Self {
+            target,
+            particles: AttachParticles::Run(name.into()),
+            held: Vec::new(),
+        }
+    }
+
     /// Particles `indices` held to `target`.
     pub fn indices(target: Entity, indices: Vec<u32>) -> Self {
         Self {

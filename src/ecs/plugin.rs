@@ -563,9 +563,10 @@ fn place_colliders(
 /// transform (despawned) lets its particles go.
 fn attach_cloths(
     transforms: TransformHelper,
-    mut cloths: Query<(&mut ClothSimulation, &mut ClothAttachments)>,
+    mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothAttachments)>,
+    mut reported: Local<bevy::platform::collections::HashSet<(Entity, String)>>,
 ) {
-    for (mut sim, mut attachments) in &mut cloths {
+    for (entity, mut sim, mut attachments) in &mut cloths {
         let solver = &mut sim.solver;
         for attachment in &mut attachments.0 {
             let Ok(frame) = transforms.compute_global_transform(attachment.target) else {
@@ -593,6 +594,15 @@ fn attach_cloths(
                         order.truncate(*count as usize);
                         order
                     }
+                    AttachParticles::Run(name) => match solver.run(name) {
+                        Some(run) => run.to_vec(),
+                        None => {
+                            if reported.insert((entity, name.clone())) {
+                                error!("cloth {entity}: no run named `{name}` to attach");
+                            }
+                            Vec::new()
+                        }
+                    },
                 };
                 let to_local = frame.affine().inverse();
                 attachment.held = chosen

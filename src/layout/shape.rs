@@ -73,6 +73,7 @@ impl ClothShape {
                     triangles: topology::grid_triangles(width, height),
                     grid: Some((width, height)),
                     pieces: Vec::new(),
+                    runs: Vec::new(),
                 })
             }
             ClothShape::Mesh => Err(ClothError::ShapeNeedsSource {

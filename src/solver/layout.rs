@@ -25,6 +25,8 @@ pub struct Layout {
     pub grid: Option<(u32, u32)>,
     /// `(name, particle range)` of each garment piece; empty: one piece, `cloth`.
     pub pieces: Vec<(String, Range<u32>)>,
+    /// `(name, particles)` of each named run of particles (a garment's `runs`).
+    pub runs: Vec<(String, Vec<u32>)>,
 }
 
 impl Layout {
@@ -88,7 +90,7 @@ impl Layout {
 
     /// Checks what the solver relies on: at least one particle and at most
     /// [`MAX_PARTICLES`], finite positions, springs and triangles between distinct
-    /// particles that exist, a grid size that matches the particle count, pieces inside.
+    /// particles that exist, a grid size that matches the particle count, pieces and runs inside.
     pub fn validate(&self) -> Result<(), ClothError> {
         let n = self.positions.len();
         if n == 0 {
@@ -126,6 +128,15 @@ impl Layout {
         if let Some((name, range)) = self.pieces.iter().find(|(_, r)| r.end as usize > n) {
             return Err(ClothError::BadLayout {
                 reason: format!("piece {name} ends at particle {} of {n}", range.end),
+            });
+        }
+        if let Some((name, _)) = self
+            .runs
+            .iter()
+            .find(|(_, particles)| particles.iter().any(|&i| !exists(i)))
+        {
+            return Err(ClothError::BadLayout {
+                reason: format!("run {name} holds a particle past the {n} there are"),
             });
         }
         Ok(())

@@ -92,6 +92,8 @@ pub struct ClothSolver {
     length_scale: f32,
     /// Names and particle ranges of garment pieces (one range for other cloths).
     pieces: Vec<(String, std::ops::Range<u32>)>,
+    /// Named runs of particles (a garment's `runs`).
+    runs: Vec<(String, Vec<u32>)>,
     /// The length each seam spring starts at, before sewing.
     seam_start: Vec<f32>,
     /// Colliders in world space the particles are kept out of (see `collide.rs`).
@@ -176,6 +178,7 @@ impl ClothSolver {
             triangles,
             grid,
             pieces,
+            runs,
         } = layout;
         let count = local.len();
         if let Some(&index) = pins.iter().find(|&&i| i as usize >= count) {
@@ -221,6 +224,7 @@ impl ClothSolver {
             grab: None,
             model: ModelState::None,
             length_scale: 1.0,
+            runs,
             pieces: if pieces.is_empty() {
                 vec![(String::from("cloth"), 0..n as u32)]
             } else {
@@ -678,6 +682,14 @@ impl ClothSolver {
     /// particle for other cloths).
     pub fn pieces(&self) -> &[(String, std::ops::Range<u32>)] {
         &self.pieces
+    }
+
+    /// The particles of the named run (a garment file's `runs`), or `None`.
+    pub fn run(&self, name: &str) -> Option<&[u32]> {
+        self.runs
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, particles)| particles.as_slice())
     }
 
     /// Replaces the colliders the particles are kept out of (world space); reuses its

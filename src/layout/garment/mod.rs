@@ -15,6 +15,10 @@
 //!         (name: "left side", a: (piece: "front", from: (6, 7), to: (6, 22)),
 //!                             b: (piece: "back", from: (23, 7), to: (23, 22))),
 //!     ],
+//!     // optional: named runs of nodes a game attaches (`ClothAttachment::run`)
+//!     runs: [
+//!         (name: "collar", nodes: (piece: "back", from: (12, 0), to: (17, 0))),
+//!     ],
 //! )
 //! ```
 //! Pattern paths are relative to the garment file. A piece's node `(c, r)` starts at
@@ -50,6 +54,20 @@ pub struct GarmentFile {
     /// The seams joining them.
     #[serde(default)]
     pub seams: Vec<SeamDesc>,
+    /// Named runs of nodes, for a game to attach (a collar to a neck, a cape's top edge to
+    /// the shoulders).
+    #[serde(default)]
+    pub runs: Vec<RunDesc>,
+}
+
+/// A named straight run of nodes on one piece.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunDesc {
+    /// The name attachments refer to.
+    pub name: String,
+    /// The nodes, as a seam edge gives them.
+    pub nodes: SeamEdge,
 }
 
 /// One pattern piece and where it starts.
@@ -107,6 +125,8 @@ pub struct GarmentLayout {
     pub pieces: Vec<(String, Range<u32>)>,
     /// `(name, particle pairs)` of each seam.
     pub seams: Vec<(String, Vec<[u32; 2]>)>,
+    /// `(name, particles)` of each named run.
+    pub runs: Vec<(String, Vec<u32>)>,
     /// Legal but odd things in the patterns (disconnected islands).
     pub warnings: Vec<PatternWarning>,
 }
@@ -120,6 +140,7 @@ impl GarmentLayout {
             triangles: self.triangles,
             grid: None,
             pieces: self.pieces,
+            runs: self.runs,
         }
     }
 }
@@ -239,6 +260,22 @@ impl GarmentLayout {
                 .extend(pairs.iter().map(|p| (SpringKind::Seam, p[0], p[1])));
             layout.seams.push((seam.name.clone(), pairs));
         }
+        for run in &desc.runs {
+            let needle = format!("\"{}\"", run.name);
+            if desc.runs.iter().filter(|r| r.name == run.name).count() > 1 {
+                return Err(error(&needle, format!("two runs are named `{}`", run.name)));
+            }
+            let label = format!("run `{}`", run.name);
+            let particles = edge_particles(
+                &run.nodes,
+                (&label, &needle),
+                &desc.pieces,
+                &grids,
+                resolution,
+                &error,
+            )?;
+            layout.runs.push((run.name.clone(), particles));
+        }
         Ok(layout)
     }
 }
@@ -307,31 +344,10 @@ fn seam_pairs(
     };
     let mut sides = Vec::new();
     for edge in [&seam.a, &seam.b] {
-        let Some(p) = pieces.iter().position(|p| p.name == edge.piece) else {
-            return Err(error(
-                &needle,
-                format!("{label}: no piece is named `{}`", edge.piece),
-            ));
-        };
-        let (pattern, index) = &grids[p];
-        let nodes = edge_nodes(edge, resolution, pattern)
-            .map_err(|m| error(&needle, format!("{label}: {m}")))?;
-        let mut particles = Vec::with_capacity(nodes.len());
-        for (c, r) in nodes {
-            if !pattern.has(c as i64, r as i64) {
-                return Err(error(
-                    &needle,
-                    format!(
-                        "{label}: node ({}, {}) of `{}` is not in the pattern",
-                        c as f32 / resolution as f32,
-                        r as f32 / resolution as f32,
-                        edge.piece
-                    ),
-                ));
-            }
-            particles.push(index[(r * pattern.width + c) as usize]);
-        }
-        sides.push(particles);
+        let where_ = (label.as_str(), needle.as_str());
+        sides.push(edge_particles(
+            edge, where_, pieces, grids, resolution, error,
+        )?);
     }
     if sides[0].len() != sides[1].len() {
         return Err(error(
@@ -355,6 +371,43 @@ fn seam_pairs(
         ));
     }
     Ok(pairs)
+}
+
+/// The particles of a seam edge or a run, in order; `(label, needle)`: what an error calls
+/// it and the text it points at.
+fn edge_particles(
+    edge: &SeamEdge,
+    (label, needle): (&str, &str),
+    pieces: &[PieceDesc],
+    grids: &[(Pattern, Vec<u32>)],
+    resolution: u32,
+    error: &dyn Fn(&str, String) -> ClothError,
+) -> Result<Vec<u32>, ClothError> {
+    let Some(p) = pieces.iter().position(|p| p.name == edge.piece) else {
+        return Err(error(
+            needle,
+            format!("{label}: no piece is named `{}`", edge.piece),
+        ));
+    };
+    let (pattern, index) = &grids[p];
+    let nodes = edge_nodes(edge, resolution, pattern)
+        .map_err(|m| error(needle, format!("{label}: {m}")))?;
+    let mut particles = Vec::with_capacity(nodes.len());
+    for (c, r) in nodes {
+        if !pattern.has(c as i64, r as i64) {
+            return Err(error(
+                needle,
+                format!(
+                    "{label}: node ({}, {}) of `{}` is not in the pattern",
+                    c as f32 / resolution as f32,
+                    r as f32 / resolution as f32,
+                    edge.piece
+                ),
+            ));
+        }
+        particles.push(index[(r * pattern.width + c) as usize]);
+    }
+    Ok(particles)
 }
 
 /// Adds one piece's particles, springs and triangles; returns the particle index of each
