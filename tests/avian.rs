@@ -205,3 +205,69 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
         "running along +x: the cape at {along_x}"
     );
 }
+
+#[test]
+fn a_ball_dropped_on_a_hammock_is_held_by_the_cloths_push_back() {
+    use avian3d::prelude::{Mass, PhysicsPlugins, RigidBody};
+    use bevy::prelude::*;
+    // A 60 g avian ball (radius 0.1) dropped from 0.3 m onto a 0.75 m square cloth
+    // pinned by its four corners at y = 1. The cloth gives the ball the reaction to its
+    // particles' contacts, so the ball comes to rest in the cloth; in the last half
+    // second the cloth's mean impulse on it is its weight's, m g dt per step. (Without
+    // the reaction it would push the particles aside and fall through.) The hammock has
+    // air drag (0.02 N·s/m a particle): with the default 0.0005 the ball keeps bouncing
+    // (y 0.82–1.0 for the 19 s measured), the reaction reaching it a step late.
+    let mut app = bevy_cloth::headless::headless_app();
+    app.add_plugins((TransformPlugin, PhysicsPlugins::default()));
+    app.finish();
+    app.cleanup();
+    let n = 16;
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(n, n, 0.05)
+                .with_pins(Pins::Indices(vec![0, n - 1, n * (n - 1), n * n - 1]))
+                .with_params(ClothParams {
+                    drag: 0.02,
+                    ..ClothParams::default()
+                }),
+            Transform::from_xyz(0.0, 1.0, -0.375)
+                .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        ))
+        .id();
+    let mass = 0.06;
+    let ball = app
+        .world_mut()
+        .spawn((
+            RigidBody::Dynamic,
+            Collider::sphere(0.1),
+            Mass(mass),
+            Transform::from_xyz(0.0, 1.3, 0.0),
+        ))
+        .id();
+    let dt = 0.016;
+    let mut support = Vec::new();
+    let frames = 250;
+    let mut heights = Vec::new();
+    for frame in 0..frames {
+        app.update();
+        if frame + 31 >= frames {
+            let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+            support.push(sim.solver.collider_impulses()[0].linear);
+            heights.push(app.world().get::<Transform>(ball).unwrap().translation.y);
+        }
+    }
+    let y = heights[heights.len() - 1];
+    let span = heights.iter().fold(0.0f32, |m, h| m.max((h - y).abs()));
+    let mean = support.iter().sum::<Vec3>() / support.len() as f32;
+    let weight = mass * 9.81 * dt;
+    eprintln!(
+        "ball at y = {y} (moved {span} m in the last 0.5 s); mean impulse from the cloth {mean} (weight {weight})"
+    );
+    assert!(y > 0.55 && y < 1.0, "the ball rests in the cloth: y = {y}");
+    assert!(span < 2e-3, "at rest: it moved {span} m");
+    assert!(
+        (mean.y - weight).abs() < 0.1 * weight && mean.x.abs() < 0.1 * weight,
+        "the cloth carries its weight: {mean} against {weight}"
+    );
+}

@@ -991,3 +991,34 @@ fn named_runs_list_their_particles_and_bad_ones_are_refused() {
         assert_eq!(garment(runs).unwrap_err().to_string(), expected, "{runs}");
     }
 }
+
+#[test]
+fn a_resting_particle_gives_the_ground_its_weight_as_impulse() {
+    // A particle resting on a plane at x = (1, y, 0.5): over each step the plane takes its
+    // weight's impulse, m g dt downwards, and its moment about the origin, x × (−m g dt ŷ).
+    let start = Vec3::new(1.0, 0.02, 0.5);
+    let ground = Collider {
+        shape: ColliderShape::Plane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        },
+        thickness: 0.005,
+        friction: 0.5,
+        motion: bevy_cloth::solver::Motion::NONE,
+    };
+    let mut cloth = drop_particle(start, ground, 2.0);
+    let m = cloth.params().node_mass;
+    cloth.step(0.016, &Environment::default());
+    let got = cloth.collider_impulses()[0];
+    let weight = Vec3::new(0.0, -m * 9.81 * 0.016, 0.0);
+    let x = cloth.positions()[0];
+    eprintln!("impulse {got:?}, weight {weight}");
+    assert!(
+        got.linear.distance(weight) < 1e-3 * weight.length(),
+        "{got:?}"
+    );
+    assert!(
+        got.angular.distance(x.cross(weight)) < 1e-3 * weight.length(),
+        "{got:?}"
+    );
+}

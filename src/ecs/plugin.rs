@@ -168,6 +168,7 @@ impl Plugin for ClothPlugin {
             .init_resource::<ClothEnvironment>()
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
+            .init_resource::<PlacedColliders>()
             .add_message::<ClothTorn>()
             .add_message::<ClothWake>()
             .register_type::<ClothSleep>()
@@ -226,6 +227,13 @@ impl Plugin for ClothPlugin {
             write_meshes
                 .in_set(ClothSystems::WriteMesh)
                 .before(AssetEventSystems),
+        );
+        #[cfg(feature = "avian")]
+        app.add_systems(
+            self.schedule,
+            push_back_bodies
+                .after(finish_steps)
+                .in_set(ClothSystems::Finish),
         );
     }
 }
@@ -504,6 +512,10 @@ impl ColliderPoses {
     }
 }
 
+/// The entity of each collider the cloths were given this step, in their order.
+#[derive(Resource, Default)]
+struct PlacedColliders(Vec<Entity>);
+
 /// Gives every cloth the colliders where their entities are now, each with its motion
 /// since the last step (so the solver sweeps it through the step and friction carries the
 /// cloth along): each collider's world placement is computed once per step, then copied to
@@ -524,9 +536,11 @@ fn place_colliders(
     mut cloths: Query<&mut ClothSimulation>,
     mut world_colliders: Local<Vec<solver::Collider>>,
     mut poses: Local<ColliderPoses>,
+    mut placed: ResMut<PlacedColliders>,
 ) {
     let dt = time.delta_secs();
     world_colliders.clear();
+    placed.0.clear();
     for (entity, collider) in &colliders {
         let Ok(transform) = transforms.compute_global_transform(entity) else {
             continue;
@@ -535,6 +549,7 @@ fn place_colliders(
             motion: poses.motion(entity, &transform, dt),
             ..collider.to_world(&transform)
         });
+        placed.0.push(entity);
     }
     // avian bodies' colliders (`ecs/avian.rs`), unless the entity has its own.
     #[cfg(feature = "avian")]
@@ -547,12 +562,51 @@ fn place_colliders(
                 motion: poses.motion(entity, &transform, dt),
                 ..c
             });
+            placed.0.push(entity);
         }
     }
     poses.end_step();
     for mut sim in &mut cloths {
         if !(world_colliders.is_empty() && sim.solver.colliders().is_empty()) {
             sim.solver.set_colliders(world_colliders.iter().copied());
+        }
+    }
+}
+
+/// The cloth pushes back (the `avian` feature): every cloth that stepped gives each avian
+/// dynamic body among its colliders the impulse of its particles' contacts with it
+/// ([`solver::ClothSolver::collider_impulses`]), so a ball dropped on a hammock is held.
+#[cfg(feature = "avian")]
+fn push_back_bodies(
+    placed: Res<PlacedColliders>,
+    cloths: Query<(&ClothSimulation, &StepProgress), Without<ClothInvalid>>,
+    mut bodies: Query<(&avian3d::prelude::RigidBody, avian3d::prelude::Forces)>,
+    mut totals: Local<Vec<solver::ColliderImpulse>>,
+) {
+    use avian3d::prelude::WriteRigidBodyForces;
+    totals.clear();
+    totals.resize(placed.0.len(), solver::ColliderImpulse::default());
+    for (sim, progress) in &cloths {
+        if progress.substeps == 0 {
+            continue;
+        }
+        for (total, impulse) in totals.iter_mut().zip(sim.solver.collider_impulses()) {
+            total.linear += impulse.linear;
+            total.angular += impulse.angular;
+        }
+    }
+    for (&entity, total) in placed.0.iter().zip(totals.iter()) {
+        if *total == solver::ColliderImpulse::default() {
+            continue;
+        }
+        let Ok((body, mut forces)) = bodies.get_mut(entity) else {
+            continue;
+        };
+        if body.is_dynamic() {
+            // The linear impulse at the origin and the angular one about it: about the
+            // centre of mass c that is `angular − c × linear`, as the impulse needs.
+            forces.apply_linear_impulse_at_point(total.linear, Vec3::ZERO);
+            forces.apply_angular_impulse(total.angular);
         }
     }
 }

@@ -75,6 +75,17 @@ pub struct Collider {
     pub motion: Motion,
 }
 
+/// What the cloth gave one collider over the last step: the reaction to every push and
+/// friction correction of its particles (each changes a particle's momentum by `m Δx / h`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ColliderImpulse {
+    /// Linear impulse on the collider, N·s.
+    pub linear: Vec3,
+    /// Angular impulse on it about the world origin, N·m·s (about a point `c`, it is
+    /// `angular − c × linear`).
+    pub angular: Vec3,
+}
+
 /// A collider's rigid motion over a step: its velocity when the step ends. The solver
 /// sweeps the collider back along it to where it was at each substep, and takes friction
 /// against the surface's velocity there, `linear + angular × (x − pivot)`.
@@ -420,6 +431,13 @@ fn cylinder_distance(offset: Vec3, axis: Vec3, half_height: f32, radius: f32) ->
 }
 
 impl ClothSolver {
+    /// What the cloth gave each collider (in [`ClothSolver::colliders`]' order) over the
+    /// last step: the reaction a physics engine applies to a dynamic body, so a cloth
+    /// pushed by a ball pushes back.
+    pub fn collider_impulses(&self) -> &[ColliderImpulse] {
+        &self.collider_impulses
+    }
+
     /// Pushes every free particle out of every collider to `thickness` outside its surface,
     /// then removes tangential motion of this substep up to `friction × push` (Coulomb).
     /// Velocities follow the corrected positions: `v = (x − x_prev)/h`.
@@ -456,6 +474,11 @@ impl ClothSolver {
             (&self.colliders, &self.collider_bounds)
         };
         let turns = &self.turns_now;
+        if self.collider_impulses.len() != colliders.len() {
+            self.collider_impulses
+                .resize(colliders.len(), ColliderImpulse::default());
+        }
+        let impulses = &mut self.collider_impulses;
         let p = &mut self.particles;
         for i in 0..p.position.len() {
             if p.inv_mass[i] == 0.0 {
@@ -470,6 +493,7 @@ impl ClothSolver {
                 let Some((depth, n)) = c.penetration(x) else {
                     continue;
                 };
+                let before = x;
                 x += n * depth;
                 // Friction acts on the motion relative to the surface under the particle:
                 // a particle that sticks moves with the body's point where it was.
@@ -486,6 +510,10 @@ impl ClothSolver {
                     tangential * (grip / slide)
                 };
                 touched = true;
+                // The reaction: the particle's momentum change, the other way.
+                let push = (x - before) / (p.inv_mass[i] * h);
+                impulses[k].linear -= push;
+                impulses[k].angular -= x.cross(push);
             }
             if touched {
                 p.position[i] = x;

@@ -28,7 +28,7 @@ mod switch;
 pub mod topology;
 mod xpbd;
 
-pub use collide::{Collider, ColliderShape, Motion};
+pub use collide::{Collider, ColliderImpulse, ColliderShape, Motion};
 pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
@@ -110,6 +110,8 @@ pub struct ClothSolver {
     bounds_now: Vec<collide::Bounds>,
     /// Each moving collider's turn over the current substep.
     turns_now: Vec<bevy::math::Quat>,
+    /// What the cloth gave each collider over the step (see `collide.rs`).
+    collider_impulses: Vec<collide::ColliderImpulse>,
     /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
     /// garments.
     stencil: Option<lattice::Stencil>,
@@ -238,6 +240,7 @@ impl ClothSolver {
             colliders_now: Vec::new(),
             bounds_now: Vec::new(),
             turns_now: Vec::new(),
+            collider_impulses: Vec::new(),
             stencil,
             disturbed: true,
             switch: None,
@@ -440,6 +443,9 @@ impl ClothSolver {
             g.from = self.particles.position[g.particle as usize];
         }
         self.torn_this_step.clear();
+        self.collider_impulses.clear();
+        self.collider_impulses
+            .resize(self.colliders.len(), collide::ColliderImpulse::default());
         n
     }
 
