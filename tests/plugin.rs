@@ -826,3 +826,47 @@ fn a_garment_hangs_from_its_named_runs_on_a_moving_hanger() {
         "hangs below the hanger: lowest {lowest}"
     );
 }
+
+#[test]
+fn particles_attached_at_local_offsets_go_there_and_follow() {
+    // Two corners of a cloth held at points given in a bar entity's frame (not where they
+    // start): they are pulled there in the first step and then follow the bar.
+    let mut app = app();
+    let bar = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.5, 2.0, 0.0))
+        .id();
+    let offsets = vec![
+        (0, Vec3::new(-0.3, 0.0, 0.1)),
+        (7, Vec3::new(0.3, 0.0, 0.1)),
+    ];
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 6, 0.05).with_pins(Pins::None),
+            Transform::from_xyz(0.0, 1.8, 0.0),
+            ClothAttachments(vec![ClothAttachment::at(bar, offsets.clone())]),
+        ))
+        .id();
+    app.update();
+    for frame in 0..40 {
+        {
+            let mut t = app.world_mut().get_mut::<Transform>(bar).unwrap();
+            t.translation.z -= 0.01;
+            t.rotate_y(0.02);
+        }
+        app.update();
+        if frame == 0 {
+            continue; // the first step after the cloth is built attaches them
+        }
+        let t = *app.world().get::<Transform>(bar).unwrap();
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        for &(i, local) in &offsets {
+            let (got, want) = (sim.solver.positions()[i as usize], t.transform_point(local));
+            assert!(
+                got.distance(want) < 1e-5,
+                "frame {frame}: particle {i} at {got}, wanted {want}"
+            );
+        }
+    }
+}

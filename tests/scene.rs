@@ -246,4 +246,32 @@ fn a_box_collider_reads_from_a_scene_and_scales_with_its_transform() {
     let flat = text.replace("(0.1, 0.2, 0.3)", "(0.1, 0.0, 0.3)");
     let e = ClothScene::parse(&flat, std::path::Path::new("box.ron")).unwrap_err();
     assert!(e.to_string().contains("half_extents.y"), "{e}");
+    // A cylinder in a scene file: scaled along y for its height, x/z for its radius; a
+    // flat one is refused the same way.
+    let cylinder = text.replace(
+        "Cuboid(half_extents: (0.1, 0.2, 0.3))",
+        "Cylinder(radius: 0.1, half_height: 0.4)",
+    );
+    let scene = ClothScene::parse(&cylinder, std::path::Path::new("c.ron")).unwrap();
+    let transform = scene.colliders[0]
+        .transform()
+        .with_scale(Vec3::new(2.0, 0.5, 1.0));
+    match scene.colliders[0]
+        .collider
+        .to_world(&GlobalTransform::from(transform))
+        .shape
+    {
+        bevy_cloth::solver::ColliderShape::Cylinder {
+            half_height,
+            radius,
+            axis,
+            ..
+        } => {
+            assert_eq!((half_height, radius, axis), (0.2, 0.2, Vec3::Y));
+        }
+        other => panic!("{other:?}"),
+    }
+    let flat = cylinder.replace("half_height: 0.4", "half_height: 0.0");
+    let e = ClothScene::parse(&flat, std::path::Path::new("c.ron")).unwrap_err();
+    assert!(e.to_string().contains("half_height"), "{e}");
 }

@@ -258,23 +258,14 @@ impl ClothCollider {
             };
             check(field, value, low && value <= MAX, expected)
         };
+        let radius = |r: f32| size("radius", r, true, "a radius from 0 (excluded) to 1e5 m");
         match self.shape {
-            ColliderKind::Sphere { radius } => size(
-                "radius",
-                radius,
-                true,
-                "a radius from 0 (excluded) to 1e5 m",
-            )?,
+            ColliderKind::Sphere { radius: r } => radius(r)?,
             ColliderKind::Capsule {
-                radius,
+                radius: r,
                 half_length,
             } => {
-                size(
-                    "radius",
-                    radius,
-                    true,
-                    "a radius from 0 (excluded) to 1e5 m",
-                )?;
+                radius(r)?;
                 size(
                     "half_length",
                     half_length,
@@ -297,15 +288,10 @@ impl ClothCollider {
                 }
             }
             ColliderKind::Cylinder {
-                radius,
+                radius: r,
                 half_height,
             } => {
-                size(
-                    "radius",
-                    radius,
-                    true,
-                    "a radius from 0 (excluded) to 1e5 m",
-                )?;
+                radius(r)?;
                 size(
                     "half_height",
                     half_height,
@@ -662,7 +648,7 @@ impl ClothLod {
 /// Attaches particles of this cloth to other entities (a cape to a character's
 /// shoulders, a flag to a mast): each attached particle follows its entity's global
 /// transform every step, interpolated over the substeps as pins are, at the point it had
-/// in that entity's frame when first attached.
+/// in that entity's frame when first attached (or at a point given, [`ClothAttachment::at`]).
 #[derive(Component, Clone, Debug, Default)]
 pub struct ClothAttachments(pub Vec<ClothAttachment>);
 
@@ -691,6 +677,9 @@ pub enum AttachParticles {
     },
     /// A garment's named run of nodes (its file's `runs`, e.g. a collar).
     Run(String),
+    /// Particles at given points of the target's frame (local offsets): each is pulled
+    /// there from wherever it is.
+    At(Vec<(u32, Vec3)>),
 }
 
 impl ClothAttachment {
@@ -700,6 +689,16 @@ impl ClothAttachment {
         Self {
             target,
             particles: AttachParticles::Run(name.into()),
+            held: Vec::new(),
+        }
+    }
+
+    /// Each particle held to `target` at its point in `target`'s frame (a local offset),
+    /// wherever the particle starts; indices past the cloth are skipped.
+    pub fn at(target: Entity, points: Vec<(u32, Vec3)>) -> Self {
+        Self {
+            target,
+            particles: AttachParticles::At(points),
             held: Vec::new(),
         }
     }

@@ -629,9 +629,20 @@ fn attach_cloths(
                 }
                 continue;
             };
+            if attachment.held.is_empty()
+                && let AttachParticles::At(points) = &attachment.particles
+            {
+                let count = solver.positions().len();
+                attachment.held = points
+                    .iter()
+                    .copied()
+                    .filter(|&(i, local)| (i as usize) < count && local.is_finite())
+                    .collect();
+            }
             if attachment.held.is_empty() {
                 let x = solver.positions();
                 let chosen: Vec<u32> = match &attachment.particles {
+                    AttachParticles::At(_) => Vec::new(),
                     AttachParticles::Indices(list) => list
                         .iter()
                         .copied()
