@@ -83,7 +83,7 @@ impl SceneRun {
         let mut cloths = Vec::with_capacity(scene.cloths.len());
         for entry in &scene.cloths {
             let mut cloth = entry.cloth.build(entry.transform().compute_affine())?;
-            cloth.set_colliders(colliders.iter().copied());
+            cloth.set_colliders(colliders.iter().cloned());
             cloths.push((entry.name.clone(), cloth));
         }
         Ok(Self {

@@ -6,7 +6,7 @@
 use avian3d::prelude::{Collider, Friction};
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy::prelude::{GlobalTransform, Transform};
-use bevy_cloth::ecs::avian::{THICKNESS, to_solver_collider};
+use bevy_cloth::ecs::avian::{HullCache, THICKNESS, to_solver_collider};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Layout};
 
@@ -79,6 +79,23 @@ fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
             Vec3::new(0.0, 1.5, 0.2),
             Vec3::new(0.0, 0.7 + THICKNESS, 0.2),
         ),
+        // The convex hull of a tetrahedron's corners, turned 30° about y, at y = 0.5: its
+        // flat base up (corners at y = +0.2 above its apex at −0.3).
+        (
+            "convex hull",
+            Collider::convex_hull(vec![
+                Vec3::new(-0.3, 0.2, -0.3),
+                Vec3::new(0.4, 0.2, -0.2),
+                Vec3::new(0.0, 0.2, 0.4),
+                Vec3::new(0.0, -0.3, 0.0),
+            ])
+            .unwrap(),
+            GlobalTransform::from(
+                Transform::from_xyz(0.0, 0.5, 0.0).with_rotation(Quat::from_rotation_y(0.5)),
+            ),
+            Vec3::new(0.02, 1.5, 0.01),
+            Vec3::new(0.02, 0.7 + THICKNESS, 0.01),
+        ),
         // The ground at y = 0.25.
         (
             "half-space",
@@ -88,11 +105,12 @@ fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
             Vec3::new(0.3, 0.25 + THICKNESS, 0.3),
         ),
     ];
+    let mut hulls = HullCache::default();
     for (name, collider, transform, start, rest) in cases {
-        let c = to_solver_collider(&collider, &transform, Some(&Friction::new(0.5)))
+        let c = to_solver_collider(&collider, &transform, Some(&Friction::new(0.5)), &mut hulls)
             .unwrap_or_else(|| panic!("{name}"));
         assert_eq!(c.friction, 0.5);
-        let x = rest_on(c, start);
+        let x = rest_on(c.clone(), start);
         assert!(
             x.distance(rest) < 1e-4,
             "{name}: rests at {x}, expected {rest}"
@@ -100,7 +118,18 @@ fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
         assert!((c.distance(x).0 - THICKNESS).abs() < 1e-4, "{name}");
     }
     // A shape the cloth does not collide with.
-    assert!(to_solver_collider(&Collider::cone(0.1, 1.0), &at(0.0, 0.0, 0.0), None).is_none());
+    let cone = Collider::cone(0.1, 1.0);
+    assert!(to_solver_collider(&cone, &at(0.0, 0.0, 0.0), None, &mut hulls).is_none());
+    // A hull is made once per avian shape: the same shared hull however it is placed.
+    let points = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+    let shape = Collider::convex_hull(points).unwrap();
+    let hull_of = |c: bevy_cloth::solver::Collider| match c.shape {
+        bevy_cloth::solver::ColliderShape::Convex { hull, .. } => hull,
+        other => panic!("{other:?}"),
+    };
+    let first = hull_of(to_solver_collider(&shape, &at(0.0, 0.0, 0.0), None, &mut hulls).unwrap());
+    let again = hull_of(to_solver_collider(&shape, &at(1.0, 2.0, 3.0), None, &mut hulls).unwrap());
+    assert!(std::sync::Arc::ptr_eq(&first, &again));
 }
 
 /// Distance from `x` to the segment `a–b`.

@@ -1,14 +1,31 @@
 //! Colliders from avian3d (the `avian` feature): the cloth is kept out of avian bodies'
-//! colliders — balls, capsules, cuboids, cylinders and half-spaces — placed by their
+//! colliders — balls, capsules, cuboids, cylinders, convex hulls and half-spaces — placed by their
 //! entities' global transforms, with avian's `Friction` (its dynamic coefficient) when the
 //! entity has one; a moving body sweeps through the step and carries the cloth by friction
 //! (the plugin gives every collider its motion). An entity with a `ClothCollider` of its own
-//! uses that instead. Other shapes (convex hulls, meshes, compounds) are not collided with.
+//! uses that instead. Other shapes (trimeshes, compounds, cones, …) are not collided with.
+
+use std::sync::Arc;
 
 use avian3d::prelude::{Collider, Friction};
+use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 
-use crate::solver::{self, ColliderShape};
+use crate::solver::{self, ColliderShape, ConvexHull};
+
+/// Hulls made from avian convex shapes, kept by the shape they came from so each is made
+/// once (not every step); ones not used in a step are dropped at [`HullCache::end_step`].
+#[derive(Default)]
+pub struct HullCache {
+    hulls: HashMap<usize, (Arc<ConvexHull>, bool)>,
+}
+
+impl HullCache {
+    /// Drops the hulls no collider used since the last call.
+    pub fn end_step(&mut self) {
+        self.hulls.retain(|_, (_, used)| std::mem::take(used));
+    }
+}
 
 /// How far outside an avian collider's surface the particles stay, m (a `ClothCollider`'s
 /// default).
@@ -20,8 +37,10 @@ pub fn to_solver_collider(
     collider: &Collider,
     transform: &GlobalTransform,
     friction: Option<&Friction>,
+    hulls: &mut HullCache,
 ) -> Option<solver::Collider> {
     let shape = collider.shape_scaled();
+    let key = Arc::as_ptr(&shape.0) as *const () as usize;
     let (rotation, translation) = {
         let (_, r, t) = transform.to_scale_rotation_translation();
         (r, t)
@@ -50,6 +69,39 @@ pub fn to_solver_collider(
             axis: rotation * Vec3::Y,
             half_height: cylinder.half_height,
             radius: cylinder.radius,
+        }
+    } else if let Some(polyhedron) = shape.as_convex_polyhedron() {
+        let hull = match hulls.hulls.get_mut(&key) {
+            Some((hull, used)) => {
+                *used = true;
+                hull.clone()
+            }
+            None => {
+                let corners = polyhedron.vertices_adj_to_face();
+                let faces = polyhedron
+                    .faces()
+                    .iter()
+                    .map(|f| {
+                        let first = f.first_vertex_or_edge as usize;
+                        let n = f.num_vertices_or_edges as usize;
+                        (f.normal, corners[first..first + n].to_vec())
+                    })
+                    .collect();
+                let hull = match ConvexHull::new(polyhedron.points().to_vec(), faces) {
+                    Ok(hull) => Arc::new(hull),
+                    Err(e) => {
+                        warn_once!("an avian convex hull the cloth cannot use: {e}");
+                        return None;
+                    }
+                };
+                hulls.hulls.insert(key, (hull.clone(), true));
+                hull
+            }
+        };
+        ColliderShape::Convex {
+            center: translation,
+            rotation,
+            hull,
         }
     } else if let Some(half_space) = shape.as_halfspace() {
         ColliderShape::Plane {

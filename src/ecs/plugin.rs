@@ -537,6 +537,7 @@ fn place_colliders(
     mut world_colliders: Local<Vec<solver::Collider>>,
     mut poses: Local<ColliderPoses>,
     mut placed: ResMut<PlacedColliders>,
+    #[cfg(feature = "avian")] mut hulls: Local<crate::ecs::avian::HullCache>,
 ) {
     let dt = time.delta_secs();
     world_colliders.clear();
@@ -557,7 +558,9 @@ fn place_colliders(
         let Ok(transform) = transforms.compute_global_transform(entity) else {
             continue;
         };
-        if let Some(c) = crate::ecs::avian::to_solver_collider(collider, &transform, friction) {
+        if let Some(c) =
+            crate::ecs::avian::to_solver_collider(collider, &transform, friction, &mut hulls)
+        {
             world_colliders.push(solver::Collider {
                 motion: poses.motion(entity, &transform, dt),
                 ..c
@@ -566,9 +569,11 @@ fn place_colliders(
         }
     }
     poses.end_step();
+    #[cfg(feature = "avian")]
+    hulls.end_step();
     for mut sim in &mut cloths {
         if !(world_colliders.is_empty() && sim.solver.colliders().is_empty()) {
-            sim.solver.set_colliders(world_colliders.iter().copied());
+            sim.solver.set_colliders(world_colliders.iter().cloned());
         }
     }
 }

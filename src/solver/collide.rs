@@ -5,12 +5,14 @@
 //! where it is, substep by substep, and friction acts on the particles' motion relative to
 //! its surface, so a moving body pushes the cloth at its own speed and carries it along.
 
+use std::sync::Arc;
+
 use bevy::math::{Quat, Vec3};
 
 use super::ClothSolver;
 
 /// The solid a collider fills, in world space.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum ColliderShape {
     /// A ball.
     Sphere {
@@ -49,6 +51,16 @@ pub enum ColliderShape {
         /// Radius, m.
         radius: f32,
     },
+    /// A convex polyhedron (a physics engine's convex hull), placed: a point `x` of the
+    /// world is `rotation⁻¹ (x − center)` in the hull's own frame.
+    Convex {
+        /// Where the hull's origin is, m.
+        center: Vec3,
+        /// Its orientation.
+        rotation: Quat,
+        /// The hull, in its own frame (shared: placing it copies no geometry).
+        hull: Arc<ConvexHull>,
+    },
     /// The half-space behind a plane (a ground).
     Plane {
         /// A point on the plane, m.
@@ -60,7 +72,7 @@ pub enum ColliderShape {
 
 /// A collider in world space: particles stay at least `thickness` outside its surface and
 /// slide on it with friction coefficient `friction`.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Collider {
     /// The solid.
     pub shape: ColliderShape,
@@ -237,6 +249,9 @@ impl Collider {
                     + (Vec3::ONE - axis * axis).max(Vec3::ZERO).sqrt() * radius;
                 around(center - extent, center + extent, self.thickness)
             }
+            ColliderShape::Convex {
+                center, ref hull, ..
+            } => around(center, center, hull.radius + self.thickness),
             ColliderShape::Plane { .. } => Bounds {
                 min: Vec3::NEG_INFINITY,
                 max: Vec3::INFINITY,
@@ -250,17 +265,17 @@ impl Collider {
         let m = self.motion;
         let turn = Quat::from_scaled_axis(-m.angular * tau);
         let point = |x: Vec3| m.back(turn, tau, x);
-        let shape = match self.shape {
-            ColliderShape::Sphere { center, radius } => ColliderShape::Sphere {
+        let shape = match &self.shape {
+            &ColliderShape::Sphere { center, radius } => ColliderShape::Sphere {
                 center: point(center),
                 radius,
             },
-            ColliderShape::Capsule { a, b, radius } => ColliderShape::Capsule {
+            &ColliderShape::Capsule { a, b, radius } => ColliderShape::Capsule {
                 a: point(a),
                 b: point(b),
                 radius,
             },
-            ColliderShape::Cuboid {
+            &ColliderShape::Cuboid {
                 center,
                 axes,
                 half_extents,
@@ -269,7 +284,7 @@ impl Collider {
                 axes: axes.map(|a| turn * a),
                 half_extents,
             },
-            ColliderShape::Cylinder {
+            &ColliderShape::Cylinder {
                 center,
                 axis,
                 half_height,
@@ -280,7 +295,16 @@ impl Collider {
                 half_height,
                 radius,
             },
-            ColliderShape::Plane { point: p, normal } => ColliderShape::Plane {
+            ColliderShape::Convex {
+                center,
+                rotation,
+                hull,
+            } => ColliderShape::Convex {
+                center: point(*center),
+                rotation: turn * *rotation,
+                hull: hull.clone(),
+            },
+            &ColliderShape::Plane { point: p, normal } => ColliderShape::Plane {
                 point: point(p),
                 normal: turn * normal,
             },
@@ -292,7 +316,8 @@ impl Collider {
         Self {
             shape,
             motion,
-            ..*self
+            thickness: self.thickness,
+            friction: self.friction,
         }
     }
 
@@ -302,10 +327,23 @@ impl Collider {
     /// particles farther away (the most of them, even inside a collider's bounding box).
     #[inline]
     pub(super) fn penetration(&self, x: Vec3) -> Option<(f32, Vec3)> {
-        let (d, n) = match self.shape {
+        let (d, n) = match &self.shape {
             ColliderShape::Plane { .. }
             | ColliderShape::Cuboid { .. }
             | ColliderShape::Cylinder { .. } => self.distance(x),
+            ColliderShape::Convex {
+                center,
+                rotation,
+                hull,
+            } => {
+                // The farthest face plane is never farther than the surface: past the
+                // thickness there, no need of the exact distance.
+                let local = rotation.inverse() * (x - *center);
+                if hull.farthest_plane(local).1 >= self.thickness {
+                    return None;
+                }
+                self.distance(x)
+            }
             _ => {
                 let (offset, radius) = self.off_core(x);
                 // A relative margin of 1e-4 leaves the particles near the band's edge
@@ -325,19 +363,27 @@ impl Collider {
     /// Signed distance from the surface (negative inside) and the outward normal at the
     /// closest surface point.
     pub fn distance(&self, x: Vec3) -> (f32, Vec3) {
-        match self.shape {
-            ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
-            ColliderShape::Cuboid {
+        match &self.shape {
+            &ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
+            &ColliderShape::Cuboid {
                 center,
                 axes,
                 half_extents,
             } => box_distance(x - center, axes, half_extents),
-            ColliderShape::Cylinder {
+            &ColliderShape::Cylinder {
                 center,
                 axis,
                 half_height,
                 radius,
             } => cylinder_distance(x - center, axis, half_height, radius),
+            ColliderShape::Convex {
+                center,
+                rotation,
+                hull,
+            } => {
+                let (d, n) = hull.distance(rotation.inverse() * (x - *center));
+                (d, *rotation * n)
+            }
             _ => {
                 let (offset, radius) = self.off_core(x);
                 self.surface(offset, radius)
@@ -358,9 +404,9 @@ impl Collider {
                 (x - (a + axis * t), radius)
             }
             ColliderShape::Plane { point, .. } => (x - point, 0.0),
-            ColliderShape::Cuboid { center, .. } | ColliderShape::Cylinder { center, .. } => {
-                (x - center, 0.0)
-            }
+            ColliderShape::Cuboid { center, .. }
+            | ColliderShape::Cylinder { center, .. }
+            | ColliderShape::Convex { center, .. } => (x - center, 0.0),
         }
     }
 
@@ -403,6 +449,156 @@ fn box_distance(offset: Vec3, axes: [Vec3; 3], half: Vec3) -> (f32, Vec3) {
         let mut n = Vec3::ZERO;
         n[k] = if local[k] >= 0.0 { 1.0 } else { -1.0 };
         (q[k], world(n))
+    }
+}
+
+/// A convex polyhedron in its own frame: its corners and its faces (each a plane and the
+/// loop of corners round it), for exact signed distances: inside, minus the distance to the
+/// nearest face plane; outside, the distance to the nearest point of the nearest face
+/// polygon (its inside, an edge or a corner).
+#[derive(Debug, PartialEq)]
+pub struct ConvexHull {
+    vertices: Vec<Vec3>,
+    faces: Vec<HullFace>,
+    /// The farthest corner from the origin (the bounding sphere), m.
+    radius: f32,
+}
+
+#[derive(Debug, PartialEq)]
+struct HullFace {
+    /// Outward unit normal.
+    normal: Vec3,
+    /// `normal · x` on the face's plane.
+    offset: f32,
+    /// Its corners, in order round `normal` (counter-clockwise seen from outside).
+    corners: Vec<u32>,
+}
+
+impl ConvexHull {
+    /// A hull from its corners and, per face, its outward normal and corners (in any
+    /// order). Refused: non-finite or fewer than 4 corners, fewer than 4 faces, a face
+    /// with fewer than 3 corners or an index past the corners, a face whose corners are
+    /// off its plane, or a corner in front of a face's plane (not convex, or a wrong
+    /// normal) — each by more than 1e-4 of the hull's size.
+    pub fn new(vertices: Vec<Vec3>, faces: Vec<(Vec3, Vec<u32>)>) -> Result<Self, String> {
+        if vertices.len() < 4 || !vertices.iter().all(|v| v.is_finite()) {
+            return Err(format!(
+                "a hull needs at least 4 finite corners, got {}",
+                vertices.len()
+            ));
+        }
+        if faces.len() < 4 {
+            return Err(format!(
+                "a hull needs at least 4 faces, got {}",
+                faces.len()
+            ));
+        }
+        let radius = vertices.iter().map(|v| v.length()).fold(0.0, f32::max);
+        let size = vertices
+            .iter()
+            .flat_map(|a| vertices.iter().map(move |b| a.distance(*b)))
+            .fold(0.0, f32::max);
+        let mut out = Vec::with_capacity(faces.len());
+        for (k, (normal, mut corners)) in faces.into_iter().enumerate() {
+            let Some(normal) = normal.try_normalize() else {
+                return Err(format!("face {k} has no normal"));
+            };
+            if corners.len() < 3 || corners.iter().any(|&i| i as usize >= vertices.len()) {
+                return Err(format!(
+                    "face {k} needs 3 or more of the {} corners",
+                    vertices.len()
+                ));
+            }
+            // Order the corners round the normal, by angle about their centroid.
+            let mid =
+                corners.iter().map(|&i| vertices[i as usize]).sum::<Vec3>() / corners.len() as f32;
+            let u = normal.any_orthonormal_vector();
+            let w = normal.cross(u);
+            let angle = |i: u32| {
+                let d = vertices[i as usize] - mid;
+                d.dot(w).atan2(d.dot(u))
+            };
+            corners.sort_by(|&a, &b| angle(a).total_cmp(&angle(b)));
+            let offset = corners
+                .iter()
+                .map(|&i| normal.dot(vertices[i as usize]))
+                .fold(f32::MIN, f32::max);
+            if corners
+                .iter()
+                .any(|&i| offset - normal.dot(vertices[i as usize]) > 1e-4 * size)
+            {
+                return Err(format!("face {k} is not flat"));
+            }
+            if let Some(v) = vertices
+                .iter()
+                .find(|v| normal.dot(**v) - offset > 1e-4 * size)
+            {
+                return Err(format!("corner {v} is in front of face {k}: not convex"));
+            }
+            out.push(HullFace {
+                normal,
+                offset,
+                corners,
+            });
+        }
+        Ok(Self {
+            vertices,
+            faces: out,
+            radius,
+        })
+    }
+
+    /// The face whose plane `x` is farthest in front of, and that distance (negative
+    /// inside): a lower bound of the distance from the hull, exact inside.
+    fn farthest_plane(&self, x: Vec3) -> (usize, f32) {
+        self.faces
+            .iter()
+            .enumerate()
+            .map(|(k, f)| (k, f.normal.dot(x) - f.offset))
+            .fold((0, f32::MIN), |a, b| if b.1 > a.1 { b } else { a })
+    }
+
+    /// Signed distance from the surface and the outward normal at the nearest surface
+    /// point, for `x` in the hull's frame.
+    fn distance(&self, x: Vec3) -> (f32, Vec3) {
+        let (k, d) = self.farthest_plane(x);
+        if d <= 0.0 {
+            return (d, self.faces[k].normal);
+        }
+        // Outside: the nearest point of the faces `x` is in front of.
+        let mut best = (f32::INFINITY, Vec3::ZERO);
+        for face in &self.faces {
+            let s = face.normal.dot(x) - face.offset;
+            if s <= 0.0 {
+                continue;
+            }
+            let q = x - face.normal * s;
+            let corner = |j: usize| self.vertices[face.corners[j % face.corners.len()] as usize];
+            let inside = (0..face.corners.len()).all(|j| {
+                let (a, b) = (corner(j), corner(j + 1));
+                (b - a).cross(q - a).dot(face.normal) >= 0.0
+            });
+            let nearest = if inside {
+                q
+            } else {
+                (0..face.corners.len())
+                    .map(|j| {
+                        let (a, b) = (corner(j), corner(j + 1));
+                        let t = ((x - a).dot(b - a)
+                            / (b - a).length_squared().max(f32::MIN_POSITIVE))
+                        .clamp(0.0, 1.0);
+                        a + (b - a) * t
+                    })
+                    .min_by(|p, r| p.distance_squared(x).total_cmp(&r.distance_squared(x)))
+                    .unwrap_or(q)
+            };
+            let length = nearest.distance(x);
+            if length < best.0 {
+                best = (length, nearest);
+            }
+        }
+        let normal = (x - best.1).try_normalize().unwrap_or(self.faces[k].normal);
+        (best.0, normal)
     }
 }
 
@@ -453,7 +649,7 @@ impl ClothSolver {
             self.colliders_now.clear();
             self.colliders_now.extend(self.colliders.iter().map(|c| {
                 if c.motion.is_still() {
-                    *c
+                    c.clone()
                 } else {
                     c.swept_back(tau)
                 }

@@ -28,7 +28,7 @@ mod switch;
 pub mod topology;
 mod xpbd;
 
-pub use collide::{Collider, ColliderImpulse, ColliderShape, Motion};
+pub use collide::{Collider, ColliderImpulse, ColliderShape, ConvexHull, Motion};
 pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
@@ -571,7 +571,7 @@ impl ClothSolver {
                             &patch,
                             self.time > 0.0,
                         );
-                        patches.parts.set_colliders(self.colliders.iter().copied());
+                        patches.parts.set_colliders(self.colliders.iter().cloned());
                         self.model = ModelState::Patches(Box::new(patches));
                     }
                 }
@@ -724,7 +724,7 @@ impl ClothSolver {
         // The part centres meet the colliders too: otherwise the targets sink into a
         // collider and pull the particles in after it.
         if let Some(patches) = self.model.patches_mut() {
-            patches.parts.set_colliders(self.colliders.iter().copied());
+            patches.parts.set_colliders(self.colliders.iter().cloned());
         }
     }
 
