@@ -1,7 +1,7 @@
 //! A cape on a running character (issue 18), with avian3d's physics: the character is an
 //! avian capsule body that runs on a ground among obstacles (avian keeps it out of them);
-//! the cape is attached by its top edge behind the character's shoulders
-//! (`ClothAttachments`) and collides with the character's own capsule, the ground and the
+//! the cape is attached by its top edge round the character's shoulders
+//! (`ClothAttachment::at`, points of the body's frame) and collides with the character's own capsule, the ground and the
 //! obstacles through their avian colliders (the `avian` feature), friction included. The
 //! orbit camera follows the character.
 //!
@@ -196,10 +196,23 @@ fn setup(
             ));
         })
         .id();
-    // The cape: its grid hangs from the middle of its top edge, put 2 cm behind the back
-    // at shoulder height (+z is behind a character facing −z); the top edge is attached
-    // to the body where it is now, in the body's frame.
-    let shoulders = Vec3::new(0.0, 0.42, RADIUS + 0.02);
+    // The cape: its grid hangs from the middle of its top edge, put 3 cm behind the back
+    // at shoulder height (+z is behind a character facing −z). Its top edge is attached
+    // at points of the body's frame (`ClothAttachment::at`): round the back on an arc 3 cm
+    // out from the body, a particle spacing apart, so it wraps the shoulders.
+    let arc_radius = RADIUS + 0.03;
+    let shoulders = Vec3::new(0.0, 0.42, arc_radius);
+    let collar: Vec<(u32, Vec3)> = (0..CAPE_WIDTH)
+        .map(|i| {
+            let angle = (i as f32 - (CAPE_WIDTH - 1) as f32 * 0.5) * CAPE_SPACING / arc_radius;
+            let at = Vec3::new(
+                arc_radius * angle.sin(),
+                shoulders.y,
+                arc_radius * angle.cos(),
+            );
+            (i, at)
+        })
+        .collect();
     let place = Transform::from_translation(start).with_rotation(Quat::from_rotation_y(heading));
     commands.spawn((
         Cloth::grid(CAPE_WIDTH, CAPE_HEIGHT, CAPE_SPACING)
@@ -212,10 +225,7 @@ fn setup(
                 ..default()
             }),
         place.with_translation(place.transform_point(shoulders)),
-        ClothAttachments(vec![ClothAttachment::indices(
-            body,
-            (0..CAPE_WIDTH).collect(),
-        )]),
+        ClothAttachments(vec![ClothAttachment::at(body, collar)]),
         MeshMaterial3d(materials.add(StandardMaterial {
             base_color: Color::srgb(0.62, 0.06, 0.10),
             double_sided: true,
