@@ -300,3 +300,66 @@ fn a_ball_dropped_on_a_hammock_is_held_by_the_cloths_push_back() {
         "the cloth carries its weight: {mean} against {weight}"
     );
 }
+
+#[test]
+fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
+    use avian3d::prelude::{LinearVelocity, PhysicsPlugins, RigidBody};
+    use bevy::prelude::*;
+    // A kinematic avian box (2 × 0.2 × 2 m, μ = 0.8) moving at 0.5 m/s along x with a
+    // cloth lying on it: the plugin gives the avian body its motion from its transforms,
+    // and friction carries the cloth (less the ~1.6 cm it slips getting up to speed).
+    let mut app = bevy_cloth::headless::headless_app();
+    app.add_plugins((TransformPlugin, PhysicsPlugins::default()));
+    app.finish();
+    app.cleanup();
+    let platform = app
+        .world_mut()
+        .spawn((
+            RigidBody::Kinematic,
+            Collider::cuboid(2.0, 0.2, 2.0),
+            Friction::new(0.8),
+            LinearVelocity(Vec3::new(0.5, 0.0, 0.0)),
+            Transform::default(),
+        ))
+        .id();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(6, 6, 0.04)
+                .with_pins(Pins::None)
+                .with_params(ClothParams {
+                    drag: 0.0,
+                    ..ClothParams::default()
+                }),
+            Transform::from_xyz(0.0, 0.106, 0.0)
+                .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        ))
+        .id();
+    app.update();
+    app.update();
+    let centroid = |app: &App| {
+        let x = app
+            .world()
+            .get::<ClothSimulation>(cloth)
+            .unwrap()
+            .solver
+            .positions();
+        x.iter().sum::<Vec3>() / x.len() as f32
+    };
+    let (start, platform_start) = (
+        centroid(&app),
+        app.world().get::<Transform>(platform).unwrap().translation,
+    );
+    for _ in 0..60 {
+        app.update();
+    }
+    let moved = centroid(&app) - start;
+    let carried = app.world().get::<Transform>(platform).unwrap().translation - platform_start;
+    eprintln!("the cloth moved {moved}, the platform {carried}");
+    assert!(carried.x > 0.45, "the platform moved {carried}");
+    assert!(
+        moved.x > carried.x - 0.03 && moved.x < carried.x + 1e-3,
+        "the cloth moved {moved}, the platform {carried}"
+    );
+    assert!(moved.y.abs() < 3e-3, "stays on top: {moved}");
+}
