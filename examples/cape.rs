@@ -84,7 +84,7 @@ fn setup(
     // A light gusty breeze (seed 002's trigonometric field) that makes the cape ripple.
     environment.wind = Wind {
         direction: Vec3::new(0.4, 0.0, 1.0),
-        strength: 0.0012,
+        strength: 0.0025,
         field: WindField::Trigonometric,
     };
     // The character starts on the loop, facing along it (+x).
