@@ -1,9 +1,9 @@
 //! A cape on a running character (issue 18), with avian3d's physics: the character is an
 //! avian capsule body that runs on a ground among obstacles (avian keeps it out of them);
 //! the cape is attached by its top edge round the character's shoulders
-//! (`ClothAttachment::at`, points of the body's frame) and collides with the character's own capsule, the ground and the
-//! obstacles through their avian colliders (the `avian` feature), friction included. The
-//! orbit camera follows the character.
+//! (`ClothAttachment::at`, points of the body's frame) and collides with the character's
+//! own capsule, the ground and the obstacles through their avian colliders (the `avian`
+//! feature), friction included. The orbit camera follows the character.
 //!
 //! WASD or the arrow keys run (relative to the camera); without input for two seconds the
 //! character runs its own loop round the middle. Mouse: orbit (left), zoom (wheel).
@@ -69,8 +69,9 @@ O/P wind · G gravity · Space pause · N step · R reset · Esc quit",
         ))
         .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
         .add_systems(Startup, setup)
-        // The character moves before the cloth reads where it is.
-        .add_systems(FixedUpdate, run.before(ClothSystems::Prepare))
+        // The character's velocity is set before avian's step (in `FixedPostUpdate`); the
+        // cloth steps after it (`ClothPlugin`'s default with the `avian` feature).
+        .add_systems(FixedUpdate, run)
         .add_systems(Update, follow)
         .run();
 }
