@@ -19,8 +19,7 @@ use avian3d::prelude::{
 };
 use bevy::prelude::*;
 use bevy_cloth::prelude::*;
-use bevy_egui::EguiPlugin;
-use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
+use bevy_panorbit_camera::PanOrbitCamera;
 
 /// The character's capsule: radius and half the length of its axis (m); 1.6 m tall.
 const RADIUS: f32 = 0.3;
@@ -51,23 +50,12 @@ struct Runner {
 
 fn main() {
     let args = common::ExampleArgs::parse("");
-    App::new()
-        .add_plugins((
-            DefaultPlugins.set(common::window_plugin("bevy_cloth — cape")),
-            EguiPlugin::default(),
-            PanOrbitCameraPlugin,
-            PhysicsPlugins::default(),
-            ClothPlugin::default(),
-            ClothControlsPlugin,
-            common::inspector::InspectorPlugin,
-            common::ScreenshotPlugin,
-        ))
-        .insert_resource(args)
+    common::app("bevy_cloth — cape", args)
+        .add_plugins(PhysicsPlugins::default())
         .insert_resource(common::inspector::Help(
             "W/A/S/D or arrows run (the loop after 2 s without) · left-drag orbit · wheel zoom · \
 O/P wind · G gravity · Space pause · N step · R reset · Esc quit",
         ))
-        .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
         .add_systems(Startup, setup)
         // The character's velocity is set before avian's step (in `FixedPostUpdate`); the
         // cloth steps after it (`ClothPlugin`'s default with the `avian` feature).

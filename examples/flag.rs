@@ -14,8 +14,6 @@ use bevy::asset::RenderAssetUsages;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
 use bevy_cloth::prelude::*;
-use bevy_egui::EguiPlugin;
-use bevy_panorbit_camera::PanOrbitCameraPlugin;
 
 /// The flag: particles across and down, and their spacing (m).
 const WIDTH: u32 = 36;
@@ -34,19 +32,8 @@ struct Carried {
 
 fn main() {
     let args = common::ExampleArgs::parse("");
-    App::new()
-        .add_plugins((
-            DefaultPlugins.set(common::window_plugin("bevy_cloth — flag")),
-            EguiPlugin::default(),
-            PanOrbitCameraPlugin,
-            ClothPlugin::default(),
-            ClothControlsPlugin,
-            common::inspector::InspectorPlugin,
-            common::tools::ToolsPlugin,
-            common::ScreenshotPlugin,
-        ))
-        .insert_resource(args)
-        .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
+    common::app("bevy_cloth — flag", args)
+        .add_plugins(common::tools::ToolsPlugin)
         .add_systems(Startup, setup)
         .add_systems(FixedUpdate, carry_pole.before(ClothSystems::Prepare))
         .run();

@@ -20,24 +20,13 @@ pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
     let args = ExampleArgs::parse(default_scene);
     let scene = args.load_scene();
     let yaw = args.yaw_degrees.to_radians();
-    App::new()
-        .add_plugins((
-            DefaultPlugins.set(window_plugin(title)),
-            EguiPlugin::default(),
-            PanOrbitCameraPlugin,
-            ClothPlugin::default(),
-            ClothControlsPlugin,
-            inspector::InspectorPlugin,
-            tools::ToolsPlugin,
-            ScreenshotPlugin,
-        ))
-        .insert_resource(args)
+    app(title, args)
+        .add_plugins(tools::ToolsPlugin)
         // A setting too stiff for real time slows the simulation down instead of freezing
         // the window: at most 100 ms of simulated time per frame.
         .insert_resource(Time::<Virtual>::from_max_delta(
             std::time::Duration::from_millis(100),
         ))
-        .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)))
         .add_systems(
             Startup,
             move |mut commands: Commands,
@@ -55,6 +44,25 @@ pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
             },
         )
         .run();
+}
+
+/// The app every example starts from: the window, the cloth and its keys, the egui
+/// inspector, the orbit camera, screenshots (`args`) and the sky. The scene examples add the
+/// mouse tools; an example with keys of its own leaves them out.
+pub fn app(title: &str, args: ExampleArgs) -> App {
+    let mut app = App::new();
+    app.add_plugins((
+        DefaultPlugins.set(window_plugin(title)),
+        EguiPlugin::default(),
+        PanOrbitCameraPlugin,
+        ClothPlugin::default(),
+        ClothControlsPlugin,
+        inspector::InspectorPlugin,
+        ScreenshotPlugin,
+    ))
+    .insert_resource(args)
+    .insert_resource(ClearColor(Color::srgb(0.62, 0.70, 0.78)));
+    app
 }
 
 /// Options every example accepts (`cargo run --example curtain -- --help`): `--scene FILE`,

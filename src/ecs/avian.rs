@@ -11,6 +11,7 @@ use avian3d::prelude::{Collider, Friction};
 use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 
+use crate::ecs::components::ClothCollider;
 use crate::solver::{self, ColliderShape, ConvexHull};
 
 /// Hulls made from avian convex shapes, kept by the shape they came from so each is made
@@ -29,7 +30,7 @@ impl HullCache {
 
 /// How far outside an avian collider's surface the particles stay, m (a `ClothCollider`'s
 /// default).
-pub const THICKNESS: f32 = 0.005;
+pub const THICKNESS: f32 = ClothCollider::THICKNESS;
 
 /// The solver collider of an avian `collider` placed by `transform` (its scale is the
 /// collider's own, `shape_scaled`), or `None` for a shape the cloth does not collide with.
@@ -40,7 +41,6 @@ pub fn to_solver_collider(
     hulls: &mut HullCache,
 ) -> Option<solver::Collider> {
     let shape = collider.shape_scaled();
-    let key = Arc::as_ptr(&shape.0) as *const () as usize;
     let (rotation, translation) = {
         let (_, r, t) = transform.to_scale_rotation_translation();
         (r, t)
@@ -58,11 +58,7 @@ pub fn to_solver_collider(
             radius: capsule.radius,
         }
     } else if let Some(cuboid) = shape.as_cuboid() {
-        ColliderShape::Cuboid {
-            center: translation,
-            axes: [rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z],
-            half_extents: cuboid.half_extents,
-        }
+        ColliderShape::cuboid(translation, rotation, cuboid.half_extents)
     } else if let Some(cylinder) = shape.as_cylinder() {
         ColliderShape::Cylinder {
             center: translation,
@@ -71,6 +67,9 @@ pub fn to_solver_collider(
             radius: cylinder.radius,
         }
     } else if let Some(polyhedron) = shape.as_convex_polyhedron() {
+        // The shape's own allocation names it (avian keeps a scaled shape until the scale
+        // changes).
+        let key = Arc::as_ptr(&shape.0) as *const () as usize;
         let hull = match hulls.hulls.get_mut(&key) {
             Some((hull, used)) => {
                 *used = true;
@@ -114,7 +113,7 @@ pub fn to_solver_collider(
     Some(solver::Collider {
         shape,
         thickness: THICKNESS,
-        friction: friction.map_or(0.3, |f| f.dynamic_coefficient.max(0.0)),
+        friction: friction.map_or(ClothCollider::FRICTION, |f| f.dynamic_coefficient.max(0.0)),
         motion: solver::Motion::NONE,
     })
 }

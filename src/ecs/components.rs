@@ -194,11 +194,17 @@ impl Default for ClothCollider {
 }
 
 impl ClothCollider {
+    /// The thickness a collider has unless set, m (also avian colliders').
+    pub const THICKNESS: f32 = 0.005;
+    /// The friction coefficient a collider has unless set (also avian colliders' without
+    /// a `Friction`).
+    pub const FRICTION: f32 = 0.3;
+
     fn new(shape: ColliderKind) -> Self {
         Self {
             shape,
-            thickness: 0.005,
-            friction: 0.3,
+            thickness: Self::THICKNESS,
+            friction: Self::FRICTION,
         }
     }
 
@@ -333,14 +339,11 @@ impl ClothCollider {
                 b: transform.transform_point(Vec3::new(0.0, half_length.max(0.0), 0.0)),
                 radius: radius.max(0.0) * scale,
             },
-            ColliderKind::Cuboid { half_extents } => {
-                let rotation = transform.rotation();
-                ColliderShape::Cuboid {
-                    center: transform.translation(),
-                    axes: [rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z],
-                    half_extents: half_extents.max(Vec3::ZERO) * transform.scale().abs(),
-                }
-            }
+            ColliderKind::Cuboid { half_extents } => ColliderShape::cuboid(
+                transform.translation(),
+                transform.rotation(),
+                half_extents.max(Vec3::ZERO) * transform.scale().abs(),
+            ),
             ColliderKind::Cylinder {
                 radius,
                 half_height,
@@ -659,8 +662,9 @@ pub struct ClothAttachment {
     pub target: Entity,
     /// Which particles.
     pub particles: AttachParticles,
-    /// Each particle and its point in the target's frame, fixed when first attached.
-    pub(crate) held: Vec<(u32, Vec3)>,
+    /// Each particle and its point in the target's frame, chosen when first attached
+    /// (`None` until then, and again after the cloth is rebuilt).
+    pub(crate) held: Option<Vec<(u32, Vec3)>>,
 }
 
 /// Which particles an attachment holds.
@@ -689,7 +693,7 @@ impl ClothAttachment {
         Self {
             target,
             particles: AttachParticles::Run(name.into()),
-            held: Vec::new(),
+            held: None,
         }
     }
 
@@ -699,7 +703,7 @@ impl ClothAttachment {
         Self {
             target,
             particles: AttachParticles::At(points),
-            held: Vec::new(),
+            held: None,
         }
     }
 
@@ -708,7 +712,7 @@ impl ClothAttachment {
         Self {
             target,
             particles: AttachParticles::Indices(indices),
-            held: Vec::new(),
+            held: None,
         }
     }
 
@@ -717,14 +721,14 @@ impl ClothAttachment {
         Self {
             target,
             particles: AttachParticles::Nearest { point, count },
-            held: Vec::new(),
+            held: None,
         }
     }
 
     /// The particles held and their points in the target's frame (empty until the first
     /// step after the cloth is built).
     pub fn held(&self) -> &[(u32, Vec3)] {
-        &self.held
+        self.held.as_deref().unwrap_or(&[])
     }
 }
 

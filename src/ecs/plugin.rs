@@ -618,78 +618,80 @@ fn push_back_bodies(
 
 /// Holds each [`ClothAttachments`] cloth's particles at their entities' global
 /// transforms for this step (the solver reaches them over its substeps). The particles and
-/// their points in the target's frame are fixed the first time; a target without a
-/// transform (despawned) lets its particles go.
+/// their points in the target's frame are chosen the first time (and again when the cloth
+/// is rebuilt); a target without a transform (despawned) lets its particles go.
 fn attach_cloths(
     transforms: TransformHelper,
     mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothAttachments)>,
-    mut reported: Local<bevy::platform::collections::HashSet<(Entity, String)>>,
 ) {
     for (entity, mut sim, mut attachments) in &mut cloths {
+        let rebuilt = sim.is_added();
         let solver = &mut sim.solver;
         for attachment in &mut attachments.0 {
+            if rebuilt {
+                attachment.held = None;
+            }
             let Ok(frame) = transforms.compute_global_transform(attachment.target) else {
-                for &(i, _) in &attachment.held {
+                for &(i, _) in attachment.held() {
                     solver.detach(i);
                 }
                 continue;
             };
-            if attachment.held.is_empty()
-                && let AttachParticles::At(points) = &attachment.particles
-            {
-                let count = solver.positions().len();
-                attachment.held = points
-                    .iter()
-                    .copied()
-                    .filter(|&(i, local)| (i as usize) < count && local.is_finite())
-                    .collect();
-            }
-            if attachment.held.is_empty() {
-                let x = solver.positions();
-                let chosen: Vec<u32> = match &attachment.particles {
-                    AttachParticles::At(_) => Vec::new(),
-                    AttachParticles::Indices(list) => list
-                        .iter()
-                        .copied()
-                        .filter(|&i| (i as usize) < x.len())
-                        .collect(),
-                    AttachParticles::Nearest { point, count } => {
-                        let at = frame.transform_point(*point);
-                        let mut order: Vec<u32> = (0..x.len() as u32).collect();
-                        order.sort_by(|&a, &b| {
-                            x[a as usize]
-                                .distance_squared(at)
-                                .total_cmp(&x[b as usize].distance_squared(at))
-                        });
-                        order.truncate(*count as usize);
-                        order
-                    }
-                    AttachParticles::Run(name) => match solver.run(name) {
-                        Some(run) => run.to_vec(),
-                        None => {
-                            if reported.insert((entity, name.clone())) {
-                                error!("cloth {entity}: no run named `{name}` to attach");
-                            }
-                            Vec::new()
-                        }
-                    },
-                };
-                let to_local = frame.affine().inverse();
-                attachment.held = chosen
-                    .into_iter()
-                    .map(|i| (i, to_local.transform_point3(x[i as usize])))
-                    .collect();
-            }
-            let attached = attachment
+            let held = attachment
                 .held
+                .get_or_insert_with(|| choose_held(entity, &attachment.particles, solver, &frame));
+            let attached = held
                 .iter()
                 .try_for_each(|&(i, local)| solver.attach(i, frame.transform_point(local)));
             if let Err(e) = attached {
-                // A rebuilt cloth with fewer particles: chosen again next step.
                 warn!("cloth attachment: {e}; choosing its particles again");
-                attachment.held.clear();
+                attachment.held = None;
             }
         }
+    }
+}
+
+/// The particles an attachment holds and each one's point in the target's frame (`frame`
+/// where the target is now): given, or where the particle is now.
+fn choose_held(
+    cloth: Entity,
+    particles: &AttachParticles,
+    solver: &solver::ClothSolver,
+    frame: &GlobalTransform,
+) -> Vec<(u32, Vec3)> {
+    let x = solver.positions();
+    let to_local = frame.affine().inverse();
+    let here = |i: u32| (i, to_local.transform_point3(x[i as usize]));
+    match particles {
+        AttachParticles::At(points) => points
+            .iter()
+            .copied()
+            .filter(|&(i, local)| (i as usize) < x.len() && local.is_finite())
+            .collect(),
+        AttachParticles::Indices(list) => list
+            .iter()
+            .copied()
+            .filter(|&i| (i as usize) < x.len())
+            .map(here)
+            .collect(),
+        AttachParticles::Nearest { point, count } => {
+            let at = frame.transform_point(*point);
+            let mut order: Vec<u32> = (0..x.len() as u32).collect();
+            order.sort_by(|&a, &b| {
+                x[a as usize]
+                    .distance_squared(at)
+                    .total_cmp(&x[b as usize].distance_squared(at))
+            });
+            order.truncate(*count as usize);
+            order.into_iter().map(here).collect()
+        }
+        AttachParticles::Run(name) => match solver.run(name) {
+            Some(run) => run.iter().copied().map(here).collect(),
+            None => {
+                error!("cloth {cloth}: no run named `{name}` to attach");
+                Vec::new()
+            }
+        },
     }
 }
 

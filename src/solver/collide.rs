@@ -70,6 +70,17 @@ pub enum ColliderShape {
     },
 }
 
+impl ColliderShape {
+    /// A box of `half_extents` along the axes of `rotation`, about `center`.
+    pub fn cuboid(center: Vec3, rotation: Quat, half_extents: Vec3) -> Self {
+        Self::Cuboid {
+            center,
+            axes: [rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z],
+            half_extents,
+        }
+    }
+}
+
 /// A collider in world space: particles stay at least `thickness` outside its surface and
 /// slide on it with friction coefficient `friction`.
 #[derive(Clone, Debug, PartialEq)]
@@ -141,12 +152,6 @@ impl Motion {
     /// Whether the collider does not move.
     pub fn is_still(&self) -> bool {
         self.linear == Vec3::ZERO && self.angular == Vec3::ZERO
-    }
-
-    /// The velocity of the body's point at `x`, m/s.
-    #[inline]
-    pub fn velocity_at(&self, x: Vec3) -> Vec3 {
-        self.linear + self.angular.cross(x - self.pivot)
     }
 
     /// How far the body's point at `x` moves over the `h` seconds that end now, `turn`
@@ -328,9 +333,10 @@ impl Collider {
     #[inline]
     pub(super) fn penetration(&self, x: Vec3) -> Option<(f32, Vec3)> {
         let (d, n) = match &self.shape {
-            ColliderShape::Plane { .. }
-            | ColliderShape::Cuboid { .. }
-            | ColliderShape::Cylinder { .. } => self.distance(x),
+            &ColliderShape::Sphere { center, radius } => self.near_core(x - center, radius)?,
+            &ColliderShape::Capsule { a, b, radius } => {
+                self.near_core(x - segment_point(a, b, x), radius)?
+            }
             ColliderShape::Convex {
                 center,
                 rotation,
@@ -339,22 +345,14 @@ impl Collider {
                 // The farthest face plane is never farther than the surface: past the
                 // thickness there, no need of the exact distance.
                 let local = rotation.inverse() * (x - *center);
-                if hull.farthest_plane(local).1 >= self.thickness {
+                let farthest = hull.farthest_plane(local);
+                if farthest.1 >= self.thickness {
                     return None;
                 }
-                self.distance(x)
+                let (d, n) = hull.distance_given(local, farthest);
+                (d, *rotation * n)
             }
-            _ => {
-                let (offset, radius) = self.off_core(x);
-                // A relative margin of 1e-4 leaves the particles near the band's edge
-                // (those pushed out to it rest there) to the exact test, so the result is
-                // the same bits.
-                let reach = (radius + self.thickness).powi(2) * 1.0001;
-                if offset.length_squared() >= reach {
-                    return None;
-                }
-                self.surface(offset, radius)
-            }
+            _ => self.distance(x),
         };
         let depth = self.thickness - d;
         (depth > 0.0).then_some((depth, n))
@@ -364,6 +362,10 @@ impl Collider {
     /// closest surface point.
     pub fn distance(&self, x: Vec3) -> (f32, Vec3) {
         match &self.shape {
+            &ColliderShape::Sphere { center, radius } => self.surface(x - center, radius),
+            &ColliderShape::Capsule { a, b, radius } => {
+                self.surface(x - segment_point(a, b, x), radius)
+            }
             &ColliderShape::Plane { point, normal } => ((x - point).dot(normal), normal),
             &ColliderShape::Cuboid {
                 center,
@@ -384,34 +386,23 @@ impl Collider {
                 let (d, n) = hull.distance(rotation.inverse() * (x - *center));
                 (d, *rotation * n)
             }
-            _ => {
-                let (offset, radius) = self.off_core(x);
-                self.surface(offset, radius)
-            }
         }
     }
 
-    /// `x` less the nearest point of the solid's core (a sphere's centre, a capsule's
-    /// axis segment) and the radius around it. (A plane has no core: its point, 0.)
+    /// [`Self::surface`] for a sphere or capsule, `offset` being the point less the nearest
+    /// point of its core, or `None` when that is past the thickness band (skipping the
+    /// square root and the normal for the most particles, even inside its bounding box).
     #[inline]
-    fn off_core(&self, x: Vec3) -> (Vec3, f32) {
-        match self.shape {
-            ColliderShape::Sphere { center, radius } => (x - center, radius),
-            ColliderShape::Capsule { a, b, radius } => {
-                let axis = b - a;
-                let t = ((x - a).dot(axis) / axis.length_squared().max(f32::MIN_POSITIVE))
-                    .clamp(0.0, 1.0);
-                (x - (a + axis * t), radius)
-            }
-            ColliderShape::Plane { point, .. } => (x - point, 0.0),
-            ColliderShape::Cuboid { center, .. }
-            | ColliderShape::Cylinder { center, .. }
-            | ColliderShape::Convex { center, .. } => (x - center, 0.0),
-        }
+    fn near_core(&self, offset: Vec3, radius: f32) -> Option<(f32, Vec3)> {
+        // A relative margin of 1e-4 leaves the particles near the band's edge (those
+        // pushed out to it rest there) to the exact test, so the result is the same bits.
+        let reach = (radius + self.thickness).powi(2) * 1.0001;
+        (offset.length_squared() < reach).then(|| self.surface(offset, radius))
     }
 
     /// Signed distance and outward normal of a sphere's or capsule's surface from
-    /// `offset`, a point less the nearest point of the core (see [`Self::off_core`]).
+    /// `offset`, a point less the nearest point of the core (its centre, or the capsule's
+    /// [`segment_point`]).
     #[inline]
     fn surface(&self, offset: Vec3, radius: f32) -> (f32, Vec3) {
         let normal = offset.try_normalize().unwrap_or_else(|| match self.shape {
@@ -420,6 +411,14 @@ impl Collider {
         });
         (offset.length() - radius, normal)
     }
+}
+
+/// The point of the segment `a–b` nearest `x`.
+#[inline]
+fn segment_point(a: Vec3, b: Vec3, x: Vec3) -> Vec3 {
+    let axis = b - a;
+    let t = ((x - a).dot(axis) / axis.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+    a + axis * t
 }
 
 /// Signed distance from a box's surface and the outward normal at the nearest surface
@@ -561,7 +560,11 @@ impl ConvexHull {
     /// Signed distance from the surface and the outward normal at the nearest surface
     /// point, for `x` in the hull's frame.
     fn distance(&self, x: Vec3) -> (f32, Vec3) {
-        let (k, d) = self.farthest_plane(x);
+        self.distance_given(x, self.farthest_plane(x))
+    }
+
+    /// [`Self::distance`] given `x`'s [`Self::farthest_plane`].
+    fn distance_given(&self, x: Vec3, (k, d): (usize, f32)) -> (f32, Vec3) {
         if d <= 0.0 {
             return (d, self.faces[k].normal);
         }
@@ -670,10 +673,6 @@ impl ClothSolver {
             (&self.colliders, &self.collider_bounds)
         };
         let turns = &self.turns_now;
-        if self.collider_impulses.len() != colliders.len() {
-            self.collider_impulses
-                .resize(colliders.len(), ColliderImpulse::default());
-        }
         let impulses = &mut self.collider_impulses;
         let p = &mut self.particles;
         for i in 0..p.position.len() {

@@ -443,9 +443,8 @@ impl ClothSolver {
             g.from = self.particles.position[g.particle as usize];
         }
         self.torn_this_step.clear();
-        self.collider_impulses.clear();
         self.collider_impulses
-            .resize(self.colliders.len(), collide::ColliderImpulse::default());
+            .fill(collide::ColliderImpulse::default());
         n
     }
 
@@ -706,6 +705,9 @@ impl ClothSolver {
         std::mem::swap(&mut self.colliders, &mut self.colliders_spare);
         self.colliders.clear();
         self.colliders.extend(colliders);
+        // One impulse sum per collider (zeroed by each step).
+        self.collider_impulses
+            .resize(self.colliders.len(), collide::ColliderImpulse::default());
         let before = &self.colliders_spare;
         if *before == self.colliders {
             return; // the same colliders (the plugin sets them every step): all derived holds
