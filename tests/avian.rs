@@ -3,6 +3,8 @@
 //! surface. `cargo test --features avian --test avian`.
 #![cfg(feature = "avian")]
 
+mod common;
+
 use avian3d::prelude::{Collider, Friction};
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy::prelude::{GlobalTransform, Transform};
@@ -324,36 +326,18 @@ fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
         .id();
     let cloth = app
         .world_mut()
-        .spawn((
-            Cloth::grid(6, 6, 0.04)
-                .with_pins(Pins::None)
-                .with_params(ClothParams {
-                    drag: 0.0,
-                    ..ClothParams::default()
-                }),
-            Transform::from_xyz(0.0, 0.106, 0.0)
-                .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
-        ))
+        .spawn(common::lying_cloth(Vec3::new(0.0, 0.106, 0.0)))
         .id();
     app.update();
     app.update();
-    let centroid = |app: &App| {
-        let x = app
-            .world()
-            .get::<ClothSimulation>(cloth)
-            .unwrap()
-            .solver
-            .positions();
-        x.iter().sum::<Vec3>() / x.len() as f32
-    };
     let (start, platform_start) = (
-        centroid(&app),
+        common::entity_centroid(&app, cloth),
         app.world().get::<Transform>(platform).unwrap().translation,
     );
     for _ in 0..60 {
         app.update();
     }
-    let moved = centroid(&app) - start;
+    let moved = common::entity_centroid(&app, cloth) - start;
     let carried = app.world().get::<Transform>(platform).unwrap().translation - platform_start;
     eprintln!("the cloth moved {moved}, the platform {carried}");
     assert!(carried.x > 0.45, "the platform moved {carried}");

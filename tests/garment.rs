@@ -2,6 +2,8 @@
 
 use std::path::Path;
 
+mod common;
+
 use bevy::math::{Affine3A, Vec3};
 use bevy::prelude::App;
 use bevy_cloth::headless::SceneRun;
@@ -719,30 +721,14 @@ fn the_plugin_loads_garments_as_assets_and_rebuilds_them_when_a_file_changes() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// A cloth of 6 × 6 particles 4 cm apart lying flat (in xz) with its middle at `centre`.
+/// [`common::lying_cloth`] as a solver.
 fn flat_cloth(centre: Vec3) -> ClothSolver {
-    let frame = Affine3A::from_rotation_translation(
-        bevy::math::Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
-        centre,
-    );
-    let mut cloth = Cloth::grid(6, 6, 0.04)
-        .with_pins(Pins::None)
-        .build(frame)
-        .expect("builds");
-    let mean = cloth.positions().iter().sum::<Vec3>() / 36.0;
+    let (cloth, place) = common::lying_cloth(centre);
+    let cloth = cloth.build(place.compute_affine()).expect("builds");
+    let mean = common::centroid(&cloth);
     let y = cloth.positions().iter().map(|x| (x.y - mean.y).abs());
     assert!(y.fold(0.0, f32::max) < 1e-5, "lies flat");
     cloth
-        .set_params(&ClothParams {
-            drag: 0.0,
-            ..*cloth.params()
-        })
-        .unwrap();
-    cloth
-}
-
-fn centroid(cloth: &ClothSolver) -> Vec3 {
-    cloth.positions().iter().sum::<Vec3>() / cloth.positions().len() as f32
 }
 
 #[test]
@@ -766,7 +752,7 @@ fn friction_against_a_moving_box_carries_the_cloth_along() {
     let env = Environment::default();
     let run = |moving: bool| {
         let mut cloth = flat_cloth(Vec3::new(0.0, 0.106, 0.0));
-        let start = centroid(&cloth);
+        let start = common::centroid(&cloth);
         for k in 1..=steps {
             let t = k as f32 * dt;
             let motion = if moving {
@@ -782,7 +768,7 @@ fn friction_against_a_moving_box_carries_the_cloth_along() {
             cloth.step(dt, &env);
         }
         let v = cloth.particles().velocity.iter().sum::<Vec3>() / 36.0;
-        (centroid(&cloth) - start, v)
+        (common::centroid(&cloth) - start, v)
     };
     let travelled = speed * steps as f32 * dt;
     let (carried, velocity) = run(true);

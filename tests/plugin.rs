@@ -1,5 +1,7 @@
 //! Headless App tests of `ClothPlugin`: MinimalPlugins, manual time, no window.
 
+mod common;
+
 use bevy::ecs::message::Messages;
 use bevy::mesh::{Mesh, Mesh3d, VertexAttributeValues};
 use bevy::prelude::*;
@@ -711,29 +713,11 @@ fn a_cloth_lying_on_a_moving_collider_entity_is_carried_along() {
         .id();
     let cloth = app
         .world_mut()
-        .spawn((
-            Cloth::grid(6, 6, 0.04)
-                .with_pins(Pins::None)
-                .with_params(ClothParams {
-                    drag: 0.0,
-                    ..default()
-                }),
-            Transform::from_xyz(0.0, 0.106, 0.0)
-                .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
-        ))
+        .spawn(common::lying_cloth(Vec3::new(0.0, 0.106, 0.0)))
         .id();
     app.update();
     app.update();
-    let centroid = |app: &App| {
-        let x = app
-            .world()
-            .get::<ClothSimulation>(cloth)
-            .unwrap()
-            .solver
-            .positions();
-        x.iter().sum::<Vec3>() / x.len() as f32
-    };
-    let start = centroid(&app);
+    let start = common::entity_centroid(&app, cloth);
     for _ in 0..60 {
         app.world_mut()
             .get_mut::<Transform>(platform)
@@ -742,7 +726,7 @@ fn a_cloth_lying_on_a_moving_collider_entity_is_carried_along() {
             .x += 0.008;
         app.update();
     }
-    let moved = centroid(&app) - start;
+    let moved = common::entity_centroid(&app, cloth) - start;
     let platform_x = app
         .world()
         .get::<Transform>(platform)
