@@ -401,16 +401,27 @@ pub struct XpbdParams {
     /// length) that solving each substep's constraints once may leave beyond what the
     /// material itself stretches. One iteration per substep makes an inextensible
     /// constraint act like a spring of stiffness about `m/h²` (Macklin et al. 2019 §4), so
-    /// a cloth `R` springs of length `L` long hanging under gravity `g` stretches its most
-    /// loaded constraint by about `2 R g h² / L`; the automatic substeps are the fewest
-    /// that keep that within this target (`ClothSolver::stable_substeps`).
+    /// the stretch it leaves scales as `h²`. When the structural springs' length is bounded
+    /// (inextensible or strain limited) the automatic substeps follow the largest stretch
+    /// past that bound measured after each step, toward this target (a closed loop with
+    /// hysteresis, `ClothSolver::xpbd_closed_loop`); otherwise, and for a run's first step,
+    /// they are estimated: a cloth `R` springs of length `L` long hanging under gravity `g`
+    /// stretches its most loaded constraint by about `2 R g h² / L`
+    /// (`ClothSolver::stable_substeps`).
     pub max_stretch_error: f32,
+    /// Long-range attachments (Kim, Chentanez, Müller 2012): no particle moves farther from
+    /// its nearest pin (or attachment) than the shortest path to it through the cloth's
+    /// springs allows, times `1 + strain limit` (× 1 for an inextensible cloth). They act
+    /// when the structural family's length is bounded (`stiffness: inf`, or a strain
+    /// limit) and the cloth is held; a hung cloth then keeps its length with few substeps.
+    pub tethers: bool,
 }
 
 impl Default for XpbdParams {
     fn default() -> Self {
         Self {
             max_stretch_error: 0.01,
+            tethers: true,
         }
     }
 }

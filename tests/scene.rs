@@ -187,7 +187,8 @@ fn xpbd_reads_from_scene_files_and_overrides_and_only_it_takes_an_infinite_stiff
     assert_eq!(
         params.model,
         Model::Xpbd(XpbdParams {
-            max_stretch_error: 0.005
+            max_stretch_error: 0.005,
+            ..XpbdParams::default()
         })
     );
     assert_eq!(params.springs.structural.stiffness, f32::INFINITY);

@@ -330,6 +330,18 @@ fn tears_past_its_ratio_and_not_below(model: Model) {
         "no face was hidden"
     );
     assert!(pulled.is_finite(), "{}", model.kind());
+    // A torn spring stops pulling: what hung below the tears fell freely (under 200 g for
+    // the seconds left, kilometres; held by a spring that still acted, a few metres).
+    let lowest = pulled
+        .positions()
+        .iter()
+        .map(|p| p.y)
+        .fold(f32::INFINITY, f32::min);
+    assert!(
+        lowest < -100.0,
+        "{}: lowest particle at {lowest} m",
+        model.kind()
+    );
 }
 
 /// Seed 002's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
@@ -820,6 +832,45 @@ fn the_coloured_limiter_limits_as_the_sequential_one() {
     );
     let far = max_distance(&stencil, &general);
     assert!(far < 0.005, "coloured and sequential differ by {far} m");
+}
+
+/// XPBD on a grid's stencil (offsets in colours of rows and columns) and on the general
+/// constraint lists (greedy colours) are different orders of the same projections: the
+/// same formula, so the two curtains fall the same way within millimetres, with and
+/// without damping, strain limit and tethers.
+#[test]
+fn xpbd_on_the_stencil_projects_as_the_general_path() {
+    for (damping, limit, tethers) in [(0.0, None, false), (0.05, Some(0.05), true)] {
+        let mut params = ClothParams {
+            model: Model::Xpbd(XpbdParams {
+                tethers,
+                ..XpbdParams::default()
+            }),
+            substeps: Substeps::Fixed(20),
+            strain_limit: limit,
+            ..ClothParams::default()
+        };
+        params.springs.damping = damping;
+        let (mut stencil, mut general) = stencil_and_general(&params);
+        let env = Environment::default();
+        for _ in 0..63 {
+            stencil.step(0.016, &env);
+            general.step(0.016, &env);
+        }
+        let far = max_distance(&stencil, &general);
+        let (s, g) = (stencil.strain().max, general.strain().max);
+        println!(
+            "damping {damping}, limit {limit:?}, tethers {tethers}: {far:.2e} m apart, strain {s:.4} and {g:.4}"
+        );
+        assert!(far < 5e-3, "stencil and general XPBD differ by {far} m");
+        assert!(
+            (s - g).abs() < 0.01,
+            "strain {s} (stencil) and {g} (general)"
+        );
+        // It fell: the bottom row's middle is lower than it started (1.45 m).
+        let bottom = stencil.positions()[11 * 16 + 8].y;
+        assert!(bottom < 1.44, "the bottom row's middle at {bottom} m");
+    }
 }
 
 /// A left–right symmetric curtain (even width, top corners pinned, no wind, limiter on)

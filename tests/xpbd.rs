@@ -9,10 +9,14 @@ const DT: f32 = 0.016;
 const G: f32 = 9.81;
 
 /// XPBD with structural stiffness `k` (every other family off), node mass `m`, no drag,
-/// limit or damping, `substeps` fixed.
+/// limit, damping or tethers (what one iteration a substep does on its own), `substeps`
+/// fixed.
 fn xpbd(k: f32, m: f32, substeps: u32) -> ClothParams {
     ClothParams {
-        model: Model::Xpbd(XpbdParams::default()),
+        model: Model::Xpbd(XpbdParams {
+            tethers: false,
+            ..XpbdParams::default()
+        }),
         node_mass: m,
         springs: SpringParams {
             structural: SpringFamily::new(k),
@@ -56,6 +60,7 @@ fn settled_chain(links: u32, k: f32, substeps: Substeps, target: f32) -> Vec<f32
     let params = ClothParams {
         model: Model::Xpbd(XpbdParams {
             max_stretch_error: target,
+            tethers: false,
         }),
         drag: 2e-3,
         substeps,
@@ -63,16 +68,25 @@ fn settled_chain(links: u32, k: f32, substeps: Substeps, target: f32) -> Vec<f32
     };
     params.validate().unwrap();
     let mut cloth = chain(links, 0.1, &params);
-    for _ in 0..3_000 {
+    for _ in 0..2_940 {
         cloth.step(DT, &gravity_only());
     }
-    let speed = cloth
-        .particles()
-        .velocity
+    // At rest: nothing moved by more than 0.1 mm over the last second. (Not the largest
+    // velocity: a substep's velocity is the change of position over `h`, and at 4 m from
+    // the pin one float step of position over a 0.2 ms substep is 2e-3 m/s of noise.)
+    let before = cloth.positions().to_vec();
+    for _ in 0..60 {
+        cloth.step(DT, &gravity_only());
+    }
+    let moved = before
         .iter()
-        .map(|v| v.length())
+        .zip(cloth.positions())
+        .map(|(a, b)| a.distance(*b))
         .fold(0.0, f32::max);
-    assert!(speed < 1e-3, "not at rest: {speed} m/s");
+    assert!(
+        moved < 1e-4,
+        "not at rest: moved {moved} m in the last second"
+    );
     stretches(&cloth, 0.1)
 }
 
@@ -115,6 +129,7 @@ fn a_hanging_inextensible_chain_keeps_its_length_to_the_automatic_substeps_targe
         let params = ClothParams {
             model: Model::Xpbd(XpbdParams {
                 max_stretch_error: 1e-3,
+                tethers: false,
             }),
             ..xpbd(f32::INFINITY, 1e-3, 1)
         };
@@ -156,6 +171,81 @@ fn a_swinging_inextensible_chain_stays_within_half_a_percent() {
     }
     println!("largest strain while swinging {worst:.3e}");
     assert!(worst < 5e-3, "strain while swinging {:.4}%", worst * 100.0);
+}
+
+/// Tethers (long-range attachments) on an inextensible chain.
+fn tethered(substeps: u32) -> ClothParams {
+    ClothParams {
+        model: Model::Xpbd(XpbdParams::default()),
+        drag: 2e-3,
+        ..xpbd(f32::INFINITY, 1e-3, substeps)
+    }
+}
+
+#[test]
+fn tethers_hold_a_hanging_inextensible_chain_to_its_length_at_one_substep() {
+    // 40 links of 0.1 m at one substep of 16 ms: alone, one iteration leaves the top
+    // link stretched by about 2 R g h² / L = 200%; with tethers no particle can be
+    // farther from the pin than its path along the chain.
+    let settle = |params: &ClothParams| {
+        let mut cloth = chain(40, 0.1, params);
+        for _ in 0..600 {
+            cloth.step(DT, &gravity_only());
+        }
+        let worst = stretches(&cloth, 0.1).into_iter().fold(0.0f32, f32::max) / 0.1;
+        let bottom = cloth.positions()[40].y;
+        (worst, bottom)
+    };
+    let (alone, alone_bottom) = settle(&ClothParams {
+        model: Model::Xpbd(XpbdParams {
+            tethers: false,
+            ..XpbdParams::default()
+        }),
+        ..tethered(1)
+    });
+    let (with, bottom) = settle(&tethered(1));
+    println!(
+        "largest link strain at 1 substep: {alone:.3} alone, {with:.2e} with tethers; bottom at {alone_bottom:.3} and {bottom:.5} m"
+    );
+    assert!(
+        alone > 0.1,
+        "one iteration alone stretches the chain: {alone}"
+    );
+    assert!(with < 1e-5, "tethered link strain {with}");
+    assert!(
+        (bottom + 4.0).abs() < 1e-4,
+        "the bottom hangs 4 m below the pin: {bottom}"
+    );
+}
+
+#[test]
+fn tethers_let_go_below_a_cut_and_follow_an_attachment() {
+    let mut cloth = chain(10, 0.1, &tethered(4));
+    for _ in 0..60 {
+        cloth.step(DT, &gravity_only());
+    }
+    // Cut the sixth link: what hangs below it falls freely (its tethers are gone).
+    assert!(cloth.tear(5));
+    for _ in 0..30 {
+        cloth.step(DT, &gravity_only());
+    }
+    let fell = -cloth.positions()[10].y - 1.0;
+    assert!(fell > 0.5, "the cut-off end fell only {fell} m");
+    // The rest hangs from the pin; attached at a point 30° to the side (as far from the
+    // pin as the chain between them allows), particle 3 tethers the two below it: 5 is
+    // never farther than 0.2 m from it.
+    let at = Vec3::new(0.15, -0.3 * 0.75f32.sqrt(), 0.0);
+    cloth.attach(3, at).unwrap();
+    for _ in 0..120 {
+        cloth.step(DT, &gravity_only());
+        let x = cloth.positions();
+        assert!(
+            x[5].distance(x[3]) <= 0.2 * (1.0 + 1e-5),
+            "{}",
+            x[5].distance(x[3])
+        );
+    }
+    assert!(cloth.positions()[3].distance(at) < 1e-5);
 }
 
 #[test]
@@ -237,4 +327,64 @@ fn the_energy_of_a_free_undamped_cloth_does_not_grow_over_ten_thousand_steps() {
         most <= start * 1.001,
         "energy rose from {start} J to {most} J"
     );
+}
+
+/// A 24×24 inextensible cloth (structural and shear `inf`) of 5 cm hung from its top row.
+fn hung_cloth(params: &ClothParams) -> ClothSolver {
+    ClothShape::Grid {
+        width: 24,
+        height: 24,
+        spacing: 0.05,
+    }
+    .build_solver(&Pins::TopRow, params, Affine3A::IDENTITY)
+    .unwrap()
+}
+
+fn inextensible(target: f32, tethers: bool) -> ClothParams {
+    let mut params = ClothParams {
+        model: Model::Xpbd(XpbdParams {
+            max_stretch_error: target,
+            tethers,
+        }),
+        substeps: Substeps::Auto { max: 8192 },
+        drag: 2e-4,
+        strain_limit: None,
+        ..ClothParams::default()
+    };
+    params.springs.structural = SpringFamily::new(f32::INFINITY);
+    params.springs.shear = SpringFamily::new(f32::INFINITY);
+    params
+}
+
+#[test]
+fn the_automatic_substeps_follow_the_measured_stretch_to_the_target() {
+    // The estimate from the cloth's size starts the loop; then each step's count follows
+    // the stretch the last one left. Once hanging (the last second of three) the largest
+    // structural stretch stays within the target; with tethers, which hold the length
+    // themselves, the loop needs fewer substeps than without.
+    for target in [0.01f32, 0.002] {
+        let mut most = [0u32; 2];
+        for (k, tethers) in [false, true].into_iter().enumerate() {
+            let mut cloth = hung_cloth(&inextensible(target, tethers));
+            cloth.step(DT, &gravity_only());
+            let estimate = cloth.substeps();
+            let mut worst = 0.0f32;
+            for step in 1..188 {
+                cloth.step(DT, &gravity_only());
+                if step >= 125 {
+                    worst = worst.max(cloth.strain().max);
+                    most[k] = most[k].max(cloth.substeps());
+                }
+            }
+            println!(
+                "target {target}, tethers {tethers}: estimate {estimate} substeps, then at most {}; largest strain in the last second {worst:.2e}",
+                most[k]
+            );
+            assert!(worst < target, "strain {worst} against {target}");
+        }
+        assert!(
+            most[1] < most[0],
+            "{most:?} substeps without and with tethers"
+        );
+    }
 }

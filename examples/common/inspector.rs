@@ -388,6 +388,8 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                         .logarithmic(true)
                         .text("stretch error target (auto substeps)"),
                 );
+                ui.checkbox(&mut xpbd.tethers, "tethers to the pins")
+                    .on_hover_text("Long-range attachments: no particle farther from its nearest pin than the cloth between them allows (acts when the structural springs are inextensible or strain limited)");
                 true
             } else {
                 false

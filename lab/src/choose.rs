@@ -72,6 +72,7 @@ pub fn overrides(index: usize, chosen: &ClothParams) -> Vec<String> {
                 "model.0.max_stretch_error",
                 x.max_stretch_error.to_string(),
             ));
+            out.push(at("model.0.tethers", x.tethers.to_string()));
         }
     }
     out.push(at("integrator", format!("{:?}", chosen.integrator)));

@@ -183,8 +183,9 @@ impl ClothSolver {
         unconverged
     }
 
-    /// XPBD: every spring's constraint projected once (`xpbd.rs`), the strain limit
-    /// with the structural and shear ones.
+    /// XPBD: every spring's constraint projected once (`xpbd.rs`; a grid's on its
+    /// stencil, `lattice/xpbd.rs`), the strain limit with the structural and shear ones,
+    /// then the tethers to the pins (`tethers.rs`).
     fn project_constraints(&mut self, h: f32) {
         let ModelState::Xpbd(constraints) = &mut self.model else {
             return;
@@ -195,7 +196,42 @@ impl ClothSolver {
             let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
             xpbd::Family::new(k, c, h, limit.filter(|_| limited))
         });
-        constraints.project(&mut self.particles, &families, h);
+        match &mut self.stencil {
+            Some(stencil) => stencil.project_xpbd(&mut self.particles, &families, h),
+            None => constraints.project(&mut self.particles, &families, h),
+        }
+        // Last, so the bound they keep holds at the end of the substep.
+        constraints
+            .tethers
+            .project(&mut self.particles, &self.pins, h);
+    }
+
+    /// Builds XPBD's tethers to the pins again when the pins, the torn springs or the
+    /// material's bounds changed (`tethers.rs`); drops them when switched off. A family's
+    /// length is bounded when it is inextensible (the tether's slack 0) or strain limited
+    /// (the slack the limit); the slack is the larger of the bounded families'.
+    pub(super) fn refresh_tethers(&mut self) {
+        let Model::Xpbd(xpbd) = self.params.model else {
+            return;
+        };
+        let bounds = [
+            self.family_bound(SpringKind::Structural),
+            self.family_bound(SpringKind::Shear),
+        ];
+        let ModelState::Xpbd(constraints) = &mut self.model else {
+            return;
+        };
+        let on = xpbd.tethers && bounds[0].is_some();
+        let pins: &[u32] = if on { &self.pins } else { &[] };
+        let slack = bounds.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
+        constraints.tethers.refresh(
+            &self.springs,
+            self.torn_count,
+            pins,
+            bounds.map(|b| b.is_some()),
+            slack,
+            self.particles.len(),
+        );
     }
 
     /// Keeps Verlet's implicit velocity `(x − x_prev)/h` when `h` changes by `ratio`.

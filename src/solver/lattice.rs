@@ -25,6 +25,8 @@ use bevy::math::Vec3;
 use super::parallel::{self, PIECE};
 use super::{Particles, SpringKind, Springs};
 
+mod xpbd;
+
 /// One stencil offset: the springs `(a, a + step)` of one family.
 #[derive(Clone, Debug)]
 struct Offset {
@@ -35,10 +37,11 @@ struct Offset {
     dy: usize,
     /// `b − a` in particle indices.
     step: usize,
-    /// Rest length of the spring from `a` (0 where there is none), indexed by `a`.
+    /// Rest length of the spring from `a` (0 where there is none), indexed by `a`; one
+    /// per particle (the last `step` are 0), so a row's springs read in whole chunks.
     rest: Vec<f32>,
     /// Stiffness factor × alive of the spring from `a` (0 where there is none or it
-    /// tore), indexed by `a`.
+    /// tore), indexed by `a`, one per particle as `rest`.
     weight: Vec<f32>,
 }
 
@@ -162,6 +165,8 @@ pub(super) struct Stencil {
     f: Lanes,
     /// The limiter's corrections in one call, summed per particle (zero between calls).
     dx: Lanes,
+    /// Positions at the start of the substep, for XPBD's damping (`lattice/xpbd.rs`).
+    previous: Lanes,
 }
 
 impl Stencil {
@@ -196,8 +201,8 @@ impl Stencil {
                         dx,
                         dy,
                         step,
-                        rest: vec![0.0; n - step],
-                        weight: vec![0.0; n - step],
+                        rest: vec![0.0; n],
+                        weight: vec![0.0; n],
                     });
                     offsets.len() - 1
                 }
@@ -221,6 +226,7 @@ impl Stencil {
             v: Lanes::new(n),
             f: Lanes::new(n),
             dx: Lanes::new(n),
+            previous: Lanes::new(n),
         };
         stencil.sync(springs);
         Some(stencil)

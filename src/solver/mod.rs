@@ -25,6 +25,7 @@ pub mod shape_matching;
 mod state;
 mod substeps;
 mod switch;
+mod tethers;
 pub mod topology;
 mod xpbd;
 
@@ -82,6 +83,9 @@ pub struct ClothSolver {
     under_resolved: bool,
     /// Automatic substeps remembered for (parameters, dt) (see [`SubstepCache`]).
     substep_cache: SubstepCache,
+    /// XPBD's measured substeps of the last step, for (parameters, dt)
+    /// ([`ClothSolver::xpbd_closed_loop`]); empty after a reset.
+    xpbd_loop: substeps::SubstepLoop,
     torn_this_step: Vec<u32>,
     torn_count: usize,
     grab: Option<Grab>,
@@ -222,6 +226,7 @@ impl ClothSolver {
             substep_index: 0,
             under_resolved: false,
             substep_cache: SubstepCache::default(),
+            xpbd_loop: substeps::SubstepLoop::default(),
             torn_count: 0,
             grab: None,
             model: ModelState::None,
@@ -301,6 +306,7 @@ impl ClothSolver {
         self.torn_this_step.clear();
         self.time = 0.0;
         self.last_h = 0.0;
+        self.xpbd_loop = substeps::SubstepLoop::default();
     }
 
     // ----- parameters and frame -------------------------------------------------------
@@ -391,7 +397,10 @@ impl ClothSolver {
         self.sew();
         if let ModelState::Xpbd(constraints) = &mut self.model {
             // This step's seam lengths, torn springs, pins.
-            constraints.sync(&self.springs, &self.particles.inv_mass);
+            if self.stencil.is_none() {
+                constraints.sync(&self.springs);
+            }
+            self.refresh_tethers();
         }
         if let (Model::Patches(patch), Some(patches)) =
             (self.params.model, self.model.patches_mut())
@@ -406,14 +415,16 @@ impl ClothSolver {
                 n.max(1)
             }
             crate::params::Substeps::Auto { max } => {
+                let cap = crate::limits::auto_substeps_cap(self.particles.len(), max);
                 // Shape matching's stiffness (and the patch pull's for p ≠ 1) depends on
-                // the deformation: no cache.
+                // the deformation: no cache. XPBD follows what it measures.
                 let needed = if self.state_dependent_stiffness() {
                     self.stable_substeps(dt)
+                } else if let Some(n) = self.xpbd_closed_loop(dt, cap) {
+                    n
                 } else {
                     self.refresh_substep_cache(dt)
                 };
-                let cap = crate::limits::auto_substeps_cap(self.particles.len(), max);
                 self.under_resolved = needed > cap;
                 needed.clamp(1, cap)
             }
@@ -482,6 +493,9 @@ impl ClothSolver {
                         > (ratio * s.rest_length[k]).powi(2)
                 {
                     s.alive[k] = false;
+                    if let Some(stencil) = &mut self.stencil {
+                        stencil.tear(k);
+                    }
                     self.torn_this_step.push(k as u32);
                     for &t in &self.spring_triangles[k] {
                         self.triangle_visible[t as usize] = false;
@@ -597,7 +611,9 @@ impl ClothSolver {
             Model::Xpbd(_) => {
                 if !matches!(self.model, ModelState::Xpbd(_)) {
                     let n = self.particles.len();
-                    let constraints = xpbd::Constraints::new(&self.springs, n);
+                    // A grid is projected on its stencil: no constraint lists.
+                    let general = self.stencil.is_none();
+                    let constraints = xpbd::Constraints::new(&self.springs, n, general);
                     self.model = ModelState::Xpbd(Box::new(constraints));
                 }
             }

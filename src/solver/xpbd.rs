@@ -8,8 +8,10 @@
 //! drag: symplectic Euler), then projects the constraints colour by colour: a greedy
 //! colouring of the spring graph puts springs that share no particle in one colour, so a
 //! colour's projections do not depend on their order nor on the thread that makes them
-//! (Gauss–Seidel across colours, Jacobi within). Each particle's corrections are summed
-//! and its velocity takes them over `h` (as the strain limiter's, `lattice.rs`).
+//! (Gauss–Seidel across colours, Jacobi within). Each particle's velocity then takes its
+//! change from the predicted position over `h`. A grid cloth is projected by the same
+//! formula ([`correction`]) on its stencil instead (`lattice/xpbd.rs`), with no index
+//! lists.
 //!
 //! Per constraint `C = |x_b − x_a| − l0`, with `α̃ = α/h²` and the paper's damping
 //! `γ = α̃ β̃ / h = c / (k h)` (β̃ = h² c, c the springs' damping in N·s/m, eq. 26):
@@ -24,6 +26,7 @@ use std::ops::Range;
 use bevy::math::Vec3;
 
 use super::parallel::{self, PIECE};
+use super::tethers::Tethers;
 use super::{Particles, SpringKind, Springs};
 
 /// A colour goes to the compute pool from this many pieces (16,384 constraints) on: a
@@ -33,7 +36,7 @@ use super::{Particles, SpringKind, Springs};
 const PARALLEL_PIECES: usize = 8;
 
 /// The order families are projected in within a substep (see [`Constraints::new`]).
-const PROJECTION_ORDER: [SpringKind; 5] = [
+pub(super) const PROJECTION_ORDER: [SpringKind; 5] = [
     SpringKind::Seam,
     SpringKind::BendDiagonal,
     SpringKind::Bend,
@@ -51,20 +54,15 @@ pub(super) struct Constraints {
     b: Vec<u32>,
     /// Its rest length, synced once per step.
     rest: Vec<f32>,
-    /// The inverse masses of its ends (0 for a torn spring), and `1/(w_a + w_b)` (0
-    /// when both are 0), synced once per step.
-    wa: Vec<f32>,
-    wb: Vec<f32>,
-    inv_w: Vec<f32>,
-    /// `1/((1 + γ) w + α̃)` of its family in the substep (0 when `w` is 0), computed
-    /// when the families' coefficients change ([`Self::project`]).
-    scale: Vec<f32>,
-    /// The coefficients `scale` was computed for.
-    scaled_for: Option<[Family; 5]>,
+    /// 1 while its spring is whole, 0 once torn; synced once per step.
+    alive: Vec<f32>,
     /// The colours, in projection order.
     colours: Vec<Colour>,
-    /// Corrections made in this substep, summed per particle (zero between substeps).
-    dx: Vec<Vec3>,
+    /// The positions predicted for this substep, before any projection (for the
+    /// velocity).
+    predicted: Vec<Vec3>,
+    /// Long-range attachments to the pins (`tethers.rs`), projected after the colours.
+    pub tethers: Tethers,
 }
 
 /// What one family's constraints take in a substep.
@@ -103,8 +101,21 @@ impl Constraints {
     /// The families are projected in the order [`PROJECTION_ORDER`]: what is projected
     /// last is met best after the one iteration, so the structural springs (and their
     /// strain limit) come last, after the seams that pull against them.
-    /// Call [`Self::sync`] before projecting.
-    pub fn new(springs: &Springs, n: usize) -> Self {
+    /// Call [`Self::sync`] before projecting. Not `general`: no constraint lists (a
+    /// grid's are projected on its stencil), only the tethers.
+    pub fn new(springs: &Springs, n: usize, general: bool) -> Self {
+        if !general {
+            return Self {
+                spring: Vec::new(),
+                a: Vec::new(),
+                b: Vec::new(),
+                rest: Vec::new(),
+                alive: Vec::new(),
+                colours: Vec::new(),
+                predicted: Vec::new(),
+                tethers: Tethers::default(),
+            };
+        }
         // Each particle's springs (CSR), to find the colours already taken around a spring.
         let mut start = vec![0u32; n + 1];
         for s in 0..springs.len() {
@@ -167,16 +178,13 @@ impl Constraints {
         let m = order.len();
         let constraints = Self {
             rest: vec![0.0; m],
-            wa: vec![0.0; m],
-            wb: vec![0.0; m],
-            inv_w: vec![0.0; m],
-            scale: vec![0.0; m],
-            scaled_for: None,
+            alive: vec![0.0; m],
             a,
             b,
             spring: order,
             colours,
-            dx: vec![Vec3::ZERO; n],
+            predicted: Vec::with_capacity(n),
+            tethers: Tethers::default(),
         };
         debug_assert!(constraints.colours_are_disjoint(n));
         constraints
@@ -199,44 +207,19 @@ impl Constraints {
         true
     }
 
-    /// Takes the springs' rest lengths (seams change theirs while sewn), alive flags and
-    /// the particles' inverse masses (pins, mass edits); called once per step, before
-    /// its substeps.
-    pub fn sync(&mut self, springs: &Springs, inv_mass: &[f32]) {
-        let ends = self.spring.iter().zip(self.a.iter().zip(&self.b));
-        let out = self
-            .rest
-            .iter_mut()
-            .zip(self.wa.iter_mut().zip(&mut self.wb))
-            .zip(&mut self.inv_w);
-        for (((rest, (wa, wb)), inv_w), (&s, (&a, &b))) in out.zip(ends) {
-            let alive = f32::from(u8::from(springs.alive[s as usize]));
+    /// Takes the springs' rest lengths (seams change theirs while sewn) and alive flags;
+    /// called once per step, before its substeps.
+    pub fn sync(&mut self, springs: &Springs) {
+        let out = self.rest.iter_mut().zip(&mut self.alive);
+        for ((rest, alive), &s) in out.zip(&self.spring) {
             *rest = springs.rest_length[s as usize];
-            (*wa, *wb) = (inv_mass[a as usize] * alive, inv_mass[b as usize] * alive);
-            let w = *wa + *wb;
-            *inv_w = if w > 0.0 { 1.0 / w } else { 0.0 };
+            *alive = f32::from(u8::from(springs.alive[s as usize]));
         }
-        self.scaled_for = None;
     }
 
-    /// Each constraint's `1/((1 + γ) w + α̃)` for `families`, unless already computed.
-    fn rescale(&mut self, families: &[Family; 5]) {
-        if self.scaled_for.as_ref() == Some(families) {
-            return;
-        }
-        for colour in &self.colours {
-            let f = families[colour.kind as usize];
-            for k in colour.pieces.iter().flat_map(Clone::clone) {
-                let w = self.wa[k] + self.wb[k];
-                let denominator = (1.0 + f.damping) * w + f.compliance;
-                self.scale[k] = if w > 0.0 { 1.0 / denominator } else { 0.0 };
-            }
-        }
-        self.scaled_for = Some(*families);
-    }
-
-    /// Projects every constraint once, colour by colour, then gives each particle's
-    /// velocity its summed correction over `h`. `families` by [`SpringKind`].
+    /// Projects every constraint once, colour by colour, then gives each particle its
+    /// change from the predicted position as velocity over `h`. `families` by
+    /// [`SpringKind`].
     ///
     /// A colour's pieces (`PIECE` constraints each, sorted by first particle) reach the
     /// particles between their first particle and their last: where those windows of
@@ -245,9 +228,10 @@ impl Constraints {
     /// colours run on this thread. The same bits either way: a colour's constraints
     /// share no particle.
     pub fn project(&mut self, p: &mut Particles, families: &[Family; 5], h: f32) {
-        self.rescale(families);
         let n = p.len();
-        let (x, dx) = (&mut p.position[..], &mut self.dx[..]);
+        self.predicted.clear();
+        self.predicted.extend_from_slice(&p.position);
+        let (x, inv_mass) = (&mut p.position[..], &p.inv_mass[..]);
         let previous = &p.previous[..];
         for colour in &self.colours {
             let family = families[colour.kind as usize];
@@ -260,40 +244,92 @@ impl Constraints {
                     a: &self.a[range.clone()],
                     b: &self.b[range.clone()],
                     rest: &self.rest[range.clone()],
-                    wa: &self.wa[range.clone()],
-                    wb: &self.wb[range.clone()],
-                    inv_w: &self.inv_w[range.clone()],
-                    scale: &self.scale[range],
+                    alive: &self.alive[range],
+                }
+            };
+            let damped = family.damping > 0.0;
+            let limited = family.max_stretch.is_finite();
+            let project = |piece, x: &mut [Vec3], offset| match (damped, limited) {
+                (false, false) => {
+                    project_piece::<false, false>(piece, (x, offset), previous, inv_mass, family)
+                }
+                (false, true) => {
+                    project_piece::<false, true>(piece, (x, offset), previous, inv_mass, family)
+                }
+                (true, false) => {
+                    project_piece::<true, false>(piece, (x, offset), previous, inv_mass, family)
+                }
+                (true, true) => {
+                    project_piece::<true, true>(piece, (x, offset), previous, inv_mass, family)
                 }
             };
             if !colour.windowed || colour.pieces.len() < PARALLEL_PIECES {
                 for k in 0..colour.pieces.len() {
-                    project_piece(piece(k), (&mut *x, &mut *dx, 0), previous, family);
+                    project(piece(k), &mut *x, 0);
                 }
                 continue;
             }
             for parity in 0..2 {
                 let windows = Windows {
                     x: &mut *x,
-                    dx: &mut *dx,
                     at: 0,
                     bounds: &colour.windows,
                     next: parity,
                 };
-                let pieces = windows.map(|(k, x, dx, offset)| (piece(k), x, dx, offset));
-                parallel::for_each(n, pieces, |(piece, x, dx, offset)| {
-                    project_piece(piece, (x, dx, offset), previous, family);
-                });
+                let pieces = windows.map(|(k, x, offset)| (piece(k), x, offset));
+                parallel::for_each(n, pieces, |(piece, x, offset)| project(piece, x, offset));
             }
         }
-        let pieces = p.velocity.chunks_mut(PIECE).zip(self.dx.chunks_mut(PIECE));
-        parallel::for_each(n, pieces, |(velocity, dx)| {
-            for (v, d) in velocity.iter_mut().zip(dx) {
-                *v += *d / h;
-                *d = Vec3::ZERO;
+        let pieces = p
+            .velocity
+            .chunks_mut(PIECE)
+            .zip(p.position.chunks(PIECE))
+            .zip(self.predicted.chunks(PIECE));
+        parallel::for_each(n, pieces, |((velocity, x), predicted)| {
+            for ((v, x), predicted) in velocity.iter_mut().zip(x).zip(predicted) {
+                *v += (*x - *predicted) / h;
             }
         });
     }
+}
+
+/// XPBD's step for one distance constraint of family `f` (module doc) whose ends are
+/// `len` apart, of rest length `rest`, with inverse masses summing to `w` (0: torn or
+/// held at both ends) and, for damping, `approach = d·((x_b − x_b,prev) − (x_a −
+/// x_a,prev))` with `d = x_b − x_a`: the factor `s` of `d` with `Δx_a = −s w_a d` and
+/// `Δx_b = s w_b d`. `DAMPED`, `LIMITED`: whether the family has damping, a strain limit
+/// (chosen once per colour, not per constraint).
+#[inline(always)]
+pub(super) fn correction<const DAMPED: bool, const LIMITED: bool>(
+    len: f32,
+    rest: f32,
+    w: f32,
+    approach: f32,
+    f: Family,
+) -> f32 {
+    // No direction to push along (coincident ends): nothing.
+    let inv_len = if len > f32::EPSILON * rest.max(1.0) {
+        1.0 / len
+    } else {
+        0.0
+    };
+    let scale = if w > 0.0 {
+        1.0 / ((1.0 + f.damping) * w + f.compliance)
+    } else {
+        0.0
+    };
+    let c = len - rest;
+    let mut delta_lambda = if DAMPED {
+        (-c - f.damping * approach * inv_len) * scale
+    } else {
+        -c * scale
+    };
+    if LIMITED {
+        // The strain limit: no longer than `max_stretch · l0` after the step.
+        let inv_w = if w > 0.0 { 1.0 / w } else { 0.0 };
+        delta_lambda = delta_lambda.min((f.max_stretch * rest - len) * inv_w);
+    }
+    delta_lambda * inv_len
 }
 
 /// One colour: its family, its pieces of constraints, and the particles each piece
@@ -341,10 +377,9 @@ impl Colour {
 }
 
 /// The pieces of one parity in order, each with its own slice of the particles
-/// (`x[lo..=hi]`, `dx[lo..=hi]`) and `lo`.
+/// (`x[lo..=hi]`) and `lo`.
 struct Windows<'a, 'w> {
     x: &'a mut [Vec3],
-    dx: &'a mut [Vec3],
     /// The particle index `x[0]` is.
     at: usize,
     bounds: &'w [(usize, usize)],
@@ -352,19 +387,16 @@ struct Windows<'a, 'w> {
 }
 
 impl<'a> Iterator for Windows<'a, '_> {
-    type Item = (usize, &'a mut [Vec3], &'a mut [Vec3], usize);
+    type Item = (usize, &'a mut [Vec3], usize);
 
     fn next(&mut self) -> Option<Self::Item> {
         let k = self.next;
         let &(lo, hi) = self.bounds.get(k)?;
         self.next += 2;
         let x = std::mem::take(&mut self.x);
-        let dx = std::mem::take(&mut self.dx);
-        let (x, dx) = (&mut x[lo - self.at..], &mut dx[lo - self.at..]);
-        let (window, x) = x.split_at_mut(hi + 1 - lo);
-        let (window_dx, dx) = dx.split_at_mut(hi + 1 - lo);
-        (self.x, self.dx, self.at) = (x, dx, hi + 1);
-        Some((k, window, window_dx, lo))
+        let (window, x) = x[lo - self.at..].split_at_mut(hi + 1 - lo);
+        (self.x, self.at) = (x, hi + 1);
+        Some((k, window, lo))
     }
 }
 
@@ -374,56 +406,125 @@ struct Piece<'a> {
     a: &'a [u32],
     b: &'a [u32],
     rest: &'a [f32],
-    wa: &'a [f32],
-    wb: &'a [f32],
-    inv_w: &'a [f32],
-    scale: &'a [f32],
+    alive: &'a [f32],
 }
 
-/// Projects a piece's constraints (module doc) on positions and summed corrections
-/// `x`, `dx` that start at particle `offset`; `previous`: all positions at the start of
-/// the substep.
+/// Projects a piece's constraints ([`correction`]) on positions `x` that start at
+/// particle `offset`; `previous`: all positions at the start of the substep, `inv_mass`
+/// all inverse masses.
 #[inline(always)]
-fn project_piece(
+fn project_piece<const DAMPED: bool, const LIMITED: bool>(
     piece: Piece<'_>,
-    (x, dx, offset): (&mut [Vec3], &mut [Vec3], usize),
+    (x, offset): (&mut [Vec3], usize),
     previous: &[Vec3],
+    inv_mass: &[f32],
     family: Family,
 ) {
-    let (gamma, max_stretch) = (family.damping, family.max_stretch);
-    let damped = gamma > 0.0;
-    let constraints = piece
-        .a
-        .iter()
-        .zip(piece.b)
-        .zip(piece.rest.iter().zip(piece.scale))
-        .zip(piece.wa.iter().zip(piece.wb).zip(piece.inv_w));
-    for (((&a, &b), (&rest, &scale)), ((&wa, &wb), &inv_w)) in constraints {
-        let (a, b) = (a as usize, b as usize);
+    for k in 0..piece.a.len() {
+        let (a, b) = (piece.a[k] as usize, piece.b[k] as usize);
         let (la, lb) = (a - offset, b - offset);
         let d = x[lb] - x[la];
-        let len = d.length();
-        // No direction to push along (coincident ends): nothing.
-        let inv_len = if len > f32::EPSILON * rest.max(1.0) {
-            1.0 / len
+        let (wa, wb) = (inv_mass[a] * piece.alive[k], inv_mass[b] * piece.alive[k]);
+        let approach = if DAMPED {
+            d.dot((x[lb] - previous[b]) - (x[la] - previous[a]))
         } else {
             0.0
         };
+        let s = correction::<DAMPED, LIMITED>(d.length(), piece.rest[k], wa + wb, approach, family);
+        x[la] -= d * (s * wa);
+        x[lb] += d * (s * wb);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// XPBD eq. 18 and 26 for one constraint with λ = 0, in f64: the ends' moves.
+    fn reference(
+        xa: [f64; 3],
+        xb: [f64; 3],
+        (wa, wb): (f64, f64),
+        rest: f64,
+        (compliance, gamma): (f64, f64),
+        approach_rate: f64,
+    ) -> ([f64; 3], [f64; 3]) {
+        let d: Vec<f64> = (0..3).map(|i| xb[i] - xa[i]).collect();
+        let len = d.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let n: Vec<f64> = d.iter().map(|v| v / len).collect();
         let c = len - rest;
-        let lambda = if damped {
-            let relative = (x[lb] - previous[b]) - (x[la] - previous[a]);
-            (-c - gamma * d.dot(relative) * inv_len) * scale
+        // ∇C·(x − x_prev) along n, for damping.
+        let delta_lambda = (-c - gamma * approach_rate) / ((1.0 + gamma) * (wa + wb) + compliance);
+        let move_a = [0, 1, 2].map(|i| -wa * delta_lambda * n[i]);
+        let move_b = [0, 1, 2].map(|i| wb * delta_lambda * n[i]);
+        (move_a, move_b)
+    }
+
+    fn moves(
+        xa: Vec3,
+        xb: Vec3,
+        (wa, wb): (f32, f32),
+        rest: f32,
+        family: Family,
+        relative: Vec3,
+    ) -> (Vec3, Vec3) {
+        let d = xb - xa;
+        let approach = d.dot(relative);
+        let s = if family.damping > 0.0 {
+            correction::<true, true>(d.length(), rest, wa + wb, approach, family)
         } else {
-            -c * scale
+            correction::<false, true>(d.length(), rest, wa + wb, approach, family)
         };
-        // The strain limit: no longer than `max_stretch · l0` after the step (`inf` for a
-        // family without one: nothing). A held or torn constraint has `w = 0`: no move.
-        let lambda = lambda.min((max_stretch * rest - len) * inv_w);
-        let correction = d * (lambda * inv_len);
-        let (ca, cb) = (correction * wa, correction * wb);
-        x[la] -= ca;
-        x[lb] += cb;
-        dx[la] -= ca;
-        dx[lb] += cb;
+        (-d * (s * wa), d * (s * wb))
+    }
+
+    #[test]
+    fn one_constraint_moves_its_ends_as_the_papers_formula() {
+        let (xa, xb) = (Vec3::new(0.1, 0.2, -0.3), Vec3::new(0.9, -0.4, 0.5));
+        let (wa, wb) = (1.0, 0.5);
+        let rest = 0.8;
+        for (compliance, gamma) in [(0.0, 0.0), (0.25, 0.0), (0.25, 0.3)] {
+            let family = Family {
+                on: true,
+                compliance,
+                damping: gamma,
+                max_stretch: f32::INFINITY,
+            };
+            let relative = Vec3::new(0.01, -0.02, 0.03);
+            let (ma, mb) = moves(xa, xb, (wa, wb), rest, family, relative);
+            let f = |v: Vec3| [v.x, v.y, v.z].map(f64::from);
+            let d = xb - xa;
+            let rate = f64::from(d.dot(relative) / d.length());
+            let (ra, rb) = reference(
+                f(xa),
+                f(xb),
+                (f64::from(wa), f64::from(wb)),
+                f64::from(rest),
+                (f64::from(compliance), f64::from(gamma)),
+                rate,
+            );
+            for i in 0..3 {
+                assert!((f64::from(ma[i]) - ra[i]).abs() < 1e-6, "{ma} {ra:?}");
+                assert!((f64::from(mb[i]) - rb[i]).abs() < 1e-6, "{mb} {rb:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn the_strain_limit_caps_the_length_and_a_torn_or_held_constraint_does_not_move() {
+        let family = Family {
+            on: true,
+            compliance: 10.0, // soft: alone it would leave the constraint long
+            damping: 0.0,
+            max_stretch: 1.1,
+        };
+        let (xa, xb) = (Vec3::ZERO, Vec3::new(2.0, 0.0, 0.0));
+        let (ma, mb) = moves(xa, xb, (1.0, 1.0), 1.0, family, Vec3::ZERO);
+        assert!(((xb + mb).distance(xa + ma) - 1.1).abs() < 1e-6);
+        let (ma, mb) = moves(xa, xb, (0.0, 0.0), 1.0, family, Vec3::ZERO);
+        assert_eq!((ma, mb), (Vec3::ZERO, Vec3::ZERO));
+        // Coincident ends: no direction, no move (and nothing non-finite).
+        let (ma, mb) = moves(xa, xa, (1.0, 1.0), 1.0, family, Vec3::ZERO);
+        assert_eq!((ma, mb), (Vec3::ZERO, Vec3::ZERO));
     }
 }
