@@ -8,6 +8,7 @@ pub mod accuracy;
 pub mod baseline;
 pub mod choose;
 pub mod fps;
+pub mod peers;
 pub mod soak;
 pub mod stability;
 

@@ -8,6 +8,7 @@ use std::path::Path;
 use bevy_cloth::prelude::Integrator;
 use bevy_cloth_lab::accuracy::Row;
 use bevy_cloth_lab::fps::{AppFrame, SEED_002_FPS};
+use bevy_cloth_lab::peers::PeerRow;
 use bevy_cloth_lab::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
 use bevy_cloth_lab::{BENCH_MODELS, BenchCell, SEED_COUNTS, SEED_MS};
 use plotters::coord::Shift;
@@ -529,6 +530,108 @@ impl Chart for Stability<'_> {
                         .map(|c| Cross::new(at(c), 5, PALETTE[0].stroke_width(2))),
                 )
                 .map_err(err)?;
+        }
+        Ok(())
+    }
+}
+
+// ----- peers --------------------------------------------------------------------------
+
+/// `docs/peers.png`: one panel per cloth size, strain against ms per frame (log-log), one
+/// line per solver through its configurations, cheap to dear; the 1% and 0.1% strains
+/// as dashed lines. Failed runs are not drawn (they are in the table).
+pub fn peers(png: &Path, rows: &[PeerRow]) -> Result<()> {
+    let mut sides: Vec<usize> = rows.iter().map(|r| r.side).collect();
+    sides.sort_unstable();
+    sides.dedup();
+    let width = 520 * sides.len().max(1) as u32;
+    both(
+        png,
+        (width, 560),
+        &Peers {
+            rows,
+            sides: &sides,
+        },
+    )
+}
+
+struct Peers<'a> {
+    rows: &'a [PeerRow],
+    sides: &'a [usize],
+}
+
+impl Chart for Peers<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
+        let panels = area.split_evenly((1, self.sides.len().max(1)));
+        let mut solvers: Vec<&str> = Vec::new();
+        for r in self.rows {
+            if !solvers.contains(&r.solver.as_str()) {
+                solvers.push(&r.solver);
+            }
+        }
+        for (panel, &side) in panels.iter().zip(self.sides) {
+            let ok: Vec<(&PeerRow, f64, f64)> = self
+                .rows
+                .iter()
+                .filter(|r| r.side == side)
+                .filter_map(|r| Some((r, r.ms?, r.strain?.max(1e-6))))
+                .collect();
+            let xs = log_range(ok.iter().map(|(_, ms, _)| *ms));
+            let ys = log_range(ok.iter().map(|(_, _, s)| *s).chain([1e-3, 1e-2]));
+            let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
+            let mut chart = ChartBuilder::on(panel)
+                .caption(
+                    format!("{} particles ({side}×{side})", side * side),
+                    (FONT, 20),
+                )
+                .margin(12)
+                .x_label_area_size(45)
+                .y_label_area_size(65)
+                .build_cartesian_2d(
+                    xs.clone().log_scale().with_key_points(x_ticks),
+                    ys.log_scale().with_key_points(y_ticks),
+                )
+                .map_err(err)?;
+            chart
+                .configure_mesh()
+                .x_desc("ms per frame (median)")
+                .y_desc("largest structural strain")
+                .x_label_formatter(&tick_label)
+                .y_label_formatter(&tick_label)
+                .label_style((FONT, 14))
+                .axis_desc_style((FONT, 16))
+                .draw()
+                .map_err(err)?;
+            for strain in [1e-2, 1e-3] {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        [(xs.start, strain), (xs.end, strain)],
+                        4,
+                        4,
+                        BLACK.mix(0.4).stroke_width(1),
+                    ))
+                    .map_err(err)?;
+            }
+            for (k, solver) in solvers.iter().enumerate() {
+                let color = PALETTE[k % PALETTE.len()];
+                let mut points: Vec<(f64, f64)> = ok
+                    .iter()
+                    .filter(|(r, _, _)| r.solver == *solver)
+                    .map(|(_, ms, s)| (*ms, *s))
+                    .collect();
+                points.sort_by(|a, b| a.0.total_cmp(&b.0));
+                chart
+                    .draw_series(LineSeries::new(points.clone(), color.stroke_width(2)))
+                    .map_err(err)?
+                    .label(*solver)
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+                    });
+                chart
+                    .draw_series(points.iter().map(|&p| Circle::new(p, 4, color.filled())))
+                    .map_err(err)?;
+            }
+            legend(&mut chart, SeriesLabelPosition::UpperRight, 13)?;
         }
         Ok(())
     }

@@ -50,6 +50,7 @@ use bevy_cloth::solver;
 use bevy_cloth_lab::accuracy::{self, Case};
 use bevy_cloth_lab::baseline;
 use bevy_cloth_lab::fps::{self, APP_COUNTS};
+use bevy_cloth_lab::peers::{self, Hang, PEER_SOLVERS, Peer, PeerRow};
 use bevy_cloth_lab::stability::{
     self, MASS, MODELS, NONLINEAR_MODELS, NONLINEAR_TIMESTEP, Regime, STIFFNESS, TIMESTEP,
 };
@@ -83,6 +84,10 @@ enum Verb {
     /// parameter edits (and refused invalid ones), model switches and resets, checking
     /// every step for non-finite state and the memory for growth.
     Soak(SoakArgs),
+    /// Speed at equal accuracy beside other solvers, in one run: a cloth hung from its top
+    /// row (or corners) with our XPBD without and with tethers, rapier-cloth-core and a
+    /// Verlet + sticks baseline, each over a sweep of its cost setting.
+    Peers(PeersArgs),
 }
 
 #[derive(Args)]
@@ -207,6 +212,27 @@ struct AccuracyArgs {
 }
 
 #[derive(Args)]
+struct PeersArgs {
+    /// Particles across (and down) the square cloth, comma separated (2 to 512).
+    #[arg(long, value_delimiter = ',', default_values_t = [16, 64, 256], value_parser = side)]
+    sides: Vec<usize>,
+    /// What holds it: its whole top row (`top-row`) or its two top corners (`corners`).
+    #[arg(long, default_value = "top-row", value_parser = hang)]
+    hang: Hang,
+    /// Frames of 1/60 s per run (the first 5 are not timed).
+    #[arg(long, default_value_t = 60, value_parser = steps)]
+    frames: usize,
+    /// The solvers, comma separated: ours, tethers, rapier, sticks (all when absent).
+    #[arg(long, value_delimiter = ',', value_parser = peer_solver)]
+    solvers: Vec<&'static str>,
+    /// Keeps our kernels on one thread (the peers always run on one).
+    #[arg(long = "one-thread")]
+    one_thread: bool,
+    #[command(flatten)]
+    output: Output,
+}
+
+#[derive(Args)]
 struct StabilityArgs {
     /// The models, comma separated (all when absent).
     #[arg(long, value_delimiter = ',', value_parser = stability_model)]
@@ -237,6 +263,7 @@ fn main() -> ExitCode {
         Verb::Stability(args) => stability(args),
         Verb::Choose(args) => choose(args),
         Verb::Soak(args) => soak(args),
+        Verb::Peers(args) => peers(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -320,6 +347,25 @@ fn seed_model(text: &str) -> Result<&'static str, String> {
 
 fn stability_model(text: &str) -> Result<&'static str, String> {
     one_of(text, &MODELS, "model")
+}
+
+fn side(text: &str) -> Result<usize, String> {
+    match text.parse::<usize>() {
+        Ok(n) if (2..=512).contains(&n) => Ok(n),
+        _ => Err(format!("`{text}` is not a side from 2 to 512 particles")),
+    }
+}
+
+fn hang(text: &str) -> Result<Hang, String> {
+    match text {
+        "top-row" => Ok(Hang::TopRow),
+        "corners" => Ok(Hang::Corners),
+        _ => Err(format!("no hang `{text}` (top-row, corners)")),
+    }
+}
+
+fn peer_solver(text: &str) -> Result<&'static str, String> {
+    one_of(text, &PEER_SOLVERS, "solver")
 }
 
 fn accuracy_scene(text: &str) -> Result<&'static str, String> {
@@ -1282,4 +1328,111 @@ fn soak(args: SoakArgs) -> Result<(), String> {
         eprintln!("error: the soak found a problem (see the summary)");
         std::process::exit(1);
     }
+}
+
+/// `cloth peers`: every configuration of every solver on every side, in one run; the
+/// table, then each solver's cheapest configuration within 1% and within 0.1% strain and
+/// its cost against rapier-cloth-core's in the same run.
+fn peers(args: PeersArgs) -> Result<(), String> {
+    let solvers = or_all(args.solvers, &PEER_SOLVERS);
+    if args.one_thread {
+        solver::set_parallel(false);
+    }
+    let configs: Vec<Peer> = peers::default_peers()
+        .into_iter()
+        .filter(|p| solvers.contains(&p.key()))
+        .collect();
+    let bar = progress(configs.len() * args.sides.len(), "runs");
+    let mut rows: Vec<PeerRow> = Vec::new();
+    for &side in &args.sides {
+        for &peer in &configs {
+            let row = peers::measure(side, args.hang, peer, args.frames)?;
+            bar.suspend(|| {
+                eprintln!(
+                    "  {:>6} {:<26} {:<26} {}",
+                    side * side,
+                    row.solver,
+                    row.label,
+                    match (&row.failed, row.ms, row.strain) {
+                        (Some(why), _, _) => format!("failed: {why}"),
+                        (None, Some(ms), Some(strain)) =>
+                            format!("{ms:.3} ms  strain {:.3}%", strain * 100.0),
+                        _ => String::new(),
+                    }
+                )
+            });
+            bar.inc(1);
+            rows.push(row);
+        }
+    }
+    bar.finish_and_clear();
+    if let Some(chart) = &args.output.chart {
+        charts::peers(chart, &rows)?;
+    }
+    let best = peers::cheapest_within(&rows, &[0.01, 0.001]);
+    if args.output.json {
+        return print_json(&serde_json::json!({
+            "threads": solver::threads(),
+            "frames": args.frames,
+            "warmup_frames": peers::WARMUP_FRAMES,
+            "rows": rows,
+            "cheapest": best,
+        }));
+    }
+    println!(
+        "{} frames of 1/60 s per run, the first {} not timed; ours on {} thread(s), the others on one.",
+        args.frames,
+        peers::WARMUP_FRAMES,
+        solver::threads()
+    );
+    println!();
+    println!(
+        "| particles | solver | configuration | ms per frame, median [p10–p90] | ns per projection | strain | sag |"
+    );
+    println!("|---:|---|---|---:|---:|---:|---:|");
+    for r in &rows {
+        let (time, ns, strain, sag) = match (r.ms, r.ms_spread, r.strain, r.sag) {
+            (Some(ms), Some((lo, hi)), Some(strain), Some(sag)) => (
+                format!("{ms:.3} [{lo:.3}–{hi:.3}]"),
+                r.ns_per_projection
+                    .map_or("-".into(), |ns| format!("{ns:.2}")),
+                format!("{:.3}%", strain * 100.0),
+                format!("{:.3}%", sag * 100.0),
+            ),
+            _ => (
+                "-".into(),
+                "-".into(),
+                format!("failed: {}", r.failed.as_deref().unwrap_or("")),
+                "-".into(),
+            ),
+        };
+        println!(
+            "| {} | {} | {} | {time} | {ns} | {strain} | {sag} |",
+            r.side * r.side,
+            r.solver,
+            r.label
+        );
+    }
+    println!();
+    println!(
+        "The cheapest configuration of each solver within a strain, and rapier-cloth-core's cost over its:"
+    );
+    println!();
+    println!(
+        "| particles | strain within | solver | configuration | ms per frame | strain | rapier / it |"
+    );
+    println!("|---:|---:|---|---|---:|---:|---:|");
+    for b in &best {
+        println!(
+            "| {} | {}% | {} | {} | {:.3} | {:.3}% | {} |",
+            b.side * b.side,
+            b.within * 100.0,
+            b.solver,
+            b.label,
+            b.ms,
+            b.strain * 100.0,
+            b.rapier_over.map_or("-".into(), |r| format!("{r:.2}x"))
+        );
+    }
+    Ok(())
 }
