@@ -20,7 +20,7 @@
 
 use std::time::Instant;
 
-use bevy::math::{Affine3A, Vec3};
+use bevy::math::{Affine3A, Quat, Vec3};
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
@@ -40,21 +40,32 @@ pub const FRAME: f32 = 1.0 / 60.0;
 /// Frames not timed at the start (caches, the pool's threads waking).
 pub const WARMUP_FRAMES: usize = 5;
 
-/// What holds the cloth up.
+/// What holds the cloth up, and how it starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 pub enum Hang {
-    /// Its whole top row.
+    /// Its whole top row, hanging straight down at rest.
     TopRow,
-    /// Its two top corners (the curtain).
+    /// Its two top corners (the curtain), hanging in its plane.
     Corners,
+    /// Its whole top row, starting level (in the XZ plane) and swinging down: the
+    /// dynamic case, where the cloth is loaded by its own motion, not only its weight.
+    Swing,
 }
 
 impl Hang {
     /// The pinned particle indices of a `side`-wide grid.
     pub fn pins(self, side: usize) -> Vec<u32> {
         match self {
-            Hang::TopRow => (0..side as u32).collect(),
+            Hang::TopRow | Hang::Swing => (0..side as u32).collect(),
             Hang::Corners => vec![0, side as u32 - 1],
+        }
+    }
+
+    /// The direction rows run from the top row: down, or level for the swing.
+    fn down(self) -> Vec3 {
+        match self {
+            Hang::Swing => Vec3::Z,
+            _ => -Vec3::Y,
         }
     }
 }
@@ -271,7 +282,7 @@ pub fn measure(side: usize, hang: Hang, peer: Peer, frames: usize) -> Result<Pee
         }
     }
     let x = solver.positions();
-    let (strain, sag) = accuracy(&x, side);
+    let (strain, sag) = accuracy(&x, &rest(side, hang), side);
     if failed.is_none() && !x.iter().all(|p| p.is_finite()) {
         failed = Some("a position is not finite".into());
     }
@@ -301,8 +312,9 @@ pub fn measure(side: usize, hang: Hang, peer: Peer, frames: usize) -> Result<Pee
     })
 }
 
-/// `(strain, sag)` of a `side × side` row-major grid's positions (see the module doc).
-pub fn accuracy(x: &[Vec3], side: usize) -> (f64, f64) {
+/// `(strain, sag)` of a `side × side` row-major grid's positions that started at `rest`
+/// (see the module doc).
+pub fn accuracy(x: &[Vec3], rest: &[Vec3], side: usize) -> (f64, f64) {
     let mut strain = 0.0f64;
     for j in 0..side {
         for i in 0..side {
@@ -318,22 +330,21 @@ pub fn accuracy(x: &[Vec3], side: usize) -> (f64, f64) {
             }
         }
     }
-    let bottom = &x[(side - 1) * side..];
-    let y = bottom.iter().map(|p| f64::from(p.y)).sum::<f64>() / side as f64;
-    let rest_y = -((side - 1) as f64) * f64::from(SPACING);
-    let sag = (rest_y - y) / ((side - 1) as f64 * f64::from(SPACING));
+    let mean_y = |x: &[Vec3]| {
+        let bottom = &x[(side - 1) * side..];
+        bottom.iter().map(|p| f64::from(p.y)).sum::<f64>() / side as f64
+    };
+    let sag = (mean_y(rest) - mean_y(x)) / ((side - 1) as f64 * f64::from(SPACING));
     (strain, sag)
 }
 
-/// The rest positions: row `j` at `y = −j·spacing`, column `i` at `x = i·spacing`.
-fn rest(side: usize) -> Vec<Vec3> {
+/// The start: column `i` at `x = i·spacing`, row `j` `j·spacing` from the top row along
+/// [`Hang::down`].
+pub fn rest(side: usize, hang: Hang) -> Vec<Vec3> {
     (0..side * side)
         .map(|k| {
-            Vec3::new(
-                (k % side) as f32 * SPACING,
-                -((k / side) as f32) * SPACING,
-                0.0,
-            )
+            let (i, j) = ((k % side) as f32, (k / side) as f32);
+            Vec3::X * (i * SPACING) + hang.down() * (j * SPACING)
         })
         .collect()
 }
@@ -376,9 +387,14 @@ impl Ours {
             height: side as u32,
             spacing: SPACING,
         };
-        // The grid's local origin is the middle of its top edge: move it to the bench's.
+        // The grid hangs down −y from the middle of its top edge: moved to the bench's
+        // origin, and turned level (rows along +z) for the swing.
         let half = (side - 1) as f32 * SPACING * 0.5;
-        let frame = Affine3A::from_translation(Vec3::new(half, 0.0, 0.0));
+        let level = match hang {
+            Hang::Swing => Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+            _ => Quat::IDENTITY,
+        };
+        let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
         let pins = Pins::Indices(hang.pins(side));
         let cloth = shape
             .build_solver(&pins, &ours_params(substeps, tethers), frame)
@@ -422,10 +438,10 @@ impl Rapier {
     fn new(side: usize, hang: Hang, steps: usize, iterations: usize) -> Result<Self, String> {
         use rapier_cloth_core::{Cloth, ClothMaterial, GridBuilder, Solver, SolverSettings};
         let size = (side - 1) as f32 * SPACING;
-        // Rows down −y from the top edge at y = 0, as [`rest`].
+        // Rows from the top edge at the origin along [`Hang::down`], as [`rest`].
         let mesh = GridBuilder::new(side, side)
             .size(size, size)
-            .axes(to_rapier(Vec3::X), to_rapier(-Vec3::Y))
+            .axes(to_rapier(Vec3::X), to_rapier(hang.down()))
             .build()
             .map_err(|e| e.to_string())?;
         let material = ClothMaterial {
@@ -435,7 +451,7 @@ impl Rapier {
             ..ClothMaterial::default()
         };
         let mut cloth = Cloth::new(mesh, material).map_err(|e| e.to_string())?;
-        let rest = rest(side);
+        let rest = rest(side, hang);
         for i in hang.pins(side) {
             cloth
                 .pin(i, to_rapier(rest[i as usize]))
@@ -497,7 +513,7 @@ pub struct Sticks {
 impl Sticks {
     /// The bench's cloth as sticks.
     pub fn new(side: usize, hang: Hang, sweeps: usize) -> Self {
-        let x = rest(side);
+        let x = rest(side, hang);
         let mut free = vec![true; x.len()];
         for i in hang.pins(side) {
             free[i as usize] = false;

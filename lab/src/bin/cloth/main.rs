@@ -216,7 +216,8 @@ struct PeersArgs {
     /// Particles across (and down) the square cloth, comma separated (2 to 512).
     #[arg(long, value_delimiter = ',', default_values_t = [16, 64, 256], value_parser = side)]
     sides: Vec<usize>,
-    /// What holds it: its whole top row (`top-row`) or its two top corners (`corners`).
+    /// What holds it: its whole top row (`top-row`), its two top corners (`corners`), or
+    /// its top row with the cloth starting level and swinging down (`swing`).
     #[arg(long, default_value = "top-row", value_parser = hang)]
     hang: Hang,
     /// Frames of 1/60 s per run (the first 5 are not timed).
@@ -360,7 +361,8 @@ fn hang(text: &str) -> Result<Hang, String> {
     match text {
         "top-row" => Ok(Hang::TopRow),
         "corners" => Ok(Hang::Corners),
-        _ => Err(format!("no hang `{text}` (top-row, corners)")),
+        "swing" => Ok(Hang::Swing),
+        _ => Err(format!("no hang `{text}` (top-row, corners, swing)")),
     }
 }
 
