@@ -286,7 +286,8 @@ pub fn measure(side: usize, hang: Hang, peer: Peer, frames: usize) -> Result<Pee
     if failed.is_none() && !x.iter().all(|p| p.is_finite()) {
         failed = Some("a position is not finite".into());
     }
-    if failed.is_none() && !(strain <= 1.0) {
+    // A NaN strain (a broken state) fails too.
+    if failed.is_none() && (strain.is_nan() || strain > 1.0) {
         failed = Some(format!("strain {:.0}% (past 100%)", strain * 100.0));
     }
     let ok = failed.is_none();

@@ -24,6 +24,13 @@ pub(super) const PIECE: usize = 2048;
 /// 8.8–9.6 against 7.9–8.0, `cloth bench --models 1`).
 pub(super) const PARALLEL_FROM: usize = 8 * PIECE;
 
+/// XPBD's kernels on a grid (its colours, the velocity store, the tethers) go to the pool
+/// from this many particles: a substep is about 20 of them, each a fork-join, and below
+/// it they cost more than the second core bought (`cloth peers --sides 128,256 --solvers
+/// ours` with and without `--one-thread`, 20 substeps: at 16,384 particles 17–19 ms a
+/// frame on the pool against 13–15 on one thread; at 65,536, 39.5 against 43–50).
+pub(super) const XPBD_PARALLEL_FROM: usize = 4 * PARALLEL_FROM;
+
 /// Whether a cloth's kernels may use the compute pool (the default).
 static PARALLEL: AtomicBool = AtomicBool::new(true);
 
@@ -68,7 +75,17 @@ pub(super) fn for_each<T: Send>(
     pieces: impl Iterator<Item = T>,
     work: impl Fn(T) + Sync,
 ) {
-    if len < PARALLEL_FROM || !PARALLEL.load(Ordering::Relaxed) {
+    for_each_from(PARALLEL_FROM, len, pieces, work);
+}
+
+/// [`for_each`] for a kernel whose own measurements put its threshold at `from` elements.
+pub(super) fn for_each_from<T: Send>(
+    from: usize,
+    len: usize,
+    pieces: impl Iterator<Item = T>,
+    work: impl Fn(T) + Sync,
+) {
+    if len < from || !PARALLEL.load(Ordering::Relaxed) {
         pieces.for_each(work);
         return;
     }

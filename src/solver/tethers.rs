@@ -20,7 +20,7 @@ use std::collections::BinaryHeap;
 
 use bevy::math::Vec3;
 
-use super::parallel::{self, PIECE};
+use super::parallel::{self, PIECE, XPBD_PARALLEL_FROM};
 use super::{Particles, SpringKind, Springs};
 
 /// At most this many groups of pins get their own tethers; a cloth held by more (a cape
@@ -157,20 +157,25 @@ impl Tethers {
                 .zip(p.velocity.chunks_mut(PIECE))
                 .zip(p.inv_mass.chunks(PIECE))
                 .zip(tethers);
-            parallel::for_each(n, pieces, |(((x, v), inv_mass), (anchor, reach))| {
-                for k in 0..x.len() {
-                    if inv_mass[k] == 0.0 || anchor[k] == u32::MAX {
-                        continue;
+            parallel::for_each_from(
+                XPBD_PARALLEL_FROM,
+                n,
+                pieces,
+                |(((x, v), inv_mass), (anchor, reach))| {
+                    for k in 0..x.len() {
+                        if inv_mass[k] == 0.0 || anchor[k] == u32::MAX {
+                            continue;
+                        }
+                        let d = x[k] - pinned[anchor[k] as usize];
+                        let len2 = d.length_squared();
+                        if len2 > reach[k] * reach[k] {
+                            let correction = d * (reach[k] / len2.sqrt() - 1.0);
+                            x[k] += correction;
+                            v[k] += correction / h;
+                        }
                     }
-                    let d = x[k] - pinned[anchor[k] as usize];
-                    let len2 = d.length_squared();
-                    if len2 > reach[k] * reach[k] {
-                        let correction = d * (reach[k] / len2.sqrt() - 1.0);
-                        x[k] += correction;
-                        v[k] += correction / h;
-                    }
-                }
-            });
+                },
+            );
         }
     }
 }

@@ -18,6 +18,8 @@
 use bevy::math::Vec3;
 
 use super::{Offset, PIECE, Stencil, parallel};
+use crate::solver::parallel::XPBD_PARALLEL_FROM;
+
 use crate::solver::Particles;
 use crate::solver::xpbd::{self, Family};
 
@@ -88,7 +90,7 @@ fn colour<const DAMPED: bool, const LIMITED: bool>(
     if dy == 0 {
         let group = w * (PIECE / w).max(1);
         let pieces = chunks3(x, 0..n, group).enumerate();
-        parallel::for_each(n, pieces, |(k, lanes)| {
+        parallel::for_each_from(XPBD_PARALLEL_FROM, n, pieces, |(k, lanes)| {
             along::<DAMPED, LIMITED>(lanes, k * group / w, shared, class);
         });
         return;
@@ -99,7 +101,7 @@ fn colour<const DAMPED: bool, const LIMITED: bool>(
     }
     let bands = band * (PIECE / (band * w)).max(1);
     let pieces = chunks3(x, first * w..n, bands * w).enumerate();
-    parallel::for_each(n, pieces, |(k, lanes)| {
+    parallel::for_each_from(XPBD_PARALLEL_FROM, n, pieces, |(k, lanes)| {
         let top = first + k * bands;
         let [x0, x1, x2] = lanes;
         let bands = x0
@@ -339,11 +341,16 @@ fn store(x: &[Vec<f32>; 3], p: &mut Particles, h: f32) {
         .chunks_mut(PIECE)
         .zip(p.velocity.chunks_mut(PIECE))
         .zip(lanes);
-    parallel::for_each(n, pieces, |((position, velocity), ((x0, x1), x2))| {
-        for (k, (x, v)) in position.iter_mut().zip(velocity).enumerate() {
-            let projected = Vec3::new(x0[k], x1[k], x2[k]);
-            *v += (projected - *x) / h;
-            *x = projected;
-        }
-    });
+    parallel::for_each_from(
+        XPBD_PARALLEL_FROM,
+        n,
+        pieces,
+        |((position, velocity), ((x0, x1), x2))| {
+            for (k, (x, v)) in position.iter_mut().zip(velocity).enumerate() {
+                let projected = Vec3::new(x0[k], x1[k], x2[k]);
+                *v += (projected - *x) / h;
+                *x = projected;
+            }
+        },
+    );
 }
