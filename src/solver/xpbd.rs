@@ -45,7 +45,7 @@ pub(super) const PROJECTION_ORDER: [SpringKind; 5] = [
 ];
 
 /// The constraints of a cloth's springs, grouped by colour.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Constraints {
     /// Each constraint's spring (index into [`Springs`]), colour after colour.
     spring: Vec<u32>,
@@ -105,16 +105,7 @@ impl Constraints {
     /// grid's are projected on its stencil), only the tethers.
     pub fn new(springs: &Springs, n: usize, general: bool) -> Self {
         if !general {
-            return Self {
-                spring: Vec::new(),
-                a: Vec::new(),
-                b: Vec::new(),
-                rest: Vec::new(),
-                alive: Vec::new(),
-                colours: Vec::new(),
-                predicted: Vec::new(),
-                tethers: Tethers::default(),
-            };
+            return Self::default();
         }
         // Each particle's springs (CSR), to find the colours already taken around a spring.
         let mut start = vec![0u32; n + 1];
