@@ -927,8 +927,9 @@ fn corner_hung_grid_with(width: u32, height: u32, params: &ClothParams) -> Cloth
 #[test]
 fn a_large_cloth_steps_to_the_same_bits_on_one_thread_and_on_the_pool() {
     // 256 × 256 = 65,536 particles: every kernel runs in pieces on the compute pool
-    // (from 16,384), several pieces per thread. Wind, limiter on, top corners pinned.
-    // Mass-spring, and XPBD (its colours' pieces side by side).
+    // (from 16,384; XPBD's grid kernels from 65,536), several pieces per thread. Wind,
+    // limiter on, top corners pinned. Mass-spring, and XPBD (its stencil colours' bands of
+    // rows side by side, its tethers to the two corners in pieces).
     let xpbd = ClothParams {
         model: Model::Xpbd(XpbdParams::default()),
         substeps: Substeps::Fixed(10),
