@@ -248,12 +248,14 @@ fn chunked<const N: usize, const DAMPED: bool, const LIMITED: bool>(
     shared: Shared<'_>,
 ) -> usize {
     let (o, f, dx) = (shared.offset, shared.family, N / 2);
-    let [x0, x1, x2] = lanes.map(|lane| lane.as_chunks_mut::<N>().0);
-    let count = x0.len().min(x1.len()).min(x2.len());
+    let count = lanes.iter().map(|lane| lane.len() / N).min().unwrap_or(0);
+    // Every slice cut to `count` chunks, so the loop has no bounds checks.
+    let [x0, x1, x2] = lanes.map(|lane| &mut lane.as_chunks_mut::<N>().0[..count]);
     let span = first..first + count * N;
     let (rest, _) = o.rest[span.clone()].as_chunks::<N>();
     let (weight, _) = o.weight[span.clone()].as_chunks::<N>();
     let (inv_mass, _) = shared.inv_mass[span.clone()].as_chunks::<N>();
+    let (rest, weight, inv_mass) = (&rest[..count], &weight[..count], &inv_mass[..count]);
     let [p0, p1, p2] = shared.previous.each_ref().map(|lane| {
         if DAMPED {
             lane[span.clone()].as_chunks::<N>().0
@@ -282,10 +284,8 @@ fn chunked<const N: usize, const DAMPED: bool, const LIMITED: bool>(
                 (rest[k][a], weight[k][a]),
                 f,
             );
-            for (lane, i) in [&mut *x0, &mut *x1, &mut *x2].into_iter().zip(0..3) {
-                lane[k][a] += ma[i];
-                lane[k][b] += mb[i];
-            }
+            (x0[k][a], x1[k][a], x2[k][a]) = (xa[0] + ma[0], xa[1] + ma[1], xa[2] + ma[2]);
+            (x0[k][b], x1[k][b], x2[k][b]) = (xb[0] + mb[0], xb[1] + mb[1], xb[2] + mb[2]);
         }
     }
     count * N
