@@ -217,3 +217,53 @@ fn goal_forces_conserve_momentum_on_a_free_cloth() {
         }
     }
 }
+
+#[test]
+fn the_peer_bench_reads_strain_and_sag_from_positions_as_defined() {
+    use bevy_cloth_lab::peers::{Hang, accuracy, rest};
+    // A 5×5 grid hung at rest: no strain, no sag. Scaled by 1.1 about its top row's
+    // first particle: every structural pair 10% long, the bottom row 10% of the height
+    // lower.
+    let start = rest(5, Hang::TopRow);
+    let (strain, sag) = accuracy(&start, &start, 5);
+    assert!(strain.abs() < 1e-6 && sag.abs() < 1e-6, "{strain} {sag}");
+    let scaled: Vec<Vec3> = start.iter().map(|p| *p * 1.1).collect();
+    let (strain, sag) = accuracy(&scaled, &start, 5);
+    assert!((strain - 0.1).abs() < 1e-5, "strain {strain}");
+    assert!((sag - 0.1).abs() < 1e-5, "sag {sag}");
+}
+
+#[test]
+fn the_peer_bench_times_every_solver_and_never_a_failed_run() {
+    use bevy_cloth_lab::peers::{Hang, Peer, measure};
+    // Every solver on a small hanging cloth: timed, its strain within reason.
+    for peer in [
+        Peer::Ours {
+            substeps: 5,
+            tethers: true,
+        },
+        Peer::Rapier {
+            steps: 1,
+            iterations: 4,
+        },
+        Peer::Sticks { sweeps: 20 },
+    ] {
+        let row = measure(8, Hang::TopRow, peer, 12).unwrap();
+        assert!(row.failed.is_none(), "{peer:?}: {:?}", row.failed);
+        let (ms, strain) = (row.ms.unwrap(), row.strain.unwrap());
+        assert!(
+            ms > 0.0 && strain < 0.05,
+            "{peer:?}: {ms} ms, strain {strain}"
+        );
+        let (lo, hi) = row.ms_spread.unwrap();
+        assert!(
+            lo <= ms && ms <= hi,
+            "{peer:?}: median {ms} outside [{lo}, {hi}]"
+        );
+    }
+    // Five sweeps of sticks cannot hold a 32×32 cloth from its corners: past 100% strain,
+    // the run is failed, with no time and no strain to rank it by.
+    let row = measure(32, Hang::Corners, Peer::Sticks { sweeps: 5 }, 60).unwrap();
+    assert!(row.failed.is_some(), "{row:?}");
+    assert!(row.ms.is_none() && row.strain.is_none() && row.ns_per_projection.is_none());
+}
