@@ -12,6 +12,8 @@ use bevy_cloth_lab::peers::PeerRow;
 use bevy_cloth_lab::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
 use bevy_cloth_lab::{BENCH_MODELS, BenchCell, SEED_COUNTS, SEED_MS};
 use plotters::coord::Shift;
+use plotters::coord::cartesian::Cartesian2d;
+use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 
 const FONT: &str = "sans-serif";
@@ -117,6 +119,41 @@ fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .border_style(BLACK)
         .draw()
         .map_err(err)
+}
+
+/// A log-log coordinate system with 1-2-5 ticks (see [`ticks_125`]).
+type LogLog = Cartesian2d<WithKeyPoints<LogCoord<f64>>, WithKeyPoints<LogCoord<f64>>>;
+
+/// A captioned log-log panel over `ranges` with its grid and the axes named `(x, y)`:
+/// the frame of the accuracy and the peers charts.
+fn log_log_panel<'a, DB: DrawingBackend>(
+    panel: &'a DrawingArea<DB, Shift>,
+    caption: String,
+    (xs, ys): (Range<f64>, Range<f64>),
+    (x, y): (&str, &str),
+) -> Result<ChartContext<'a, DB, LogLog>> {
+    let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
+    let mut chart = ChartBuilder::on(panel)
+        .caption(caption, (FONT, 20))
+        .margin(12)
+        .x_label_area_size(45)
+        .y_label_area_size(65)
+        .build_cartesian_2d(
+            xs.log_scale().with_key_points(x_ticks),
+            ys.log_scale().with_key_points(y_ticks),
+        )
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(x)
+        .y_desc(y)
+        .x_label_formatter(&tick_label)
+        .y_label_formatter(&tick_label)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 16))
+        .draw()
+        .map_err(err)?;
+    Ok(chart)
 }
 
 fn err<E: std::fmt::Display>(e: E) -> String {
@@ -292,27 +329,8 @@ impl Chart for Accuracy<'_> {
             } else {
                 format!("{scene} (reference not converged: no frontier)")
             };
-            let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
-            let mut chart = ChartBuilder::on(panel)
-                .caption(caption, (FONT, 20))
-                .margin(12)
-                .x_label_area_size(45)
-                .y_label_area_size(65)
-                .build_cartesian_2d(
-                    xs.log_scale().with_key_points(x_ticks),
-                    ys.log_scale().with_key_points(y_ticks),
-                )
-                .map_err(err)?;
-            chart
-                .configure_mesh()
-                .x_desc("ms per simulated second")
-                .y_desc("RMS error / diagonal")
-                .x_label_formatter(&tick_label)
-                .y_label_formatter(&tick_label)
-                .label_style((FONT, 14))
-                .axis_desc_style((FONT, 16))
-                .draw()
-                .map_err(err)?;
+            let axes = ("ms per simulated second", "RMS error / diagonal");
+            let mut chart = log_log_panel(panel, caption, (xs, ys), axes)?;
             // The spread of each configuration's timed runs, fastest to slowest.
             chart
                 .draw_series(ok.iter().filter_map(|(r, _, e)| {
@@ -578,30 +596,9 @@ impl Chart for Peers<'_> {
                 .collect();
             let xs = log_range(ok.iter().map(|(_, ms, _)| *ms));
             let ys = log_range(ok.iter().map(|(_, _, s)| *s).chain([1e-3, 1e-2]));
-            let (x_ticks, y_ticks) = (ticks_125(&xs), ticks_125(&ys));
-            let mut chart = ChartBuilder::on(panel)
-                .caption(
-                    format!("{} particles ({side}×{side})", side * side),
-                    (FONT, 20),
-                )
-                .margin(12)
-                .x_label_area_size(45)
-                .y_label_area_size(65)
-                .build_cartesian_2d(
-                    xs.clone().log_scale().with_key_points(x_ticks),
-                    ys.log_scale().with_key_points(y_ticks),
-                )
-                .map_err(err)?;
-            chart
-                .configure_mesh()
-                .x_desc("ms per frame (median)")
-                .y_desc("largest structural strain")
-                .x_label_formatter(&tick_label)
-                .y_label_formatter(&tick_label)
-                .label_style((FONT, 14))
-                .axis_desc_style((FONT, 16))
-                .draw()
-                .map_err(err)?;
+            let caption = format!("{} particles ({side}×{side})", side * side);
+            let axes = ("ms per frame (median)", "largest structural strain");
+            let mut chart = log_log_panel(panel, caption, (xs.clone(), ys), axes)?;
             for strain in [1e-2, 1e-3] {
                 chart
                     .draw_series(DashedLineSeries::new(
