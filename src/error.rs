@@ -95,6 +95,18 @@ pub enum ClothError {
         /// The names that exist.
         known: &'static str,
     },
+    /// A step would have left a position or velocity non-finite (an absurd parameter,
+    /// force or edit): the cloth kept the state it had before that step, and is paused
+    /// until it is reset or its parameters change.
+    #[error(
+        "the step at t = {time} s ({substeps} substeps) went non-finite; the cloth keeps its last good state until it is reset or its parameters change"
+    )]
+    NonFinite {
+        /// The simulated time the failed step started at, s.
+        time: f32,
+        /// Its substeps.
+        substeps: u32,
+    },
     /// A measurement asked of a case it cannot measure (the lab's instruments).
     #[error("cannot measure: {reason}")]
     NotMeasurable {

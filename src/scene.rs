@@ -506,7 +506,7 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         | Pattern(_)
         | Garment { .. } => "shape",
         UnknownModel { .. } => "model",
-        NotMeasurable { .. } => "cloths",
+        NotMeasurable { .. } | NonFinite { .. } => "cloths",
     }
 }
 

@@ -854,3 +854,73 @@ fn particles_attached_at_local_offsets_go_there_and_follow() {
         }
     }
 }
+
+/// A cloth whose step goes non-finite (parameters no explicit step can hold) is paused
+/// with `ClothInvalid` saying so, keeps finite positions in its mesh, and runs again
+/// after a reset; with valid parameters again and a reset it stays running.
+#[test]
+fn a_cloth_that_goes_non_finite_is_paused_with_the_reason_and_recovers() {
+    let mut app = app();
+    let (e, handle) = spawn_small_cloth(&mut app);
+    let absurd = ClothParams {
+        model: Model::MassSpring,
+        springs: SpringParams::from_structural(1e5),
+        node_mass: 1e-3,
+        substeps: Substeps::Fixed(1),
+        strain_limit: None,
+        ..quiet_params()
+    };
+    app.world_mut().get_mut::<Cloth>(e).unwrap().params = absurd;
+    let mut invalid = None;
+    for _ in 0..300 {
+        app.update();
+        if let Some(reason) = app.world().get::<ClothInvalid>(e) {
+            invalid = Some(reason.0.clone());
+            break;
+        }
+    }
+    let reason = invalid.expect("the absurd parameters never went non-finite");
+    assert!(matches!(reason, ClothError::NonFinite { .. }), "{reason}");
+    let t = sim_time(&app, e);
+    app.update();
+    assert_eq!(sim_time(&app, e), t, "a paused cloth does not step");
+    let sim = app.world().get::<ClothSimulation>(e).unwrap();
+    assert!(sim.solver.is_finite());
+    assert!(
+        mesh_positions(&app, &handle)
+            .iter()
+            .flatten()
+            .all(|v| v.is_finite())
+    );
+
+    // A reset lifts the pause (the parameters are still absurd: it runs, then fails again).
+    app.world_mut()
+        .get_mut::<ClothSimulation>(e)
+        .unwrap()
+        .reset();
+    app.update();
+    assert!(sim_time(&app, e) > 0.0, "stepping again after the reset");
+    for _ in 0..300 {
+        app.update();
+        if app.world().get::<ClothInvalid>(e).is_some() {
+            break;
+        }
+    }
+    assert!(app.world().get::<ClothInvalid>(e).is_some(), "fails again");
+    app.world_mut().get_mut::<Cloth>(e).unwrap().params = quiet_params();
+    app.world_mut()
+        .get_mut::<ClothSimulation>(e)
+        .unwrap()
+        .reset();
+    for _ in 0..20 {
+        app.update();
+    }
+    assert!(app.world().get::<ClothInvalid>(e).is_none());
+    assert!(
+        app.world()
+            .get::<ClothSimulation>(e)
+            .unwrap()
+            .solver
+            .is_finite()
+    );
+}

@@ -320,7 +320,8 @@ fn tears_past_its_ratio_and_not_below(model: Model) {
         for _ in 0..n {
             pulled.substep(&env);
         }
-        torn.extend_from_slice(pulled.end_step());
+        pulled.end_step();
+        torn.extend_from_slice(pulled.last_torn());
     }
     assert!(!torn.is_empty());
     assert_eq!(torn.len(), pulled.torn_count());
@@ -1057,4 +1058,142 @@ fn an_attached_particle_reaches_its_target_every_step_and_falls_when_let_go() {
         assert!(cloth.attach(99, Vec3::ZERO).is_err());
         assert!(cloth.attach(1, Vec3::splat(f32::NAN)).is_err());
     }
+}
+
+/// Parameters an explicit step cannot hold: springs of 1e5 N/m on 1 g particles at one
+/// substep of 16 ms (ω h ≈ 160, a hundred times past the bound of 2).
+fn absurd(params: &ClothParams) -> ClothParams {
+    ClothParams {
+        model: Model::MassSpring,
+        springs: SpringParams::from_structural(1e5),
+        node_mass: 1e-3,
+        substeps: Substeps::Fixed(1),
+        strain_limit: None,
+        tear_ratio: None,
+        ..*params
+    }
+}
+
+/// A step that would leave the state non-finite says so in its report and keeps the
+/// positions of the last good step, at rest; the cloth steps normally again after a
+/// reset. Driven there twice: by an edit of its parameters that no explicit step can
+/// hold, and by a non-finite force added between the stages.
+#[test]
+fn a_step_that_goes_non_finite_reports_it_keeps_the_last_good_state_and_recovers_on_reset() {
+    let sane = ClothParams::default();
+    let mut cloth = ClothShape::Grid {
+        width: 8,
+        height: 8,
+        spacing: 0.05,
+    }
+    .build_solver(&Pins::TopRow, &sane, Affine3A::IDENTITY)
+    .unwrap();
+    let env = Environment::default();
+    for _ in 0..10 {
+        assert!(cloth.step(DT, &env).finite);
+    }
+    cloth.set_params(&absurd(&sane)).unwrap();
+    let mut failed = None;
+    for step in 0..200 {
+        let before = (
+            cloth.positions().to_vec(),
+            cloth.particles().velocity.clone(),
+        );
+        let time = cloth.time();
+        let report = cloth.step(DT, &env);
+        if !report.finite {
+            assert_eq!(cloth.positions(), &before.0[..], "positions kept");
+            assert!(cloth.particles().velocity.iter().all(|v| *v == Vec3::ZERO));
+            assert!(before.1.iter().all(|v| v.is_finite()));
+            assert_eq!(cloth.time(), time, "the clock kept");
+            failed = Some(step);
+            break;
+        }
+    }
+    let step = failed.expect("the absurd parameters never went non-finite");
+    assert!(step > 0, "it blew up from a finite state");
+    assert!(cloth.is_finite());
+    // Every later step fails the same way and keeps the same state.
+    let kept = cloth.positions().to_vec();
+    assert!(!cloth.step(DT, &env).finite);
+    assert_eq!(cloth.positions(), &kept[..]);
+
+    cloth.reset();
+    assert!(cloth.last_report().finite);
+    cloth.set_params(&sane).unwrap();
+    for _ in 0..10 {
+        assert!(cloth.step(DT, &env).finite);
+    }
+    let rest = cloth.positions().to_vec();
+
+    // A non-finite force added by hand between the stages.
+    let n = cloth.begin_step(DT);
+    for k in 0..n {
+        cloth.accumulate_forces(&env);
+        if k == 0 {
+            cloth.add_force(20, Vec3::NAN);
+        }
+        cloth.integrate();
+        cloth.fit_targets();
+        cloth.constrain();
+    }
+    let report = cloth.end_step();
+    assert!(!report.finite && report.taken == n);
+    assert_eq!(cloth.positions(), &rest[..]);
+    cloth.reset();
+    assert!(cloth.step(DT, &env).finite && cloth.is_finite());
+}
+
+/// The report says what the step did: its substeps, every stage timed, and (XPBD at
+/// automatic substeps) the largest structural strain, which is the solver's own measure
+/// of the free springs.
+#[test]
+fn the_step_report_counts_substeps_times_stages_and_measures_xpbd_strain() {
+    let params = ClothParams {
+        model: Model::Xpbd(XpbdParams::default()),
+        springs: SpringParams {
+            structural: SpringFamily::new(f32::INFINITY),
+            ..SpringParams::default()
+        },
+        substeps: Substeps::Auto { max: 64 },
+        ..ClothParams::default()
+    };
+    let mut cloth = ClothShape::Grid {
+        width: 12,
+        height: 12,
+        spacing: 0.05,
+    }
+    .build_solver(&Pins::TopCorners, &params, Affine3A::IDENTITY)
+    .unwrap();
+    let env = Environment::default();
+    let mut report = cloth.step(DT, &env);
+    for _ in 0..30 {
+        report = cloth.step(DT, &env);
+    }
+    assert_eq!(report.substeps, cloth.substeps());
+    assert_eq!(report.taken, report.substeps);
+    assert!(report.finite && !report.under_resolved);
+    let t = report.time;
+    assert!(t.forces > t.fit_targets && t.constraints > std::time::Duration::ZERO);
+    assert_eq!(
+        t.total(),
+        t.begin + t.forces + t.integrate + t.fit_targets + t.constraints + t.contact + t.end
+    );
+    let strain = report
+        .max_strain
+        .expect("XPBD's closed loop measures the strain");
+    assert!(
+        strain > 0.0 && strain <= cloth.strain().max + 1e-6,
+        "{strain}"
+    );
+    assert!(
+        strain < 0.02,
+        "inextensible at its automatic substeps: {strain}"
+    );
+    // Mass-spring at fixed substeps does not measure it.
+    cloth.set_params(&ClothParams::default()).unwrap();
+    assert_eq!(cloth.step(DT, &env).max_strain, None);
+    // A step of no time does nothing and reports nothing wrong.
+    let none = cloth.step(0.0, &env);
+    assert_eq!((none.substeps, none.taken, none.finite), (0, 0, true));
 }

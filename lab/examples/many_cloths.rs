@@ -64,7 +64,11 @@ fn loop_ms() -> f64 {
         })
         .collect();
     let env = Environment::default();
-    let mut step = || cloths.iter_mut().for_each(|c| c.step(0.016, &env));
+    let mut step = || {
+        for c in cloths.iter_mut() {
+            c.step(0.016, &env);
+        }
+    };
     for _ in 0..20 {
         step();
     }

@@ -46,7 +46,9 @@ pub enum ClothSystems {
     Prepare,
     /// Run the [`ClothSubstep`] schedule as many times as the cloths need.
     Substeps,
-    /// Tear over-stretched springs and report them; record step time.
+    /// End each step ([`ClothSolver::end_step`](crate::solver::ClothSolver::end_step)):
+    /// tear over-stretched springs and report them, record step time; a cloth whose
+    /// step went non-finite keeps its last good state and gets [`ClothInvalid`].
     Finish,
     /// (In `PostUpdate`) write positions and normals into the meshes.
     WriteMesh,
@@ -57,13 +59,22 @@ pub enum ClothSystems {
 /// so they are a type of their own).
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ClothSubstepSystems {
-    /// Forces from the old state: gravity, wind, drag, springs.
+    /// [`ClothSolver::accumulate_forces`](crate::solver::ClothSolver::accumulate_forces):
+    /// every force from the old state (gravity, wind, drag; springs for mass-spring;
+    /// the goal pull for shape matching; for the patch model, the part lattice's forces
+    /// and the particles' pull toward their targets). Add forces after this set.
     AccumulateForces,
-    /// Advance positions by one substep.
+    /// [`ClothSolver::integrate`](crate::solver::ClothSolver::integrate): the prediction
+    /// (Verlet or semi-implicit Euler; XPBD always the latter; the patch model's part
+    /// lattice takes its whole substep here first).
     Integrate,
-    /// Move particles toward model targets (shape matching, patches).
+    /// [`ClothSolver::fit_targets`](crate::solver::ClothSolver::fit_targets): shape
+    /// matching's velocity update, the patch model's targets (nothing for mass-spring
+    /// and XPBD).
     FitTargets,
-    /// Pins and strain limiting.
+    /// [`ClothSolver::constrain`](crate::solver::ClothSolver::constrain): pins and grab
+    /// driven, the model's constraints (Provot's limit; XPBD's projection and tethers),
+    /// contact with the colliders; it ends the substep (the cloth's clock advances).
     Constrain,
 }
 
@@ -214,6 +225,7 @@ impl Plugin for ClothPlugin {
                     attach_cloths,
                     place_colliders,
                     wake_cloths,
+                    recover_cloths,
                     begin_steps,
                 )
                     .chain()
@@ -778,6 +790,20 @@ fn wake_cloths(
     }
 }
 
+/// A cloth paused because a step went non-finite runs again once it has been reset
+/// (its last report is no longer a failure); a valid change of its parameters lifts
+/// the pause too (`apply_params`).
+fn recover_cloths(
+    mut commands: Commands,
+    cloths: Query<(Entity, &ClothSimulation, &ClothInvalid)>,
+) {
+    for (entity, sim, invalid) in &cloths {
+        if matches!(invalid.0, ClothError::NonFinite { .. }) && sim.solver.last_report().finite {
+            commands.entity(entity).remove::<ClothInvalid>();
+        }
+    }
+}
+
 #[allow(clippy::type_complexity)]
 fn begin_steps(
     mut commands: Commands,
@@ -872,6 +898,7 @@ fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
 
 #[allow(clippy::type_complexity)]
 fn finish_steps(
+    mut commands: Commands,
     mut torn: MessageWriter<ClothTorn>,
     env: Res<ClothEnvironment>,
     time: Res<Time>,
@@ -892,7 +919,17 @@ fn finish_steps(
         }
         let start = Instant::now();
         let sim = &mut *sim;
-        sim.solver.end_step();
+        let report = sim.solver.end_step();
+        if !report.finite {
+            let error = ClothError::NonFinite {
+                time: sim.solver.time(),
+                substeps: report.substeps,
+            };
+            error!("cloth {entity}: {error}");
+            commands.entity(entity).insert(ClothInvalid(error));
+            sim.mesh_dirty = true;
+            continue;
+        }
         for &spring in sim.solver.last_torn() {
             let s = spring as usize;
             let particles = [sim.solver.springs().a[s], sim.solver.springs().b[s]];

@@ -9,8 +9,6 @@ use std::sync::Arc;
 
 use bevy::math::{Quat, Vec3};
 
-use super::ClothSolver;
-
 /// The solid a collider fills, in world space.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ColliderShape {
@@ -158,7 +156,7 @@ impl Motion {
     /// being its rotation over them (`Quat::from_scaled_axis(angular·h)`): the exact rigid
     /// motion, so a point carried round a turntable stays on its circle.
     #[inline]
-    fn carry(&self, turn: Quat, h: f32, x: Vec3) -> Vec3 {
+    pub(super) fn carry(&self, turn: Quat, h: f32, x: Vec3) -> Vec3 {
         let start = self.pivot - self.linear * h;
         self.pivot + turn * (x - start) - x
     }
@@ -170,7 +168,7 @@ impl Motion {
 }
 
 /// An axis-aligned box a collider's reach lies in: a particle outside it is farther than
-/// the thickness from the surface (the broad phase of [`ClothSolver::collide`]).
+/// the thickness from the surface (the broad phase of the contact stage, `contact.rs`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Bounds {
     min: Vec3,
@@ -208,7 +206,7 @@ impl Bounds {
 
     /// Whether `x` lies in the box.
     #[inline]
-    fn contains(&self, x: Vec3) -> bool {
+    pub(super) fn contains(&self, x: Vec3) -> bool {
         x.cmpge(self.min).all() && x.cmple(self.max).all()
     }
 }
@@ -497,49 +495,10 @@ impl ConvexHull {
             .iter()
             .flat_map(|a| vertices.iter().map(move |b| a.distance(*b)))
             .fold(0.0, f32::max);
-        let mut out = Vec::with_capacity(faces.len());
-        for (k, (normal, mut corners)) in faces.into_iter().enumerate() {
-            let Some(normal) = normal.try_normalize() else {
-                return Err(format!("face {k} has no normal"));
-            };
-            if corners.len() < 3 || corners.iter().any(|&i| i as usize >= vertices.len()) {
-                return Err(format!(
-                    "face {k} needs 3 or more of the {} corners",
-                    vertices.len()
-                ));
-            }
-            // Order the corners round the normal, by angle about their centroid.
-            let mid =
-                corners.iter().map(|&i| vertices[i as usize]).sum::<Vec3>() / corners.len() as f32;
-            let u = normal.any_orthonormal_vector();
-            let w = normal.cross(u);
-            let angle = |i: u32| {
-                let d = vertices[i as usize] - mid;
-                d.dot(w).atan2(d.dot(u))
-            };
-            corners.sort_by(|&a, &b| angle(a).total_cmp(&angle(b)));
-            let offset = corners
-                .iter()
-                .map(|&i| normal.dot(vertices[i as usize]))
-                .fold(f32::MIN, f32::max);
-            if corners
-                .iter()
-                .any(|&i| offset - normal.dot(vertices[i as usize]) > 1e-4 * size)
-            {
-                return Err(format!("face {k} is not flat"));
-            }
-            if let Some(v) = vertices
-                .iter()
-                .find(|v| normal.dot(**v) - offset > 1e-4 * size)
-            {
-                return Err(format!("corner {v} is in front of face {k}: not convex"));
-            }
-            out.push(HullFace {
-                normal,
-                offset,
-                corners,
-            });
-        }
+        let faces = faces.into_iter().enumerate();
+        let out = faces
+            .map(|(k, (normal, corners))| hull_face(&vertices, k, normal, corners, size))
+            .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
             vertices,
             faces: out,
@@ -605,6 +564,58 @@ impl ConvexHull {
     }
 }
 
+/// Face `k` of a hull of `vertices` (of diameter `size`): its unit normal, its plane's
+/// offset and its corners ordered round the normal; refused when it has no normal,
+/// fewer than 3 corners (or one past the corners), is not flat, or has a corner in
+/// front of it (see [`ConvexHull::new`]).
+fn hull_face(
+    vertices: &[Vec3],
+    k: usize,
+    normal: Vec3,
+    mut corners: Vec<u32>,
+    size: f32,
+) -> Result<HullFace, String> {
+    let Some(normal) = normal.try_normalize() else {
+        return Err(format!("face {k} has no normal"));
+    };
+    if corners.len() < 3 || corners.iter().any(|&i| i as usize >= vertices.len()) {
+        return Err(format!(
+            "face {k} needs 3 or more of the {} corners",
+            vertices.len()
+        ));
+    }
+    // Order the corners round the normal, by angle about their centroid.
+    let mid = corners.iter().map(|&i| vertices[i as usize]).sum::<Vec3>() / corners.len() as f32;
+    let u = normal.any_orthonormal_vector();
+    let w = normal.cross(u);
+    let angle = |i: u32| {
+        let d = vertices[i as usize] - mid;
+        d.dot(w).atan2(d.dot(u))
+    };
+    corners.sort_by(|&a, &b| angle(a).total_cmp(&angle(b)));
+    let offset = corners
+        .iter()
+        .map(|&i| normal.dot(vertices[i as usize]))
+        .fold(f32::MIN, f32::max);
+    if corners
+        .iter()
+        .any(|&i| offset - normal.dot(vertices[i as usize]) > 1e-4 * size)
+    {
+        return Err(format!("face {k} is not flat"));
+    }
+    if let Some(v) = vertices
+        .iter()
+        .find(|v| normal.dot(**v) - offset > 1e-4 * size)
+    {
+        return Err(format!("corner {v} is in front of face {k}: not convex"));
+    }
+    Ok(HullFace {
+        normal,
+        offset,
+        corners,
+    })
+}
+
 /// Signed distance from a cylinder's surface and the outward normal at the nearest surface
 /// point, for `offset` from its centre: the 2D box distance in (distance from the axis,
 /// height along it).
@@ -629,90 +640,144 @@ fn cylinder_distance(offset: Vec3, axis: Vec3, half_height: f32, radius: f32) ->
     }
 }
 
-impl ClothSolver {
-    /// What the cloth gave each collider (in [`ClothSolver::colliders`]' order) over the
-    /// last step: the reaction a physics engine applies to a dynamic body, so a cloth
-    /// pushed by a ball pushes back.
-    pub fn collider_impulses(&self) -> &[ColliderImpulse] {
-        &self.collider_impulses
+#[cfg(test)]
+mod tests {
+    use std::f32::consts::TAU;
+
+    use super::*;
+    use crate::solver::unit_hash;
+
+    /// `n × n` points of the parallelogram `corner + s·u + t·v`, `s, t ∈ [0, 1]`.
+    fn patch(corner: Vec3, u: Vec3, v: Vec3, n: usize, out: &mut Vec<Vec3>) {
+        for i in 0..=n {
+            for j in 0..=n {
+                out.push(corner + u * (i as f32 / n as f32) + v * (j as f32 / n as f32));
+            }
+        }
     }
 
-    /// Pushes every free particle out of every collider to `thickness` outside its surface,
-    /// then removes tangential motion of this substep up to `friction × push` (Coulomb).
-    /// Velocities follow the corrected positions: `v = (x − x_prev)/h`.
-    pub(super) fn collide(&mut self) {
-        if self.colliders.is_empty() {
-            return;
+    /// Points on the circle of `radius` about `center` across unit `axis`.
+    fn ring(center: Vec3, axis: Vec3, radius: f32, n: usize, out: &mut Vec<Vec3>) {
+        let (u, v) = axis.any_orthonormal_pair();
+        for k in 0..n {
+            let a = TAU * k as f32 / n as f32;
+            out.push(center + (u * a.cos() + v * a.sin()) * radius);
         }
-        let h = self.h;
-        // Moving colliders are where they were at this substep's end: swept back by the
-        // time left in the step (the step's colliders are where it ends).
-        if self.colliders_move {
-            let tau = self.substeps.saturating_sub(self.substep_index) as f32 * h;
-            self.colliders_now.clear();
-            self.colliders_now.extend(self.colliders.iter().map(|c| {
-                if c.motion.is_still() {
-                    c.clone()
-                } else {
-                    c.swept_back(tau)
-                }
-            }));
-            self.bounds_now.clear();
-            self.bounds_now
-                .extend(self.colliders_now.iter().map(Collider::bounds));
-            self.turns_now.clear();
-            self.turns_now.extend(
-                self.colliders_now
-                    .iter()
-                    .map(|c| Quat::from_scaled_axis(c.motion.angular * h)),
-            );
+    }
+
+    /// A shape, dense samples of its surface, and a membership test written apart from
+    /// the distance code.
+    type Case = (ColliderShape, Vec<Vec3>, Box<dyn Fn(Vec3) -> bool>);
+
+    const N: usize = 80;
+
+    fn box_case(c: Vec3, turn: Quat, half: Vec3) -> Case {
+        let mut points = Vec::new();
+        let e = [
+            turn * Vec3::X * half.x,
+            turn * Vec3::Y * half.y,
+            turn * Vec3::Z * half.z,
+        ];
+        for k in 0..3 {
+            let (u, v) = (e[(k + 1) % 3], e[(k + 2) % 3]);
+            for side in [-1.0, 1.0] {
+                patch(c + e[k] * side - u - v, u * 2.0, v * 2.0, N, &mut points);
+            }
         }
-        let (colliders, bounds) = if self.colliders_move {
-            (&self.colliders_now, &self.bounds_now)
-        } else {
-            (&self.colliders, &self.collider_bounds)
+        let inside = move |x: Vec3| (turn.inverse() * (x - c)).abs().cmple(half).all();
+        (
+            ColliderShape::cuboid(c, turn, half),
+            points,
+            Box::new(inside),
+        )
+    }
+
+    fn cylinder_case(center: Vec3, axis: Vec3, half_height: f32, radius: f32) -> Case {
+        let mut points = Vec::new();
+        for k in 0..=N {
+            let t = -half_height + 2.0 * half_height * k as f32 / N as f32;
+            ring(center + axis * t, axis, radius, 4 * N, &mut points);
+            let r = radius * k as f32 / N as f32;
+            ring(center + axis * half_height, axis, r, 4 * N, &mut points);
+            ring(center - axis * half_height, axis, r, 4 * N, &mut points);
+        }
+        let inside = move |x: Vec3| {
+            let along = (x - center).dot(axis);
+            along.abs() <= half_height && (x - center - axis * along).length() <= radius
         };
-        let turns = &self.turns_now;
-        let impulses = &mut self.collider_impulses;
-        let p = &mut self.particles;
-        for i in 0..p.position.len() {
-            if p.inv_mass[i] == 0.0 {
-                continue;
+        let shape = ColliderShape::Cylinder {
+            center,
+            axis,
+            half_height,
+            radius,
+        };
+        (shape, points, Box::new(inside))
+    }
+
+    fn capsule_case(a: Vec3, b: Vec3, radius: f32) -> Case {
+        let mut points = Vec::new();
+        let along = (b - a).normalize();
+        for k in 0..=N {
+            ring(
+                a.lerp(b, k as f32 / N as f32),
+                along,
+                radius,
+                4 * N,
+                &mut points,
+            );
+            // The hemispheres facing away from the axis.
+            let polar = std::f32::consts::FRAC_PI_2 * k as f32 / N as f32;
+            for (end, out) in [(a, -along), (b, along)] {
+                let centre = end + out * radius * polar.cos();
+                ring(centre, along, radius * polar.sin(), 4 * N, &mut points);
             }
-            let mut x = p.position[i];
-            let mut touched = false;
-            for (k, (c, bounds)) in colliders.iter().zip(bounds).enumerate() {
-                if !bounds.contains(x) {
-                    continue; // farther than the thickness: the distance would say so
-                }
-                let Some((depth, n)) = c.penetration(x) else {
-                    continue;
-                };
-                let before = x;
-                x += n * depth;
-                // Friction acts on the motion relative to the surface under the particle:
-                // a particle that sticks moves with the body's point where it was.
-                let mut moved = x - p.previous[i];
-                if !c.motion.is_still() {
-                    moved -= c.motion.carry(turns[k], h, p.previous[i]);
-                }
-                let tangential = moved - n * moved.dot(n);
-                let slide = tangential.length();
-                let grip = c.friction * depth;
-                x -= if slide <= grip {
-                    tangential
-                } else {
-                    tangential * (grip / slide)
-                };
-                touched = true;
-                // The reaction: the particle's momentum change, the other way.
-                let push = (x - before) / (p.inv_mass[i] * h);
-                impulses[k].linear -= push;
-                impulses[k].angular -= x.cross(push);
-            }
-            if touched {
-                p.position[i] = x;
-                p.velocity[i] = (x - p.previous[i]) / h;
+        }
+        let inside = move |x: Vec3| {
+            let t = ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            x.distance(a.lerp(b, t)) <= radius
+        };
+        (
+            ColliderShape::Capsule { a, b, radius },
+            points,
+            Box::new(inside),
+        )
+    }
+
+    /// Each shape's signed distance against brute force: the distance to the nearest of
+    /// dense samples of its surface (never less than the true distance, at most the
+    /// sampling's spacing more), signed by the membership test. 300 points in and around
+    /// each shape.
+    #[test]
+    fn distances_match_brute_force_sampling_of_the_surface() {
+        let turn = Quat::from_euler(bevy::math::EulerRot::XYZ, 0.3, -0.5, 0.8);
+        let c = Vec3::new(0.2, 1.0, -0.3);
+        let cases = [
+            box_case(c, turn, Vec3::new(0.4, 0.25, 0.3)),
+            cylinder_case(c, turn * Vec3::Y, 0.3, 0.25),
+            capsule_case(Vec3::new(-0.3, 0.9, 0.1), Vec3::new(0.4, 1.2, -0.2), 0.2),
+        ];
+        for (shape, surface, inside) in cases {
+            let collider = Collider {
+                shape,
+                thickness: 0.0,
+                friction: 0.0,
+                motion: Motion::NONE,
+            };
+            for i in 0..300 {
+                let q = Vec3::new(unit_hash(i, 0), unit_hash(i, 1), unit_hash(i, 2));
+                let x = c + q * 0.7;
+                let (d, _) = collider.distance(x);
+                let brute = surface
+                    .iter()
+                    .map(|s| s.distance(x))
+                    .fold(f32::MAX, f32::min);
+                let sign = if inside(x) { -1.0 } else { 1.0 };
+                assert!(
+                    brute >= d.abs() - 1e-5 && brute - d.abs() < 0.012 && d * sign >= -1e-5,
+                    "{:?} at {x}: {d} against {} by sampling",
+                    collider.shape,
+                    sign * brute
+                );
             }
         }
     }

@@ -1,75 +1,56 @@
-//! Phase 1 of a substep: every force from the old state.
+//! Stage 1 of a substep, the forces the models share: gravity, wind and drag on every
+//! particle, and Hooke springs (seed 002 eq. 1.4) with damping along them.
 
-use super::parallel::{self, PIECE};
-use super::{ClothSolver, Particles, SpringKind, Springs, pull_scale};
-use crate::params::{Environment, GoalUpdate, Model, PatchParams, ShapeMatchingParams};
+use bevy::math::Vec3;
+
+use super::parallel;
+use super::state::ParticlePiece;
+use super::{ClothSolver, Particles, SpringKind, Springs};
+use crate::params::Environment;
 
 impl ClothSolver {
-    /// Clears and accumulates the forces on every free particle: gravity (seed 002
-    /// eq. 1.6), wind, linear drag `−c v` (seed 000 eq. 31) and the springs. Reads only the
-    /// old state, so the result does not depend on particle order (seed 000 §3.2). Just
-    /// after a model switch, the force that keeps the switch smooth (`switch.rs`).
-    pub fn accumulate_forces(&mut self, env: &Environment) {
-        self.model_forces(env);
-        self.add_switch_force(env);
-    }
-
-    /// [`ClothSolver::accumulate_forces`] of the model alone.
-    fn model_forces(&mut self, env: &Environment) {
-        if let Model::Patches(patch) = self.params.model {
-            // External forces act on the part centres (one-way coupling, see patches.rs).
-            self.pull_forces(env, &patch);
-            return;
-        }
-        // While its seams are being sewn, a garment is held as a tailor holds it: gravity
-        // and wind act once the seams are closed (otherwise the pieces would fall past the
-        // body in the time it takes to sew them).
+    /// Sets every particle's force to gravity (seed 002 eq. 1.6), wind and linear drag
+    /// `−c v` (seed 000 eq. 31). While its seams are being sewn, a garment is held as a
+    /// tailor holds it: gravity and wind act once the seams are closed (otherwise the
+    /// pieces would fall past the body in the time it takes to sew them).
+    pub(super) fn external_forces(&mut self, env: &Environment) {
         let held = self.sewing();
         let g = if held {
-            bevy::math::Vec3::ZERO
+            Vec3::ZERO
         } else {
             env.effective_gravity()
         };
         let drag = self.params.drag;
-        let has_wind =
-            !held && env.wind.strength > 0.0 && env.wind.direction != bevy::math::Vec3::ZERO;
-        let wind = env.wind.at_time(self.time);
-        let p = &mut self.particles;
-        let pieces = p.force.chunks_mut(PIECE).zip(
-            p.mass
-                .chunks(PIECE)
-                .zip(p.lump.chunks(PIECE))
-                .zip(p.velocity.chunks(PIECE).zip(p.position.chunks(PIECE))),
-        );
-        parallel::for_each(
-            p.position.len(),
-            pieces,
-            |(force, ((mass, lump), (v, x)))| {
-                let particles = force
-                    .iter_mut()
-                    .zip(mass.iter().zip(lump).zip(v.iter().zip(x)));
-                for (f, ((&mass, &lump), (&v, &x))) in particles {
-                    *f = mass * g - drag * lump * v;
-                    if has_wind {
-                        *f += wind.force_at(x) * lump;
-                    }
+        let has_wind = !held && env.wind.strength > 0.0 && env.wind.direction != Vec3::ZERO;
+        let wind = env.wind.at_time(self.clock.time);
+        let n = self.particles.len();
+        let kernel = |ParticlePiece {
+                          force,
+                          mass,
+                          lump,
+                          position,
+                          velocity,
+                          ..
+                      }| {
+            let n = force.len();
+            let (f, mass, lump) = (&mut force[..n], &mass[..n], &lump[..n]);
+            let (x, v) = (&position[..n], &velocity[..n]);
+            for i in 0..n {
+                f[i] = mass[i] * g - drag * lump[i] * v[i];
+                if has_wind {
+                    f[i] += wind.force_at(x[i]) * lump[i];
                 }
-            },
-        );
-        match self.params.model {
-            Model::ShapeMatching(sm) => {
-                self.goal_forces(&sm);
-                return;
             }
-            // XPBD's springs are constraints, projected after the prediction (`xpbd.rs`).
-            Model::Xpbd(_) => return,
-            Model::MassSpring | Model::Patches(_) => {}
-        }
+        };
+        parallel::for_each(n, self.particles.pieces(), kernel);
+    }
 
+    /// Adds every acting spring's force (on a grid, by its stencil, `lattice.rs`).
+    pub(super) fn spring_forces(&mut self) {
         let damping = self.params.springs.damping;
-        if self.stencil.is_some() {
+        if self.fabric.stencil.is_some() {
             let k = SpringKind::ALL.map(|kind| self.stiffness(kind));
-            if let Some(stencil) = &mut self.stencil {
+            if let Some(stencil) = &mut self.fabric.stencil {
                 stencil.spring_forces(&mut self.particles, |kind| k[kind as usize], damping);
             }
             return;
@@ -79,11 +60,11 @@ impl ClothSolver {
             if k == 0.0 {
                 continue;
             }
-            let range = self.springs.ranges[kind as usize].clone();
+            let range = self.fabric.springs.ranges[kind as usize].clone();
             // A particle cloth's springs all take their family's constant; only the patch
             // model's part lattice scales them one by one. Two instances of one loop, so
             // the common case reads no per-spring factor.
-            let (s, p) = (&self.springs, &mut self.particles);
+            let (s, p) = (&self.fabric.springs, &mut self.particles);
             match s.stiffness_scale.as_deref() {
                 None => spring_forces(s, p, range, k, damping, |_| 1.0),
                 Some(scale) => spring_forces(s, p, range, k, damping, |i| scale[i]),
@@ -91,75 +72,10 @@ impl ClothSolver {
         }
     }
 
-    /// Shape matching's pull toward the goals (seed 000 §3.3, §4): particle damping
-    /// `−c v`, and for the force update `α (|d|/L)^(p−1) d` with `d = g − x` from goals of
-    /// the current positions.
-    fn goal_forces(&mut self, sm: &ShapeMatchingParams) {
-        let force_update = sm.update == GoalUpdate::Force;
-        if force_update && let Some(state) = self.model.shape_matching_mut() {
-            state.compute_goals(&self.particles.position, &self.particles.mass, sm);
-        }
-        let p = &mut self.particles;
-        for i in 0..p.position.len() {
-            p.force[i] -= sm.damping * p.velocity[i];
-        }
-        let (Some(state), true) = (self.model.shape_matching(), force_update) else {
-            return;
-        };
-        let (l, exponent) = (self.length_scale, sm.exponent);
-        if exponent == 1.0 {
-            // The offsets already sum to zero (mean removed per cluster).
-            for i in 0..p.position.len() {
-                p.force[i] += state.offsets[i] * sm.stiffness;
-            }
-            return;
-        }
-        // For p ≠ 1 each particle's own scale (|d|/L)^(p−1) undoes the zero sum of the
-        // offsets: take the net force back out, shared by mass, so the goal forces
-        // conserve momentum (pinned particles take their share, so a pin still holds).
-        let (mut net, mut mass) = (bevy::math::DVec3::ZERO, 0.0f64);
-        for i in 0..p.position.len() {
-            let d = state.offsets[i];
-            let f = d * (sm.stiffness * pull_scale(d.length(), l, exponent));
-            net += f.as_dvec3();
-            mass += p.mass[i] as f64;
-            p.force[i] += f;
-        }
-        let per_kg = (net / mass.max(f64::MIN_POSITIVE)).as_vec3();
-        for i in 0..p.position.len() {
-            p.force[i] -= per_kg * p.mass[i];
-        }
-    }
-
-    /// The patch model: the part lattice's forces, and each particle's pull toward its
-    /// target `α (|d|/L)^(p−1) d` damped at `ratio · 2√(α m)` on its velocity relative to
-    /// the target (damping the absolute velocity would be a drag the lattice never
-    /// feels). With tiles the particles sit on their targets: no pull at all.
-    fn pull_forces(&mut self, env: &Environment, patch: &PatchParams) {
-        let Some(patches) = self.model.patches_mut() else {
-            return;
-        };
-        patches.parts.accumulate_forces(env);
-        if patch.tiles {
-            return;
-        }
-        let (l, exponent) = (self.length_scale, patch.exponent);
-        let p = &mut self.particles;
-        let (targets, target_velocity) = (&patches.targets, &patches.target_velocity);
-        let (x, v, mass) = (&p.position, &p.velocity, &p.mass);
-        parallel::for_each_indexed(&mut p.force, |i, f| {
-            let d = targets[i] - x[i];
-            let scale = pull_scale(d.length(), l, exponent);
-            let damping = patch.particle_damping_ratio * 2.0 * (patch.stiffness * mass[i]).sqrt();
-            let relative = v[i] - target_velocity[i];
-            *f = d * (patch.stiffness * scale) - damping * relative;
-        });
-    }
-
     /// Adds an external force (N) to particle `i` for the current substep. Call it between
     /// `accumulate_forces` and `integrate` (in the plugin: after
     /// `ClothSubstepSystems::AccumulateForces`, before `ClothSubstepSystems::Integrate`).
-    pub fn add_force(&mut self, i: usize, force: bevy::math::Vec3) {
+    pub fn add_force(&mut self, i: usize, force: Vec3) {
         if let Some(f) = self.particles.force.get_mut(i) {
             *f += force;
         }
@@ -171,7 +87,7 @@ impl ClothSolver {
 /// pushes its ends with equal and opposite forces; dividing by each end's mass in
 /// `integrate` shares the motion by inverse mass, as seed 000 eq. 2 asks.
 #[inline(always)]
-fn spring_forces(
+pub(super) fn spring_forces(
     s: &Springs,
     p: &mut Particles,
     range: std::ops::Range<usize>,
@@ -197,5 +113,36 @@ fn spring_forces(
         let f = dir * magnitude;
         p.force[a] += f;
         p.force[b] -= f;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::DVec3;
+
+    use super::*;
+
+    /// One spring's force against Hooke's law with damping along the spring, in `f64`:
+    /// `F = (k (|d| − l0) + c (v_b − v_a)·d̂) d̂` on the first end, its opposite on the
+    /// second.
+    #[test]
+    fn one_spring_pulls_its_ends_by_hookes_law_with_damping_along_it() {
+        let rest = [Vec3::ZERO, Vec3::new(0.5, 0.0, 0.0)];
+        let springs = Springs::from_pairs(vec![(SpringKind::Structural, 0, 1)], &rest);
+        let mut p = Particles::with_len(2);
+        p.position = vec![Vec3::new(0.1, 0.2, -0.3), Vec3::new(0.4, -0.1, 0.5)];
+        p.velocity = vec![Vec3::new(0.3, -0.2, 0.1), Vec3::new(-0.5, 0.4, 0.2)];
+        let (k, c) = (120.0, 0.7);
+        spring_forces(&springs, &mut p, 0..1, k, c, |_| 1.0);
+
+        let d = (p.position[1] - p.position[0]).as_dvec3();
+        let dir = d / d.length();
+        let along = (p.velocity[1] - p.velocity[0]).as_dvec3().dot(dir);
+        let f: DVec3 = dir * (k as f64 * (d.length() - 0.5) + c as f64 * along);
+        assert!(
+            (p.force[0].as_dvec3() - f).length() < 1e-5 * f.length(),
+            "{f}"
+        );
+        assert!((p.force[1].as_dvec3() + f).length() < 1e-5 * f.length());
     }
 }

@@ -51,7 +51,7 @@ impl ClothSolver {
         self.release_grab();
         self.disturbed = true;
         let x = self.particles.position[i as usize];
-        self.grab = Some(Grab {
+        self.drivers.grab = Some(Grab {
             particle: i,
             from: x,
             target: x,
@@ -63,7 +63,7 @@ impl ClothSolver {
 
     /// Moves the grabbed particle's target.
     pub fn drag_grab(&mut self, target: Vec3) {
-        if let Some(g) = &mut self.grab
+        if let Some(g) = &mut self.drivers.grab
             && target.is_finite()
             && target != g.target
         {
@@ -74,7 +74,7 @@ impl ClothSolver {
 
     /// Lets go of the grabbed particle; it keeps its velocity.
     pub fn release_grab(&mut self) {
-        if let Some(g) = self.grab.take() {
+        if let Some(g) = self.drivers.grab.take() {
             self.disturbed = true;
             // A pinned particle stays pinned; a free one takes the current mass.
             self.particles.inv_mass[g.particle as usize] = if g.inv_mass == 0.0 {
@@ -87,7 +87,7 @@ impl ClothSolver {
 
     /// The current grab, if any.
     pub fn grabbed(&self) -> Option<Grab> {
-        self.grab
+        self.drivers.grab
     }
 
     /// Cuts every whole spring that crosses the triangle `(a, b, c)`: a stroke seen from
@@ -96,12 +96,12 @@ impl ClothSolver {
     /// faces along them stop being drawn.
     pub fn cut(&mut self, a: Vec3, b: Vec3, c: Vec3) -> usize {
         let mut count = 0;
-        for s in 0..self.springs.len() {
-            if !self.springs.alive[s] {
+        for s in 0..self.fabric.springs.len() {
+            if !self.fabric.springs.alive[s] {
                 continue;
             }
-            let p = self.particles.position[self.springs.a[s] as usize];
-            let q = self.particles.position[self.springs.b[s] as usize];
+            let p = self.particles.position[self.fabric.springs.a[s] as usize];
+            let q = self.particles.position[self.fabric.springs.b[s] as usize];
             if segment_crosses_triangle(p, q, a, b, c) && self.tear(s as u32) {
                 count += 1;
             }

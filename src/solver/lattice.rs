@@ -16,9 +16,7 @@
 //!
 //! Both kernels run in fixed pieces over the compute pool (`parallel.rs`).
 
-use std::iter::Zip;
 use std::ops::Range;
-use std::slice::Iter;
 
 use bevy::math::Vec3;
 
@@ -43,6 +41,23 @@ struct Offset {
     /// Stiffness factor × alive of the spring from `a` (0 where there is none or it
     /// tore), indexed by `a`, one per particle as `rest`.
     weight: Vec<f32>,
+}
+
+impl Offset {
+    /// `(rest, weight)` of the offset's springs from particle `start` on.
+    fn springs_from(&self, start: usize) -> (&[f32], &[f32]) {
+        (&self.rest[start..], &self.weight[start..])
+    }
+}
+
+/// A cell's two diagonals: the one from (r, c) to (r + 1, c + 1), and the one from
+/// (r, c + 1) to (r + 1, c).
+fn right_and_left(diagonals: Option<[&Offset; 2]>) -> (Option<&Offset>, Option<&Offset>) {
+    match diagonals {
+        Some([d1, d2]) if d1.dx == 1 => (Some(d1), Some(d2)),
+        Some([d1, d2]) => (Some(d2), Some(d1)),
+        None => (None, None),
+    }
 }
 
 /// Three lanes of `f32`, one per coordinate (x, y, z): the form the compiler vectorises.
@@ -84,39 +99,26 @@ fn spring_piece(
     let [sx, sy, sz] = out;
     let len = sx.len();
     let (a, b) = (from..from + len, from + o.step..from + o.step + len);
+    let (sy, sz) = (&mut sy[..len], &mut sz[..len]);
+    let (rest, weight) = (&o.rest[a.clone()], &o.weight[a.clone()]);
+    // Each lane at the springs' starts (`_a`) and ends (`_b`).
     let [x, y, z] = &x.0;
+    let (xa, ya, za) = (&x[a.clone()], &y[a.clone()], &z[a.clone()]);
+    let (xb, yb, zb) = (&x[b.clone()], &y[b.clone()], &z[b.clone()]);
     let [vx, vy, vz] = &v.0;
-    let springs = sx
-        .iter_mut()
-        .zip(sy.iter_mut())
-        .zip(sz.iter_mut())
-        .zip(o.rest[a.clone()].iter().zip(&o.weight[a.clone()]))
-        .zip(pair(x, &a, &b))
-        .zip(pair(y, &a, &b))
-        .zip(pair(z, &a, &b))
-        .zip(pair(vx, &a, &b))
-        .zip(pair(vy, &a, &b))
-        .zip(pair(vz, &a, &b));
-    for (((((((((fx, fy), fz), (&rest, &weight)), x), y), z), vx), vy), vz) in springs {
-        let (dx, dy, dz) = (x.1 - x.0, y.1 - y.0, z.1 - z.0);
-        let len = (dx * dx + dy * dy + dz * dz).sqrt();
+    let (vxa, vya, vza) = (&vx[a.clone()], &vy[a.clone()], &vz[a]);
+    let (vxb, vyb, vzb) = (&vx[b.clone()], &vy[b.clone()], &vz[b]);
+    for i in 0..len {
+        let (dx, dy, dz) = (xb[i] - xa[i], yb[i] - ya[i], zb[i] - za[i]);
+        let l = (dx * dx + dy * dy + dz * dz).sqrt();
         // 1/|l| for a live spring, 0 for a torn or missing one (no branch).
-        let live = f32::from(u8::from(weight != 0.0 && len > f32::EPSILON));
-        let inv = live / len.max(f32::EPSILON);
-        let along = (vx.1 - vx.0) * dx + (vy.1 - vy.0) * dy + (vz.1 - vz.0) * dz;
-        let magnitude = k * weight * (len - rest) + damping * along * inv;
+        let live = f32::from(u8::from(weight[i] != 0.0 && l > f32::EPSILON));
+        let inv = live / l.max(f32::EPSILON);
+        let along = (vxb[i] - vxa[i]) * dx + (vyb[i] - vya[i]) * dy + (vzb[i] - vza[i]) * dz;
+        let magnitude = k * weight[i] * (l - rest[i]) + damping * along * inv;
         let scale = magnitude * inv;
-        (*fx, *fy, *fz) = (dx * scale, dy * scale, dz * scale);
+        (sx[i], sy[i], sz[i]) = (dx * scale, dy * scale, dz * scale);
     }
-}
-
-/// The elements `a` and `b` of one lane, side by side.
-fn pair<'l>(
-    lane: &'l [f32],
-    a: &Range<usize>,
-    b: &Range<usize>,
-) -> Zip<Iter<'l, f32>, Iter<'l, f32>> {
-    lane[a.clone()].iter().zip(&lane[b.clone()])
 }
 
 /// Adds to `sum` (one lane of the particles from `from` on) the forces `springs` of an
@@ -140,6 +142,56 @@ fn add_ends(sum: &mut [f32], springs: &[f32], from: usize, lo: usize, step: usiz
             .zip(&springs[first - step - lo..last - step - lo])
         {
             *f -= s;
+        }
+    }
+}
+
+/// What every piece of [`Stencil::spring_forces`] reads.
+struct SpringPass<'a> {
+    offsets: &'a [Offset],
+    /// Each offset's stiffness (0: its family is off).
+    stiffness: &'a [f32],
+    damping: f32,
+    x: &'a Lanes,
+    v: &'a Lanes,
+    /// Particles in all.
+    n: usize,
+}
+
+impl SpringPass<'_> {
+    /// The spring forces on the particles of the piece from `from` on: for each offset,
+    /// the forces of the springs that start or end in the piece into `halo` (those
+    /// crossing into the previous piece computed by both, the same way), then each
+    /// particle's sum into `sums` (`+` from the springs it starts, `−` from those it
+    /// ends, offset by offset), added to `force` at the end.
+    fn piece(
+        &self,
+        from: usize,
+        mut sums: [&mut [f32]; 3],
+        halo: [&mut [f32]; 3],
+        force: &mut [Vec3],
+    ) {
+        let n = self.n;
+        sums.iter_mut().for_each(|sum| sum.fill(0.0));
+        let [hx, hy, hz] = halo;
+        for (o, &k) in self.offsets.iter().zip(self.stiffness) {
+            if k == 0.0 {
+                continue;
+            }
+            // The springs that start or end in this piece: from `lo` to `hi`.
+            let m = n - o.step;
+            let lo = from.saturating_sub(o.step).min(m);
+            let hi = (from + PIECE).min(m).max(lo);
+            let springs = [&mut hx[..hi - lo], &mut hy[..hi - lo], &mut hz[..hi - lo]];
+            spring_piece(o, k, self.damping, lo, self.x, self.v, springs);
+            let springs = [&hx[..hi - lo], &hy[..hi - lo], &hz[..hi - lo]];
+            for (sum, springs) in sums.iter_mut().zip(springs) {
+                add_ends(sum, springs, from, lo, o.step, m);
+            }
+        }
+        let [fx, fy, fz] = sums;
+        for (((force, x), y), z) in force.iter_mut().zip(&*fx).zip(&*fy).zip(&*fz) {
+            *force += Vec3::new(*x, *y, *z);
         }
     }
 }
@@ -269,8 +321,14 @@ impl Stencil {
         for (stiffness, offset) in self.stiffness.iter_mut().zip(&self.offsets) {
             *stiffness = k(offset.kind);
         }
-        let (x, v) = (&self.x, &self.v);
-        let (offsets, stiffness) = (&self.offsets, &self.stiffness);
+        let pass = SpringPass {
+            offsets: &self.offsets,
+            stiffness: &self.stiffness,
+            damping,
+            x: &self.x,
+            v: &self.v,
+            n,
+        };
         let halo = PIECE + self.max_step;
         let [fx, fy, fz] = &mut self.f.0;
         let [hx, hy, hz] = &mut self.halo.0;
@@ -289,35 +347,7 @@ impl Stencil {
             n,
             pieces,
             |(i, ((((fx, fy), fz), force), ((hx, hy), hz)))| {
-                let from = i * PIECE;
-                let mut sums = [fx, fy, fz];
-                sums.iter_mut().for_each(|sum| sum.fill(0.0));
-                for (o, &k) in offsets.iter().zip(stiffness) {
-                    if k == 0.0 {
-                        continue;
-                    }
-                    // The springs that start or end in this piece: from `lo` to `hi`.
-                    let m = n - o.step;
-                    let lo = from.saturating_sub(o.step).min(m);
-                    let hi = (from + PIECE).min(m).max(lo);
-                    let mut springs = [&mut hx[..hi - lo], &mut hy[..hi - lo], &mut hz[..hi - lo]];
-                    spring_piece(
-                        o,
-                        k,
-                        damping,
-                        lo,
-                        x,
-                        v,
-                        springs.each_mut().map(|s| &mut **s),
-                    );
-                    for (sum, springs) in sums.iter_mut().zip(&springs) {
-                        add_ends(sum, springs, from, lo, o.step, m);
-                    }
-                }
-                let [fx, fy, fz] = sums;
-                for (((force, x), y), z) in force.iter_mut().zip(&*fx).zip(&*fy).zip(&*fz) {
-                    *force += Vec3::new(*x, *y, *z);
-                }
+                pass.piece(i * PIECE, [fx, fy, fz], [hx, hy, hz], force);
             },
         );
     }
@@ -559,16 +589,7 @@ impl Projection {
         let end = from + (n - from) / band * band; // whole bands only
         let group = band * (PIECE / band).max(1);
         let pieces = chunks6(x, dx, from..end, group).enumerate();
-        /// `(rest, weight)` of an offset's springs from particle `start` on.
-        fn springs(o: &Offset, start: usize) -> (&[f32], &[f32]) {
-            (&o.rest[start..], &o.weight[start..])
-        }
-        // The diagonal from (r, c) to (r + 1, c + 1), and the one from (r, c + 1) to (r + 1, c).
-        let (right, left) = match diagonals {
-            Some([d1, d2]) if d1.dx == 1 => (Some(d1), Some(d2)),
-            Some([d1, d2]) => (Some(d2), Some(d1)),
-            None => (None, None),
-        };
+        let (right, left) = right_and_left(diagonals);
         parallel::any(n, pieces, |(i, (x, dx))| {
             let start = from + i * group;
             let bands = x[0].len() / band;
@@ -581,7 +602,7 @@ impl Projection {
             for k in 0..bands {
                 let top = k * band;
                 if let Some(o) = down {
-                    let (rest, weight) = springs(o, start);
+                    let (rest, weight) = o.springs_from(start);
                     for a in top..top + width {
                         unconverged |=
                             self.project::<TRACK>(&mut g, a, a + width, rest[a], weight[a]);
@@ -591,7 +612,7 @@ impl Projection {
                     continue;
                 };
                 let ((r_rest, r_weight), (l_rest, l_weight)) =
-                    (springs(right, start), springs(left, start));
+                    (right.springs_from(start), left.springs_from(start));
                 for cells in 0..2 {
                     for c in (top + cells..top + width - 1).step_by(2) {
                         let (a, b) = (c, c + width + 1);
@@ -603,5 +624,54 @@ impl Projection {
             }
             unconverged
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use bevy::math::Vec3;
+
+    use super::*;
+    use crate::solver::forces::spring_forces;
+    use crate::solver::unit_hash;
+
+    /// The stencil's spring forces on a crumpled, moving 7×5 grid against the general
+    /// path's, spring by spring (`forces.rs`): the same law, summed in another order.
+    #[test]
+    fn the_stencils_spring_forces_are_the_general_paths() {
+        let layout = crate::layout::shape::ClothShape::Grid {
+            width: 7,
+            height: 5,
+            spacing: 0.1,
+        }
+        .layout()
+        .unwrap();
+        let springs = Springs::from_pairs(layout.springs.clone(), &layout.positions);
+        let n = layout.positions.len();
+        let mut stencil = Stencil::new(&springs, 7, n).unwrap();
+        stencil.sync(&springs);
+        let mut p = Particles::with_len(n);
+        for i in 0..n {
+            let jitter = |axis| unit_hash(i, axis) * 0.02;
+            p.position[i] = layout.positions[i] + Vec3::new(jitter(0), jitter(1), jitter(2));
+            p.velocity[i] = Vec3::new(unit_hash(i, 3), unit_hash(i, 4), unit_hash(i, 5));
+        }
+        let mut general = p.clone();
+        let k = [200.0, 50.0, 5.0, 2.0, 0.0];
+        stencil.spring_forces(&mut p, |kind| k[kind as usize], 0.3);
+        for kind in SpringKind::ALL {
+            let range = springs.ranges[kind as usize].clone();
+            spring_forces(&springs, &mut general, range, k[kind as usize], 0.3, |_| {
+                1.0
+            });
+        }
+        for i in 0..n {
+            let (f, g) = (p.force[i], general.force[i]);
+            assert!(
+                f.distance(g) < 1e-4 * (1.0 + g.length()),
+                "particle {i}: {f} against {g}"
+            );
+        }
+        assert!(general.force.iter().any(|f| f.length() > 1.0));
     }
 }

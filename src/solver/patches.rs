@@ -275,11 +275,8 @@ impl Patches {
             frame,
         )?;
         parts.particles.lump = split.lumps;
-        scale_for_aspect(&mut parts.springs, nx, part_size);
+        scale_for_aspect(&mut parts.fabric.springs, nx, part_size);
         parts.reset();
-        let step =
-            |a: usize, b: usize| local_rest.get(b).map_or(0.0, |x| x.distance(local_rest[a]));
-        let rest_step = (step(0, 1), step(0, w as usize));
         let targets: Vec<Vec3> = local_rest
             .iter()
             .map(|x| frame.transform_point3(*x))
@@ -296,7 +293,7 @@ impl Patches {
             single: split.single,
             stencil,
             anchors,
-            rest_step,
+            rest_step: rest_steps(local_rest, w as usize),
             built_for: patch.lattice_key(),
             ease: Vec::new(),
             ease_left: 0.0,
@@ -322,7 +319,7 @@ impl Patches {
         patch: &PatchParams,
         ease: bool,
     ) {
-        self.parts.last_h = h;
+        self.parts.clock.last_h = h;
         let w = self.grid.0;
         let parts = &mut self.parts.particles;
         for (k, part) in self.layout.iter().enumerate() {
@@ -531,11 +528,7 @@ impl Patches {
             // Its length is the rest spacing, so the pull restores the cloth's
             // extent along that axis (a measured length would give no stiffness).
             (None, None) => {
-                let rest = if horizontal {
-                    self.rest_step.0
-                } else {
-                    self.rest_step.1
-                };
+                let rest = self.rest_along(horizontal);
                 let step = own_step(&part, x, w, horizontal).normalize_or_zero() * rest;
                 let n = size(part, horizontal);
                 ((c - step * n, n), (c + step * n, n))
@@ -551,14 +544,30 @@ impl Patches {
         let start = 0.5 * (t + l)
             + horizontal * (0.5 * (dl - part.width as f32 + 1.0))
             + vertical * (0.5 * (dt - part.height as f32 + 1.0));
+        self.fill_targets(&part, start, horizontal, vertical);
+        if patch.center_correction {
+            self.correct_centre(part, c);
+        }
+    }
+
+    /// The rest spacing of the particles along a row (`horizontal`) or down a column.
+    fn rest_along(&self, horizontal: bool) -> f32 {
+        if horizontal {
+            self.rest_step.0
+        } else {
+            self.rest_step.1
+        }
+    }
+
+    /// Puts the targets of `part`'s particles on the lattice `start + j·vertical +
+    /// i·horizontal`.
+    fn fill_targets(&mut self, part: &Part, start: Vec3, horizontal: Vec3, vertical: Vec3) {
+        let w = self.grid.0;
         for j in 0..part.height {
             for i in 0..part.width {
                 let index = ((part.j0 + j) * w + part.i0 + i) as usize;
                 self.targets[index] = start + horizontal * i as f32 + vertical * j as f32;
             }
-        }
-        if patch.center_correction {
-            self.correct_centre(part, c);
         }
     }
 
@@ -660,4 +669,11 @@ fn own_step(part: &Part, x: &[Vec3], w: u32, horizontal: bool) -> Vec3 {
         sum / count as f32
     };
     (line_mean(n - 1) - line_mean(0)) / (n - 1) as f32
+}
+
+/// The rest distance from particle 0 to its neighbour along a row and down a column (0
+/// where there is none).
+fn rest_steps(local_rest: &[Vec3], width: usize) -> (f32, f32) {
+    let step = |b: usize| local_rest.get(b).map_or(0.0, |x| x.distance(local_rest[0]));
+    (step(1), step(width))
 }

@@ -40,32 +40,7 @@ impl ShapeMatching {
     /// or for a `grid` of (width, height), `k × k` clusters overlapping by one particle.
     pub fn new(rest: &[Vec3], mass: &[f32], grid: Option<(u32, u32)>, k: u32) -> Self {
         let n = rest.len();
-        let members: Vec<Vec<u32>> = match grid {
-            Some((w, h)) if k > 1 => {
-                let span = |c: u32, count: u32| {
-                    let k = k.min(count - 1).max(1);
-                    let lo = (c.min(k - 1) * (count - 1)) / k;
-                    let hi = ((c.min(k - 1) + 1) * (count - 1)).div_ceil(k);
-                    (lo.saturating_sub(1), (hi + 1).min(count - 1))
-                };
-                let kx = k.min(w - 1);
-                let ky = k.min(h - 1);
-                let mut clusters = Vec::new();
-                for cy in 0..ky {
-                    for cx in 0..kx {
-                        let (i0, i1) = span(cx, w);
-                        let (j0, j1) = span(cy, h);
-                        clusters.push(
-                            (j0..=j1)
-                                .flat_map(|j| (i0..=i1).map(move |i| j * w + i))
-                                .collect(),
-                        );
-                    }
-                }
-                clusters
-            }
-            _ => vec![(0..n as u32).collect()],
-        };
+        let members = cluster_members(n, grid, k);
         let mut count = vec![0.0f32; n];
         for &i in members.iter().flatten() {
             count[i as usize] += 1.0;
@@ -252,4 +227,32 @@ fn extract_rotation(a: &Mat3, start: Quat) -> Quat {
         q = (Quat::from_axis_angle(omega / angle, angle) * q).normalize();
     }
     if q.is_finite() { q } else { start }
+}
+
+/// The particles of each cluster: all `n` in one, or for a `grid` of (width, height)
+/// `k × k` blocks of rows and columns overlapping their neighbours by one particle.
+fn cluster_members(n: usize, grid: Option<(u32, u32)>, k: u32) -> Vec<Vec<u32>> {
+    let Some((w, h)) = grid.filter(|_| k > 1) else {
+        return vec![(0..n as u32).collect()];
+    };
+    let span = |c: u32, count: u32| {
+        let k = k.min(count - 1).max(1);
+        let lo = (c.min(k - 1) * (count - 1)) / k;
+        let hi = ((c.min(k - 1) + 1) * (count - 1)).div_ceil(k);
+        (lo.saturating_sub(1), (hi + 1).min(count - 1))
+    };
+    let (kx, ky) = (k.min(w - 1), k.min(h - 1));
+    let mut clusters = Vec::new();
+    for cy in 0..ky {
+        for cx in 0..kx {
+            let (i0, i1) = span(cx, w);
+            let (j0, j1) = span(cy, h);
+            clusters.push(
+                (j0..=j1)
+                    .flat_map(|j| (i0..=i1).map(move |i| j * w + i))
+                    .collect(),
+            );
+        }
+    }
+    clusters
 }

@@ -64,3 +64,50 @@ impl Particles {
         self.inv_mass[i] == 0.0
     }
 }
+
+/// One piece of [`Particles`]' lanes (up to [`PIECE`](super::parallel::PIECE) particles
+/// from the same start), named, for the kernels that run piece by piece.
+pub(super) struct ParticlePiece<'a> {
+    pub position: &'a mut [Vec3],
+    pub previous: &'a mut [Vec3],
+    pub velocity: &'a mut [Vec3],
+    pub residue: &'a mut [Vec3],
+    pub force: &'a mut [Vec3],
+    pub mass: &'a [f32],
+    pub inv_mass: &'a [f32],
+    pub lump: &'a [f32],
+}
+
+impl Particles {
+    /// The lanes cut into pieces of [`PIECE`](super::parallel::PIECE) particles, each
+    /// piece's lanes under their names.
+    pub(super) fn pieces(&mut self) -> impl Iterator<Item = ParticlePiece<'_>> {
+        use super::parallel::PIECE;
+        let moving = self
+            .position
+            .chunks_mut(PIECE)
+            .zip(self.previous.chunks_mut(PIECE))
+            .zip(self.velocity.chunks_mut(PIECE))
+            .zip(self.residue.chunks_mut(PIECE))
+            .zip(self.force.chunks_mut(PIECE));
+        let fixed = self
+            .mass
+            .chunks(PIECE)
+            .zip(self.inv_mass.chunks(PIECE))
+            .zip(self.lump.chunks(PIECE));
+        moving.zip(fixed).map(
+            |(((((position, previous), velocity), residue), force), ((mass, inv_mass), lump))| {
+                ParticlePiece {
+                    position,
+                    previous,
+                    velocity,
+                    residue,
+                    force,
+                    mass,
+                    inv_mass,
+                    lump,
+                }
+            },
+        )
+    }
+}

@@ -45,6 +45,8 @@ impl SubstepCache {
 pub(super) struct SubstepLoop {
     last: SubstepCache,
     calm: u32,
+    /// The stretch past the bound the last step left, measured at its end.
+    violation: Option<f32>,
 }
 
 /// Steps in a row below a quarter of the target before the count is lowered (half a
@@ -53,6 +55,11 @@ pub(super) struct SubstepLoop {
 const CALM_STEPS: u32 = 30;
 
 impl SubstepLoop {
+    /// Records the stretch past the bound a step left (`end_step` measures it).
+    pub(super) fn measured(&mut self, violation: f32) {
+        self.violation = Some(violation.max(0.0));
+    }
+
     /// The next step's substeps from the last step's `n` and the stretch `violation` it
     /// left, toward `target`. One iteration a substep leaves a violation that scales as
     /// `h²` (Macklin et al. 2019 §4), so `n·√(violation/target)` meets the target. Above
@@ -88,18 +95,19 @@ impl ClothSolver {
     /// The stable substeps for `dt` from the cache, computed and remembered when the
     /// parameters or `dt` changed.
     pub(super) fn refresh_substep_cache(&mut self, dt: f32) -> u32 {
-        if let Some(n) = self.substep_cache.get(&self.params, dt) {
+        if let Some(n) = self.clock.substep_cache.get(&self.params, dt) {
             return n;
         }
         let n = self.stable_substeps(dt);
-        self.substep_cache = SubstepCache(Some((SubstepCache::key(&self.params), dt, n)));
+        self.clock.substep_cache = SubstepCache(Some((SubstepCache::key(&self.params), dt, n)));
         n
     }
 
     /// The stable substeps for `dt`: the cached value when it is current, otherwise
     /// computed now.
     pub(super) fn cached_substeps(&self, dt: f32) -> u32 {
-        self.substep_cache
+        self.clock
+            .substep_cache
             .get(&self.params, dt)
             .unwrap_or_else(|| self.stable_substeps(dt))
     }
@@ -146,8 +154,8 @@ impl ClothSolver {
     /// substeps with `h ≤ √(target · L / (2 R g))`.
     pub(super) fn xpbd_substeps(&self, dt: f32, target: f32) -> u32 {
         const G: f32 = 9.81;
-        let size = super::collide::Bounds::around(&self.local_rest).size();
-        let l = self.length_scale.max(f32::EPSILON);
+        let size = super::collide::Bounds::around(&self.fabric.local_rest).size();
+        let l = self.fabric.length_scale.max(f32::EPSILON);
         let across = size.max_element().max(l) / l;
         let h = (target * l / (2.0 * across * G)).sqrt();
         let n = (dt / h).ceil();
@@ -166,17 +174,24 @@ impl ClothSolver {
             return None;
         };
         let allowance = self.family_bound(SpringKind::Structural)?;
-        let n = match self.xpbd_loop.last.get(&self.params, dt) {
+        let n = match self.clock.xpbd_loop.last.get(&self.params, dt) {
             None => {
-                self.xpbd_loop.calm = 0;
+                self.clock.xpbd_loop.calm = 0;
+                self.clock.xpbd_loop.violation = None;
                 self.refresh_substep_cache(dt)
             }
             Some(n) => {
-                let violation = self.structural_violation(allowance);
-                self.xpbd_loop.next(n, violation, xpbd.max_stretch_error)
+                // Measured by the last `end_step`; now if the steps were run by hand.
+                let violation = match self.clock.xpbd_loop.violation.take() {
+                    Some(v) => v,
+                    None => (self.structural_strain() - allowance).max(0.0),
+                };
+                self.clock
+                    .xpbd_loop
+                    .next(n, violation, xpbd.max_stretch_error)
             }
         };
-        self.xpbd_loop.last.set(&self.params, dt, n.min(cap));
+        self.clock.xpbd_loop.last.set(&self.params, dt, n.min(cap));
         Some(n)
     }
 
@@ -192,18 +207,18 @@ impl ClothSolver {
         }
     }
 
-    /// The largest stretch of a whole structural spring with a free end beyond
-    /// `allowance` (a fraction of its rest length; 0 when none is past it).
-    fn structural_violation(&self, allowance: f32) -> f32 {
+    /// The largest stretch `(l − l0)/l0` of a whole structural spring with a free end (0
+    /// when none is stretched).
+    pub(super) fn structural_strain(&self) -> f32 {
         let (x, w) = (&self.particles.position, &self.particles.inv_mass);
-        let s = &self.springs;
+        let s = &self.fabric.springs;
         let mut worst = 0.0f32;
         for k in s.ranges[SpringKind::Structural as usize].clone() {
             let (a, b) = (s.a[k] as usize, s.b[k] as usize);
             if s.alive[k] && w[a] + w[b] > 0.0 {
                 let stretch = x[a].distance(x[b]) / s.rest_length[k] - 1.0;
                 // A NaN (a broken state) is no stretch here; `is_stable` reports it.
-                worst = worst.max(stretch - allowance);
+                worst = worst.max(stretch);
             }
         }
         worst
@@ -241,7 +256,7 @@ impl ClothSolver {
     /// most failures of a crumpled cloth at p = 0.5 and 3 went away at 4× the substeps.)
     fn pull_omega2(&self, targets: &[Vec3], stiffness: f32, exponent: f32) -> f32 {
         let p = &self.particles;
-        let l = self.length_scale;
+        let l = self.fabric.length_scale;
         (0..p.len())
             .filter(|&i| p.inv_mass[i] > 0.0)
             .map(|i| {
@@ -275,7 +290,7 @@ impl ClothSolver {
     /// (`c I`, see [`Self::lattice_eigenvalue`]) the lightest, softest one went unstable.
     fn spring_frequency(&self) -> (f32, f32) {
         let (omega2_bound, gamma_bound) = self.spring_gershgorin();
-        if self.grid.is_none() {
+        if self.fabric.grid.is_none() {
             return (omega2_bound, gamma_bound);
         }
         let damping = self.params.springs.damping;
@@ -314,10 +329,10 @@ impl ClothSolver {
             if k == 0.0 && c == 0.0 {
                 continue;
             }
-            for s in self.springs.ranges[kind as usize].clone() {
-                if self.springs.alive[s] {
-                    for p in [self.springs.a[s], self.springs.b[s]] {
-                        k_sum[p as usize] += k * self.springs.scale(s);
+            for s in self.fabric.springs.ranges[kind as usize].clone() {
+                if self.fabric.springs.alive[s] {
+                    for p in [self.fabric.springs.a[s], self.fabric.springs.b[s]] {
+                        k_sum[p as usize] += k * self.fabric.springs.scale(s);
                         c_sum[p as usize] += c;
                     }
                 }
@@ -348,28 +363,9 @@ impl ClothSolver {
         iterations: u32,
     ) -> f32 {
         let p = &self.particles;
-        let s = &self.springs;
         let n = p.len();
         let root_w: Vec<f32> = p.inv_mass.iter().map(|w| w.sqrt()).collect();
-        let springs: Vec<(usize, usize, Vec3, f32, f32)> = SpringKind::ALL
-            .into_iter()
-            .map(|kind| (kind, coefficient(kind)))
-            .filter(|&(_, c)| c > 0.0)
-            .flat_map(|(kind, c)| s.ranges[kind as usize].clone().map(move |i| (i, kind, c)))
-            .filter(|&(i, _, _)| s.alive[i])
-            .map(|(i, kind, c)| {
-                let (a, b) = (s.a[i] as usize, s.b[i] as usize);
-                let d = p.position[b] - p.position[a];
-                let len = d.length();
-                let t = match (transverse, kind) {
-                    (false, _) => 0.0,
-                    (true, SpringKind::Seam) => 1.0,
-                    (true, _) if len > 0.0 => (1.0 - s.rest_length[i] / len).clamp(0.0, 1.0),
-                    (true, _) => 0.0,
-                };
-                (a, b, d.normalize_or_zero(), c * s.scale(i), t)
-            })
-            .collect();
+        let springs = self.linearised_springs(coefficient, transverse);
         let mut u: Vec<Vec3> = (0..n)
             .map(|i| {
                 Vec3::new(unit_hash(i, 0), unit_hash(i, 1), unit_hash(i, 2)) * root_w[i].signum()
@@ -403,6 +399,36 @@ impl ClothSolver {
             std::mem::swap(&mut u, &mut y);
         }
         lambda.max(0.0) as f32
+    }
+
+    /// Each whole spring of a family with `coefficient(family) > 0` linearised at the
+    /// current shape for [`Self::lattice_eigenvalue`]: its ends, direction, `c_s` and
+    /// transverse share `t`.
+    fn linearised_springs(
+        &self,
+        coefficient: impl Fn(SpringKind) -> f32,
+        transverse: bool,
+    ) -> Vec<(usize, usize, Vec3, f32, f32)> {
+        let (p, s) = (&self.particles, &self.fabric.springs);
+        SpringKind::ALL
+            .into_iter()
+            .map(|kind| (kind, coefficient(kind)))
+            .filter(|&(_, c)| c > 0.0)
+            .flat_map(|(kind, c)| s.ranges[kind as usize].clone().map(move |i| (i, kind, c)))
+            .filter(|&(i, _, _)| s.alive[i])
+            .map(|(i, kind, c)| {
+                let (a, b) = (s.a[i] as usize, s.b[i] as usize);
+                let d = p.position[b] - p.position[a];
+                let len = d.length();
+                let t = match (transverse, kind) {
+                    (false, _) => 0.0,
+                    (true, SpringKind::Seam) => 1.0,
+                    (true, _) if len > 0.0 => (1.0 - s.rest_length[i] / len).clamp(0.0, 1.0),
+                    (true, _) => 0.0,
+                };
+                (a, b, d.normalize_or_zero(), c * s.scale(i), t)
+            })
+            .collect()
     }
 
     /// `(ω_max², γ_max)` of shape matching's goal force at the current deformation (see

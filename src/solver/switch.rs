@@ -47,7 +47,7 @@ impl ClothSolver {
     /// Starts a switch from the current model to `params`' (call before taking them).
     /// Nothing for a cloth that has not moved yet.
     pub(super) fn begin_switch(&mut self, params: &crate::params::ClothParams) {
-        if self.time == 0.0 || !changes_model(self.params.model, params.model) {
+        if self.clock.time == 0.0 || !changes_model(self.params.model, params.model) {
             return;
         }
         let mut old = self.clone();
@@ -63,7 +63,7 @@ impl ClothSolver {
             return;
         };
         if let Some(mut old) = switch.old.take() {
-            let dt = self.h * self.substeps as f32;
+            let dt = self.clock.step_length();
             old.step(dt, env);
             // x(dt) = x + v dt + a dt²/2 over the step, for each particle.
             let p = &self.particles;
@@ -97,7 +97,7 @@ impl ClothSolver {
                 *f += *c * share;
             }
         }
-        switch.left -= self.h;
+        switch.left -= self.clock.h;
         if switch.left > 0.0 {
             self.switch = Some(switch);
         }

@@ -86,6 +86,24 @@ impl Tethers {
         if !bounded[0] || pins.is_empty() {
             return;
         }
+        self.build(springs, pins, bounded, n);
+        self.pinned = Vec::with_capacity(pins.len());
+        let stretch = 1.0 + slack;
+        for (reach, anchor) in self.reach.iter_mut().zip(&self.anchor) {
+            // A pin's own entry: no tether (it does not move itself).
+            if *anchor == u32::MAX || *reach == 0.0 {
+                *reach = f32::INFINITY;
+            } else {
+                *reach *= stretch;
+                *reach += *reach * f32::EPSILON * 2.0;
+            }
+        }
+    }
+
+    /// Each particle's nearest pin (by its place among `pins`) and rest geodesic distance
+    /// to it, per group of joined pins, through the springs of the bounded families
+    /// (Dijkstra, `Graph::nearest`).
+    fn build(&mut self, springs: &Springs, pins: &[u32], bounded: [bool; 2], n: usize) {
         let kinds = [SpringKind::Structural, SpringKind::Shear];
         let graph = Graph::new(springs, n, |s| {
             springs.alive[s]
@@ -118,17 +136,6 @@ impl Tethers {
         for anchor in &mut self.anchor {
             if *anchor != u32::MAX {
                 *anchor = slot[*anchor as usize];
-            }
-        }
-        self.pinned = Vec::with_capacity(pins.len());
-        let stretch = 1.0 + slack;
-        for (reach, anchor) in self.reach.iter_mut().zip(&self.anchor) {
-            // A pin's own entry: no tether (it does not move itself).
-            if *anchor == u32::MAX || *reach == 0.0 {
-                *reach = f32::INFINITY;
-            } else {
-                *reach *= stretch;
-                *reach += *reach * f32::EPSILON * 2.0;
             }
         }
     }

@@ -107,49 +107,7 @@ impl Constraints {
         if !general {
             return Self::default();
         }
-        // Each particle's springs (CSR), to find the colours already taken around a spring.
-        let mut start = vec![0u32; n + 1];
-        for s in 0..springs.len() {
-            start[springs.a[s] as usize + 1] += 1;
-            start[springs.b[s] as usize + 1] += 1;
-        }
-        for i in 0..n {
-            start[i + 1] += start[i];
-        }
-        let mut fill = start.clone();
-        let mut incident = vec![0u32; start[n] as usize];
-        for s in 0..springs.len() {
-            for p in [springs.a[s], springs.b[s]] {
-                incident[fill[p as usize] as usize] = s as u32;
-                fill[p as usize] += 1;
-            }
-        }
-        let mut colour = vec![u32::MAX; springs.len()];
-        let mut taken: Vec<bool> = Vec::new();
-        let mut first = 0usize; // the family's first colour
-        let mut count = 0usize;
-        for kind in PROJECTION_ORDER {
-            for s in springs.ranges[kind as usize].clone() {
-                taken.iter_mut().for_each(|t| *t = false);
-                for p in [springs.a[s], springs.b[s]] {
-                    let p = p as usize;
-                    for &t in &incident[start[p] as usize..start[p + 1] as usize] {
-                        let c = colour[t as usize] as usize;
-                        if let Some(slot) = c.checked_sub(first).and_then(|c| taken.get_mut(c)) {
-                            *slot = true;
-                        }
-                    }
-                }
-                let c = taken.iter().position(|&t| !t).unwrap_or(taken.len());
-                if c == taken.len() {
-                    taken.push(false);
-                    count += 1;
-                }
-                colour[s] = (first + c) as u32;
-            }
-            first = count;
-            taken.clear();
-        }
+        let (colour, count) = greedy_colours(springs, n);
         // Constraints colour by colour, each colour in storage order.
         let mut order: Vec<u32> = (0..springs.len() as u32).collect();
         order.sort_by_key(|&s| (colour[s as usize], s));
@@ -271,17 +229,73 @@ impl Constraints {
                 parallel::for_each(n, pieces, |(piece, x, offset)| project(piece, x, offset));
             }
         }
-        let pieces = p
-            .velocity
-            .chunks_mut(PIECE)
-            .zip(p.position.chunks(PIECE))
-            .zip(self.predicted.chunks(PIECE));
-        parallel::for_each(n, pieces, |((velocity, x), predicted)| {
-            for ((v, x), predicted) in velocity.iter_mut().zip(x).zip(predicted) {
-                *v += (*x - *predicted) / h;
-            }
-        });
+        store_velocity(p, &self.predicted, h);
     }
+}
+
+/// Each particle's velocity takes its change from the predicted position over `h`.
+fn store_velocity(p: &mut Particles, predicted: &[Vec3], h: f32) {
+    let n = p.len();
+    let pieces = p
+        .velocity
+        .chunks_mut(PIECE)
+        .zip(p.position.chunks(PIECE))
+        .zip(predicted.chunks(PIECE));
+    parallel::for_each(n, pieces, |((velocity, x), predicted)| {
+        for ((v, x), predicted) in velocity.iter_mut().zip(x).zip(predicted) {
+            *v += (*x - *predicted) / h;
+        }
+    });
+}
+
+/// Each spring's colour, greedily (the first free around it) family by family in
+/// [`PROJECTION_ORDER`], so no two springs of a colour share a particle and every colour
+/// is of one family; and the number of colours.
+fn greedy_colours(springs: &Springs, n: usize) -> (Vec<u32>, usize) {
+    // Each particle's springs (CSR), to find the colours already taken around a spring.
+    let mut start = vec![0u32; n + 1];
+    for s in 0..springs.len() {
+        start[springs.a[s] as usize + 1] += 1;
+        start[springs.b[s] as usize + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let mut fill = start.clone();
+    let mut incident = vec![0u32; start[n] as usize];
+    for s in 0..springs.len() {
+        for p in [springs.a[s], springs.b[s]] {
+            incident[fill[p as usize] as usize] = s as u32;
+            fill[p as usize] += 1;
+        }
+    }
+    let mut colour = vec![u32::MAX; springs.len()];
+    let mut taken: Vec<bool> = Vec::new();
+    let mut first = 0usize; // the family's first colour
+    let mut count = 0usize;
+    for kind in PROJECTION_ORDER {
+        for s in springs.ranges[kind as usize].clone() {
+            taken.iter_mut().for_each(|t| *t = false);
+            for p in [springs.a[s], springs.b[s]] {
+                let p = p as usize;
+                for &t in &incident[start[p] as usize..start[p + 1] as usize] {
+                    let c = colour[t as usize] as usize;
+                    if let Some(slot) = c.checked_sub(first).and_then(|c| taken.get_mut(c)) {
+                        *slot = true;
+                    }
+                }
+            }
+            let c = taken.iter().position(|&t| !t).unwrap_or(taken.len());
+            if c == taken.len() {
+                taken.push(false);
+                count += 1;
+            }
+            colour[s] = (first + c) as u32;
+        }
+        first = count;
+        taken.clear();
+    }
+    (colour, count)
 }
 
 /// XPBD's step for one distance constraint of family `f` (module doc) whose ends are

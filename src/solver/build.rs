@@ -1,0 +1,101 @@
+//! Building a cloth from a layout, putting it back at rest, and tearing it by hand.
+
+use bevy::math::{Affine3A, Vec3};
+
+use super::clock::Clock;
+use super::contact::Contact;
+use super::drivers::Drivers;
+use super::fabric::Fabric;
+use super::{ClothSolver, Layout, ModelState, Particles, check_model_fits};
+use crate::error::ClothError;
+use crate::params::{ClothParams, Model};
+
+impl ClothSolver {
+    /// Builds a cloth of `layout` placed by `frame` (local → world), with the particles
+    /// `pins` held where they start (indices into the layout's positions).
+    pub fn new(
+        layout: Layout,
+        pins: &[u32],
+        params: &ClothParams,
+        frame: Affine3A,
+    ) -> Result<Self, ClothError> {
+        layout.validate()?;
+        let count = layout.positions.len();
+        if let Some(&index) = pins.iter().find(|&&i| i as usize >= count) {
+            return Err(ClothError::PinOutOfRange { index, count });
+        }
+        params.validate()?;
+        check_model_fits(params, layout.grid)?;
+        crate::limits::check_work(count, params)?;
+        let mut cloth = ClothSolver {
+            particles: Particles::with_len(count),
+            fabric: Fabric::new(layout),
+            drivers: Drivers::new(pins, frame),
+            contact: Contact::default(),
+            clock: Clock::default(),
+            params: *params,
+            model: ModelState::None,
+            stepping: Model::MassSpring,
+            switch: None,
+            disturbed: true,
+            report: Default::default(),
+            checkpoint: Default::default(),
+        };
+        cloth.clock.substeps = 1;
+        cloth.reset();
+        Ok(cloth)
+    }
+
+    /// Puts every particle back at its rest position in the current frame, at rest, with
+    /// every spring whole and the clock at zero.
+    pub fn reset(&mut self) {
+        self.disturbed = true;
+        self.switch = None;
+        match &mut self.model {
+            ModelState::ShapeMatching(sm) => sm.reset(),
+            // Rebuilt from the rest state by the next step.
+            ModelState::Patches(_) => self.model = ModelState::None,
+            ModelState::None | ModelState::Xpbd(_) => {}
+        }
+        let mass = self.params.node_mass;
+        let p = &mut self.particles;
+        for (i, local) in self.fabric.local_rest.iter().enumerate() {
+            let x = self.drivers.frame.transform_point3(*local);
+            p.position[i] = x;
+            p.previous[i] = x;
+            p.velocity[i] = Vec3::ZERO;
+            p.residue[i] = Vec3::ZERO;
+            p.force[i] = Vec3::ZERO;
+            p.mass[i] = mass * p.lump[i];
+            p.inv_mass[i] = 1.0 / p.mass[i];
+        }
+        // Attachments are dropped (their owner attaches again on its next step).
+        self.drivers.reset(p);
+        self.fabric.mend();
+        self.clock.reset();
+        self.report = Default::default();
+        self.save_checkpoint();
+    }
+
+    /// Tears spring `s` by hand (e.g. a cut with the mouse). Returns false if it was
+    /// already torn or does not exist.
+    pub fn tear(&mut self, s: u32) -> bool {
+        let k = s as usize;
+        if k >= self.fabric.springs.len() || !self.fabric.springs.alive[k] {
+            return false;
+        }
+        self.disturbed = true;
+        self.fabric.tear(k);
+        self.fabric.torn_count += 1;
+        true
+    }
+
+    /// Springs stretched past the tear ratio break and hide the faces they border (seed
+    /// 000 §3.2): the models whose springs act on the particles (mass-spring, XPBD).
+    pub(super) fn tear_overstretched(&mut self) {
+        if let Some(ratio) = self.params.tear_ratio {
+            self.fabric
+                .tear_overstretched(&self.particles.position, ratio);
+        }
+    }
+}

@@ -1,0 +1,136 @@
+//! What a cloth is made of: its rest shape, springs, faces and pieces, and what tearing
+//! has done to them. Built once from a [`Layout`]; only tears change it (and sewing, the
+//! seams' rest lengths).
+
+use std::ops::Range;
+
+use bevy::math::Vec3;
+
+use super::lattice::Stencil;
+use super::layout::Layout;
+use super::topology::{self, SpringKind, Springs, VertexFaces};
+
+/// A cloth's make-up (see the module doc).
+#[derive(Clone, Debug)]
+pub(super) struct Fabric {
+    pub springs: Springs,
+    /// Particle positions in the cloth's own frame before any motion (for reset, pins).
+    pub local_rest: Vec<Vec3>,
+    pub grid: Option<(u32, u32)>,
+    pub triangles: Vec<[u32; 3]>,
+    pub triangle_springs: Vec<[u32; 3]>,
+    pub spring_triangles: Vec<Vec<u32>>,
+    pub triangle_visible: Vec<bool>,
+    /// Each particle's triangles in increasing order, for normals gathered per particle.
+    pub vertex_faces: VertexFaces,
+    pub faces_changed: bool,
+    /// Names and particle ranges of garment pieces (one range for other cloths).
+    pub pieces: Vec<(String, Range<u32>)>,
+    /// Named runs of particles (a garment's `runs`).
+    pub runs: Vec<(String, Vec<u32>)>,
+    /// The length each seam spring starts at, before sewing.
+    pub seam_start: Vec<f32>,
+    /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
+    /// garments.
+    pub stencil: Option<Stencil>,
+    /// The cloth's characteristic length L (mean structural rest length), for the
+    /// shape-matching force law.
+    pub length_scale: f32,
+    pub torn_this_step: Vec<u32>,
+    pub torn_count: usize,
+}
+
+impl Fabric {
+    /// The make-up of a validated layout.
+    pub fn new(layout: Layout) -> Self {
+        let Layout {
+            positions: local,
+            springs: pairs,
+            triangles,
+            grid,
+            pieces,
+            runs,
+        } = layout;
+        let n = local.len();
+        let springs = Springs::from_pairs(pairs, &local);
+        let stencil = grid.and_then(|(w, _)| Stencil::new(&springs, w as usize, n));
+        let (triangle_springs, spring_triangles) =
+            topology::triangle_edge_springs(&triangles, &springs);
+        let seams = springs.ranges[SpringKind::Seam as usize].clone();
+        let seam_start = springs.rest_length[seams].to_vec();
+        let structural = springs.ranges[SpringKind::Structural as usize].clone();
+        let length_scale = if structural.is_empty() {
+            1.0
+        } else {
+            springs.rest_length[structural.clone()].iter().sum::<f32>() / structural.len() as f32
+        };
+        Fabric {
+            torn_this_step: Vec::with_capacity(springs.len()),
+            springs,
+            local_rest: local,
+            grid,
+            triangle_visible: vec![true; triangles.len()],
+            vertex_faces: VertexFaces::new(&triangles, n),
+            triangles,
+            triangle_springs,
+            spring_triangles,
+            faces_changed: true,
+            pieces: if pieces.is_empty() {
+                vec![(String::from("cloth"), 0..n as u32)]
+            } else {
+                pieces
+            },
+            runs,
+            seam_start,
+            stencil,
+            length_scale,
+            torn_count: 0,
+        }
+    }
+
+    /// Every spring whole and every face shown again.
+    pub fn mend(&mut self) {
+        self.springs.alive.fill(true);
+        self.sync_stencil();
+        self.triangle_visible.fill(true);
+        self.faces_changed = true;
+        self.torn_count = 0;
+        self.torn_this_step.clear();
+    }
+
+    /// Tears spring `k` (in the stencil too) and hides the faces it borders.
+    pub fn tear(&mut self, k: usize) {
+        self.springs.alive[k] = false;
+        if let Some(stencil) = &mut self.stencil {
+            stencil.tear(k);
+        }
+        for &t in &self.spring_triangles[k] {
+            self.triangle_visible[t as usize] = false;
+        }
+        self.faces_changed = true;
+    }
+
+    /// Seam-free springs stretched past `ratio` times their rest length at `x` tear (seed
+    /// 000 §3.2); they are this step's torn springs. Seams are sewn to a rest length of 0
+    /// and do not tear.
+    pub fn tear_overstretched(&mut self, x: &[Vec3], ratio: f32) {
+        for k in 0..self.springs.ranges[SpringKind::Seam as usize].start {
+            let s = &self.springs;
+            if s.alive[k]
+                && x[s.a[k] as usize].distance_squared(x[s.b[k] as usize])
+                    > (ratio * s.rest_length[k]).powi(2)
+            {
+                self.tear(k);
+                self.torn_this_step.push(k as u32);
+            }
+        }
+        self.torn_count += self.torn_this_step.len();
+    }
+
+    /// Mirrors the springs' rest lengths, factors and alive flags into the stencil.
+    pub fn sync_stencil(&mut self) {
+        if let Some(stencil) = &mut self.stencil {
+            stencil.sync(&self.springs);
+        }
+    }
+}

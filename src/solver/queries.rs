@@ -1,0 +1,155 @@
+//! What a cloth can be asked between steps: its particles, springs, faces, pins,
+//! pieces, the model's state, counts and the clock.
+
+use bevy::math::Vec3;
+
+use super::patches::Patches;
+use super::shape_matching::ShapeMatching;
+use super::{ClothSolver, Particles, SpringKind, Springs, family_stiffness, steps};
+use crate::params::Model;
+
+impl ClothSolver {
+    /// The patch model's state (part lattice and targets), if that is the model.
+    pub fn patches(&self) -> Option<&Patches> {
+        self.model.patches()
+    }
+
+    /// The shape-matching goals (after the last goal computation), if that is the model.
+    pub fn goals(&self) -> Option<&[Vec3]> {
+        self.model.shape_matching().map(|s| &s.goals[..])
+    }
+
+    /// The shape-matching state, if that is the model.
+    pub fn shape_matching(&self) -> Option<&ShapeMatching> {
+        self.model.shape_matching()
+    }
+
+    /// Computes the shape-matching goals of the current positions now (outside a step).
+    pub fn update_goals(&mut self) {
+        let model = self.params.model;
+        steps::model_steps(&model).build(self, true);
+    }
+
+    /// The acting stiffness of a spring kind under the current parameters (0 for every
+    /// kind when the model has no springs; XPBD's constraints have the springs'
+    /// stiffness, `inf` for an inextensible one).
+    pub fn stiffness(&self, kind: SpringKind) -> f32 {
+        if !matches!(self.params.model, Model::MassSpring | Model::Xpbd(_)) {
+            return 0.0;
+        }
+        family_stiffness(&self.params.springs, kind)
+    }
+
+    /// Particle state (positions, velocities, masses, forces).
+    pub fn particles(&self) -> &Particles {
+        &self.particles
+    }
+
+    /// Mutable particle state, for tools that move particles (grab) between steps.
+    pub fn particles_mut(&mut self) -> &mut Particles {
+        self.disturbed = true;
+        &mut self.particles
+    }
+
+    /// Particle positions in world space.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.particles.position
+    }
+
+    /// The springs, torn ones included (see `Springs::alive`).
+    pub fn springs(&self) -> &Springs {
+        &self.fabric.springs
+    }
+
+    /// All triangles, hidden ones included.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.fabric.triangles
+    }
+
+    /// For each triangle, the springs along its edges (`u32::MAX` where none).
+    pub fn triangle_springs(&self) -> &[[u32; 3]] {
+        &self.fabric.triangle_springs
+    }
+
+    /// Whether each triangle is still drawn (false once a spring on its edge tore).
+    pub fn triangle_visible(&self) -> &[bool] {
+        &self.fabric.triangle_visible
+    }
+
+    /// True once after faces were hidden (or on a new cloth); clears the flag.
+    pub fn take_faces_changed(&mut self) -> bool {
+        std::mem::take(&mut self.fabric.faces_changed)
+    }
+
+    /// The indices of the pinned particles.
+    pub fn pins(&self) -> &[u32] {
+        &self.drivers.pins
+    }
+
+    /// The name and particle range of each garment piece (one range holding every
+    /// particle for other cloths).
+    pub fn pieces(&self) -> &[(String, std::ops::Range<u32>)] {
+        &self.fabric.pieces
+    }
+
+    /// The particles of the named run (a garment file's `runs`), or `None`.
+    pub fn run(&self, name: &str) -> Option<&[u32]> {
+        self.fabric
+            .runs
+            .iter()
+            .find(|(n, _)| n == name)
+            .map(|(_, particles)| particles.as_slice())
+    }
+
+    /// `(width, height)` for a grid cloth.
+    pub fn grid_size(&self) -> Option<(u32, u32)> {
+        self.fabric.grid
+    }
+
+    /// Number of particles.
+    pub fn particle_count(&self) -> usize {
+        self.particles.len()
+    }
+
+    /// Number of springs that still act (whole and of an enabled family).
+    pub fn spring_count(&self) -> usize {
+        if let Some(patches) = self.model.patches() {
+            return patches.spring_count();
+        }
+        SpringKind::ALL
+            .into_iter()
+            .filter(|&k| self.stiffness(k) > 0.0)
+            .map(|k| {
+                self.fabric.springs.ranges[k as usize]
+                    .clone()
+                    .filter(|&s| self.fabric.springs.alive[s])
+                    .count()
+            })
+            .sum()
+    }
+
+    /// The springs torn by the last `end_step`.
+    pub fn last_torn(&self) -> &[u32] {
+        &self.fabric.torn_this_step
+    }
+
+    /// Number of springs torn since the last reset.
+    pub fn torn_count(&self) -> usize {
+        self.fabric.torn_count + self.model.patches().map_or(0, Patches::torn_count)
+    }
+
+    /// Simulated time since the last reset, in s.
+    pub fn time(&self) -> f32 {
+        self.clock.time
+    }
+
+    /// Substeps used by the last step.
+    pub fn substeps(&self) -> u32 {
+        self.clock.substeps
+    }
+
+    /// True when automatic substeps hit their maximum: the step may be unstable.
+    pub fn under_resolved(&self) -> bool {
+        self.clock.under_resolved
+    }
+}

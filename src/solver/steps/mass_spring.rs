@@ -1,0 +1,118 @@
+//! The mass-spring model's step (seeds 000 §3.2 and 002 §1): spring and external forces,
+//! Verlet or semi-implicit Euler, Provot's strain limit, tearing.
+
+use super::{MassSpring, ModelSteps};
+use crate::params::Environment;
+use crate::solver::{ClothSolver, ModelState, SpringKind};
+
+impl ModelSteps for MassSpring {
+    fn build(&self, cloth: &mut ClothSolver, _compute: bool) {
+        cloth.model = ModelState::None;
+    }
+
+    fn begin(&self, cloth: &mut ClothSolver, _dt: f32, ratio: Option<f32>) {
+        cloth.rescale_verlet_velocity(ratio);
+    }
+
+    fn forces(&self, cloth: &mut ClothSolver, env: &Environment) {
+        cloth.external_forces(env);
+        cloth.spring_forces();
+    }
+
+    fn integrate(&self, cloth: &mut ClothSolver) {
+        cloth.integrate_particles();
+    }
+
+    /// Strain limiting corrects springs (after the pins are driven).
+    fn constrain(&self, cloth: &mut ClothSolver) {
+        if let Some(limit) = cloth.params.strain_limit {
+            cloth.limit_strain(limit, cloth.clock.h);
+        }
+    }
+
+    fn end(&self, cloth: &mut ClothSolver) {
+        cloth.tear_overstretched();
+    }
+}
+
+impl ClothSolver {
+    /// Provot (1995): springs longer than `(1 + limit)·l0` are shortened to that length,
+    /// each end moved by its share of inverse mass (seed 000 eq. 2); Gauss–Seidel sweeps
+    /// over the structural and shear springs. Velocities take the same correction over `h`.
+    /// With `strain_limit_tolerance`, sweeping stops once a sweep finds every spring
+    /// within `(1 + limit + tolerance)·l0`.
+    fn limit_strain(&mut self, limit: f32, h: f32) {
+        let sweeps = self.params.strain_limit_iterations;
+        if let Some(stencil) = &mut self.fabric.stencil {
+            let springs = self.params.springs;
+            let enabled = |kind| match kind {
+                SpringKind::Structural => springs.structural.enabled,
+                SpringKind::Shear => springs.shear.enabled,
+                _ => false,
+            };
+            let past = self
+                .params
+                .strain_limit_tolerance
+                .map(|tolerance| 1.0 + limit + tolerance);
+            stencil.limit_strain(&mut self.particles, enabled, limit, sweeps, past, h);
+            return;
+        }
+        match self.params.strain_limit_tolerance {
+            None => {
+                for _ in 0..sweeps {
+                    self.limit_strain_sweep::<false>(limit, f32::INFINITY, h);
+                }
+            }
+            Some(tolerance) => {
+                let past = 1.0 + limit + tolerance;
+                for _ in 0..sweeps {
+                    if !self.limit_strain_sweep::<true>(limit, past, h) {
+                        break;
+                    }
+                }
+            }
+        }
+    }
+
+    /// One Gauss–Seidel sweep of [`Self::limit_strain`]. With `TRACK`, returns whether a
+    /// spring was longer than `past·l0` (not yet converged); the fixed-sweep limiter
+    /// compiles without that test.
+    fn limit_strain_sweep<const TRACK: bool>(&mut self, limit: f32, past: f32, h: f32) -> bool {
+        let s = &self.fabric.springs;
+        let p = &mut self.particles;
+        let mut unconverged = false;
+        for kind in [SpringKind::Structural, SpringKind::Shear] {
+            if !self.params.springs.structural.enabled && kind == SpringKind::Structural
+                || !self.params.springs.shear.enabled && kind == SpringKind::Shear
+            {
+                continue;
+            }
+            for idx in s.ranges[kind as usize].clone() {
+                if !s.alive[idx] {
+                    continue;
+                }
+                let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
+                let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
+                let w = wa + wb;
+                if w == 0.0 {
+                    continue;
+                }
+                let d = p.position[b] - p.position[a];
+                let len = d.length();
+                let max = (1.0 + limit) * s.rest_length[idx];
+                if len <= max {
+                    continue;
+                }
+                if TRACK {
+                    unconverged |= len > past * s.rest_length[idx];
+                }
+                let correction = d * ((len - max) / (len * w));
+                p.position[a] += correction * wa;
+                p.position[b] -= correction * wb;
+                p.velocity[a] += correction * (wa / h);
+                p.velocity[b] -= correction * (wb / h);
+            }
+        }
+        unconverged
+    }
+}

@@ -1,0 +1,361 @@
+//! The step as a pipeline. A step of `dt` is [`ClothSolver::begin_step`], that many
+//! [`ClothSolver::substep`]s, then [`ClothSolver::end_step`]; [`ClothSolver::step`] runs
+//! the three and returns a [`StepReport`].
+//!
+//! Each substep runs five stages in order (seed 000 §3.2: every force from the old state
+//! before any position changes):
+//! 1. [`ClothSolver::accumulate_forces`]: gravity, wind, drag and the model's forces
+//!    (springs, the goal or target pull);
+//! 2. [`ClothSolver::integrate`]: the model's prediction (Verlet or semi-implicit Euler;
+//!    the patch model's part lattice first);
+//! 3. [`ClothSolver::fit_targets`]: the model's move toward its goals or targets (shape
+//!    matching's velocity update, the patch model's single-particle parts);
+//! 4. [`ClothSolver::constrain`]: the pins and grab driven to their place, the model's
+//!    constraints (Provot's limit, XPBD's projection and tethers), then contact (the
+//!    last: no later correction pushes a particle back into a collider); it ends the
+//!    substep and advances the clock.
+//!
+//! What differs between models lives in one file per model (`steps/*.rs`), each an
+//! implementation of [`ModelSteps`]; the model is chosen once, when the step begins.
+//! A new stage common to every model (self-collision) goes into `constrain` after
+//! contact; a model's own stage into its file.
+
+mod mass_spring;
+mod patches;
+mod shape_matching;
+mod xpbd;
+
+use std::time::{Duration, Instant};
+
+use bevy::math::Vec3;
+
+use super::{ClothSolver, SpringKind};
+use crate::params::{Environment, Model, Substeps};
+
+/// The stages of a step that differ from model to model, in the order they run.
+pub(super) trait ModelSteps {
+    /// Builds the model's state when it is missing or was built for other parameters;
+    /// computes its goals or targets when `compute` asks or it was just built.
+    fn build(&self, _cloth: &mut ClothSolver, _compute: bool) {}
+    /// Gives the model's state this step's parameters, before the substeps are chosen.
+    fn prepare(&self, _cloth: &mut ClothSolver, _dt: f32) {}
+    /// Starts the step once its substeps are chosen; `ratio` is `h / last_h` when the
+    /// substep length changed.
+    fn begin(&self, _cloth: &mut ClothSolver, _dt: f32, _ratio: Option<f32>) {}
+    /// Stage 1: every force on the particles (gravity, wind and drag included).
+    fn forces(&self, cloth: &mut ClothSolver, env: &Environment);
+    /// Stage 2: the particles' prediction from their forces.
+    fn integrate(&self, cloth: &mut ClothSolver);
+    /// Stage 3: the move toward goals or targets.
+    fn fit_targets(&self, _cloth: &mut ClothSolver) {}
+    /// Stage 4, between the drivers and contact: the model's constraints.
+    fn constrain(&self, _cloth: &mut ClothSolver) {}
+    /// After the substeps: tearing.
+    fn end(&self, _cloth: &mut ClothSolver) {}
+}
+
+/// The mass-spring model has no parameters of its own.
+pub(super) struct MassSpring;
+
+/// The stages of `model`.
+pub(super) fn model_steps(model: &Model) -> &dyn ModelSteps {
+    match model {
+        Model::MassSpring => &MassSpring,
+        Model::ShapeMatching(sm) => sm,
+        Model::Patches(patch) => patch,
+        Model::Xpbd(xpbd) => xpbd,
+    }
+}
+
+/// What a step did, returned by [`ClothSolver::step`] and [`ClothSolver::end_step`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepReport {
+    /// The substeps the step planned (0: nothing happened, for a `dt` that is not
+    /// positive and finite).
+    pub substeps: u32,
+    /// The substeps taken: `substeps`, unless the stages were called by hand a different
+    /// number of times.
+    pub taken: u32,
+    /// The automatic substeps hit their cap: the step may be unstable or inaccurate.
+    pub under_resolved: bool,
+    /// The largest stretch `(l − l0)/l0` of a whole structural spring with a free end at
+    /// the end of the step, when the step measured it (XPBD's automatic substeps do, each
+    /// step); [`ClothSolver::strain`] measures it on demand.
+    pub max_strain: Option<f32>,
+    /// False when the step would have left a position or velocity non-finite: the cloth
+    /// then keeps the positions of the last good step (or reset), at rest.
+    pub finite: bool,
+    /// Springs torn in the step.
+    pub torn: usize,
+    /// Wall time spent in each stage, summed over the substeps.
+    pub time: StageTimes,
+}
+
+impl Default for StepReport {
+    /// The report of no step: nothing done, nothing wrong.
+    fn default() -> Self {
+        StepReport {
+            substeps: 0,
+            taken: 0,
+            under_resolved: false,
+            max_strain: None,
+            finite: true,
+            torn: 0,
+            time: StageTimes::default(),
+        }
+    }
+}
+
+/// Wall time per stage of a step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StageTimes {
+    /// `begin_step`: the model's state, the substep count, the drivers.
+    pub begin: Duration,
+    /// Stage 1, forces.
+    pub forces: Duration,
+    /// Stage 2, the prediction.
+    pub integrate: Duration,
+    /// Stage 3, goals and targets.
+    pub fit_targets: Duration,
+    /// Stage 4 but contact: the drivers and the model's constraints.
+    pub constraints: Duration,
+    /// Contact with the colliders.
+    pub contact: Duration,
+    /// `end_step`: the finite check, tearing, the strain measure.
+    pub end: Duration,
+}
+
+impl StageTimes {
+    /// The whole step.
+    pub fn total(&self) -> Duration {
+        self.begin
+            + self.forces
+            + self.integrate
+            + self.fit_targets
+            + self.constraints
+            + self.contact
+            + self.end
+    }
+}
+
+/// The positions at the end of the last good step (or the last reset) and the time
+/// they were at, which a step that goes non-finite gives back. Reused storage: no
+/// allocation once grown.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Checkpoint {
+    position: Vec<Vec3>,
+    /// Where the next checkpoint is written before it is known to be finite.
+    spare: Vec<Vec3>,
+    time: f32,
+}
+
+impl Checkpoint {
+    /// Takes `position` and `velocity` at `time` as the new checkpoint when every one of
+    /// them is finite; returns whether they were. One pass over both.
+    pub fn take(&mut self, position: &[Vec3], velocity: &[Vec3], time: f32) -> bool {
+        self.spare.clear();
+        let mut finite = true;
+        self.spare
+            .extend(position.iter().zip(velocity).map(|(x, v)| {
+                finite &= x.is_finite() & v.is_finite();
+                *x
+            }));
+        if finite {
+            std::mem::swap(&mut self.position, &mut self.spare);
+            self.time = time;
+        }
+        finite
+    }
+}
+
+impl ClothSolver {
+    /// Advances the cloth by `dt` seconds: [`begin_step`](Self::begin_step), that many
+    /// [`substep`](Self::substep)s, then [`end_step`](Self::end_step).
+    pub fn step(&mut self, dt: f32, env: &Environment) -> StepReport {
+        let n = self.begin_step(dt);
+        for _ in 0..n {
+            self.substep(env);
+        }
+        self.end_step()
+    }
+
+    /// One substep: the four stages in order.
+    pub fn substep(&mut self, env: &Environment) {
+        self.accumulate_forces(env);
+        self.integrate();
+        self.fit_targets();
+        self.constrain();
+    }
+
+    /// Prepares a step of `dt` seconds and returns the number of substeps it takes (0 for a
+    /// `dt` that is not positive and finite: nothing happens then).
+    pub fn begin_step(&mut self, dt: f32) -> u32 {
+        let start = Instant::now();
+        self.report = StepReport::default();
+        if !(dt > 0.0 && dt.is_finite()) {
+            self.clock.substeps = 0;
+            return 0;
+        }
+        self.stepping = self.params.model;
+        let model = self.stepping;
+        let steps = model_steps(&model);
+        self.sew();
+        // The automatic substep bound of a deformation-dependent pull needs this state's
+        // goals or targets; otherwise the substeps compute their own.
+        let auto = matches!(self.params.substeps, Substeps::Auto { .. });
+        steps.build(self, auto && self.state_dependent_stiffness());
+        steps.prepare(self, dt);
+        let n = self.choose_substeps(dt);
+        let ratio = self.clock.begin(dt, n);
+        steps.begin(self, dt, ratio);
+        let p = &self.particles.position;
+        self.drivers.begin_step(p, &self.fabric.local_rest);
+        self.fabric.torn_this_step.clear();
+        self.contact
+            .collider_impulses
+            .fill(super::collide::ColliderImpulse::default());
+        self.report.substeps = n;
+        self.report.under_resolved = self.clock.under_resolved;
+        self.report.time.begin = start.elapsed();
+        n
+    }
+
+    /// This step's substeps: the fixed count, or the automatic one (the stable bound,
+    /// or XPBD's measured loop), at most the work cap.
+    fn choose_substeps(&mut self, dt: f32) -> u32 {
+        match self.params.substeps {
+            Substeps::Fixed(n) => {
+                self.clock.under_resolved = false;
+                n.max(1)
+            }
+            Substeps::Auto { max } => {
+                let cap = crate::limits::auto_substeps_cap(self.particles.len(), max);
+                // Shape matching's stiffness (and the patch pull's for p ≠ 1) depends on
+                // the deformation: no cache. XPBD follows what it measures.
+                let needed = if self.state_dependent_stiffness() {
+                    self.stable_substeps(dt)
+                } else if let Some(n) = self.xpbd_closed_loop(dt, cap) {
+                    n
+                } else {
+                    self.refresh_substep_cache(dt)
+                };
+                self.clock.under_resolved = needed > cap;
+                needed.clamp(1, cap)
+            }
+        }
+    }
+
+    /// Stage 1: clears and accumulates the forces on every free particle (gravity, seed
+    /// 002 eq. 1.6; wind; linear drag `−c v`, seed 000 eq. 31; the model's). Reads only
+    /// the old state, so the result does not depend on particle order (seed 000 §3.2).
+    /// Just after a model switch, the force that keeps the switch smooth (`switch.rs`).
+    pub fn accumulate_forces(&mut self, env: &Environment) {
+        let start = Instant::now();
+        let model = self.stepping;
+        model_steps(&model).forces(self, env);
+        self.add_switch_force(env);
+        self.report.time.forces += start.elapsed();
+    }
+
+    /// Stage 2: advances every free particle by one substep from its force.
+    pub fn integrate(&mut self) {
+        let start = Instant::now();
+        let model = self.stepping;
+        model_steps(&model).integrate(self);
+        self.report.time.integrate += start.elapsed();
+    }
+
+    /// Stage 3: the move toward the model's goals or targets (nothing for mass-spring
+    /// and XPBD).
+    pub fn fit_targets(&mut self) {
+        let start = Instant::now();
+        let model = self.stepping;
+        model_steps(&model).fit_targets(self);
+        self.report.time.fit_targets += start.elapsed();
+    }
+
+    /// Stage 4: moves the pinned and grabbed particles along their path, projects the
+    /// model's constraints, keeps particles out of the colliders; then ends the substep
+    /// (the clock advances by `h`).
+    pub fn constrain(&mut self) {
+        let start = Instant::now();
+        let (t, h) = (self.clock.end_of_substep(), self.clock.h);
+        self.drivers.drive(&mut self.particles, t, h);
+        let model = self.stepping;
+        model_steps(&model).constrain(self);
+        let constrained = Instant::now();
+        let tau = self.clock.left_after_substep();
+        self.contact.resolve(&mut self.particles, tau, h);
+        self.clock.advance();
+        self.report.taken += 1;
+        self.report.time.constraints += constrained - start;
+        self.report.time.contact += constrained.elapsed();
+    }
+
+    /// Finishes a step. A step that left a position or velocity non-finite is undone (the
+    /// positions at the end of the last good step come back, at rest) and says so; otherwise springs stretched past the tear ratio break (seed 000 §3.2).
+    pub fn end_step(&mut self) -> StepReport {
+        let start = Instant::now();
+        if self.report.substeps == 0 {
+            return self.report;
+        }
+        let (p, time) = (&self.particles, self.clock.time);
+        self.report.finite = self.checkpoint.take(&p.position, &p.velocity, time);
+        if self.report.finite {
+            let model = self.stepping;
+            model_steps(&model).end(self);
+            self.report.max_strain = self.measure_closed_loop();
+        } else {
+            self.restore_checkpoint();
+        }
+        self.report.torn = self.fabric.torn_this_step.len()
+            + self
+                .model
+                .patches()
+                .map_or(0, |p| p.parts.last_torn().len());
+        self.report.time.end = start.elapsed();
+        self.report
+    }
+
+    /// The report of the last step (or of the step in progress, so far).
+    pub fn last_report(&self) -> StepReport {
+        self.report
+    }
+
+    /// Puts the particles back where the checkpoint has them, at rest; everything else a
+    /// step derives from them starts over from there (Verlet's previous positions, the
+    /// patch model's lattice, shape matching's goals, XPBD's substep loop).
+    fn restore_checkpoint(&mut self) {
+        let (p, c) = (&mut self.particles, &self.checkpoint);
+        p.position.clone_from(&c.position);
+        p.previous.clone_from(&c.position);
+        p.velocity.fill(Vec3::ZERO);
+        p.residue.fill(Vec3::ZERO);
+        p.force.fill(Vec3::ZERO);
+        self.clock.time = c.time;
+        self.clock.xpbd_loop = Default::default();
+        self.switch = None;
+        self.model = super::ModelState::None;
+    }
+
+    /// Takes the current positions as the state a failed step goes back to (after a
+    /// reset).
+    pub(super) fn save_checkpoint(&mut self) {
+        let (p, time) = (&self.particles, self.clock.time);
+        self.checkpoint.take(&p.position, &p.velocity, time);
+    }
+
+    /// Whether the structural springs have a bound the closed loop can measure against.
+    fn measure_closed_loop(&mut self) -> Option<f32> {
+        let bound = self.family_bound(SpringKind::Structural)?;
+        if !matches!(
+            (self.stepping, self.params.substeps),
+            (Model::Xpbd(_), Substeps::Auto { .. })
+        ) {
+            return None;
+        }
+        let strain = self.structural_strain();
+        self.clock.xpbd_loop.measured(strain - bound);
+        Some(strain)
+    }
+}

@@ -1,0 +1,95 @@
+//! XPBD's step (Macklin, Müller and Chentanez 2016; small steps, Macklin et al. 2019,
+//! algorithm 1): predict from the external forces, project every spring's constraint once
+//! a substep (on a grid's stencil, `lattice/xpbd.rs`; otherwise `xpbd.rs`), then the
+//! tethers to the pins (Kim, Chentanez and Müller 2012, `tethers.rs`); velocities are the
+//! change from the prediction over `h`.
+
+use super::ModelSteps;
+use crate::params::{Environment, XpbdParams};
+use crate::solver::integrate::symplectic_euler;
+use crate::solver::{ClothSolver, ModelState, SpringKind, family_stiffness, xpbd};
+
+impl ModelSteps for XpbdParams {
+    /// A cloth's springs never change (they only tear): the constraints are built once
+    /// per switch to XPBD.
+    fn build(&self, cloth: &mut ClothSolver, _compute: bool) {
+        if !matches!(cloth.model, ModelState::Xpbd(_)) {
+            let n = cloth.particles.len();
+            // A grid is projected on its stencil: no constraint lists.
+            let general = cloth.fabric.stencil.is_none();
+            let constraints = xpbd::Constraints::new(&cloth.fabric.springs, n, general);
+            cloth.model = ModelState::Xpbd(Box::new(constraints));
+        }
+    }
+
+    /// This step's seam lengths, torn springs and pins.
+    fn prepare(&self, cloth: &mut ClothSolver, _dt: f32) {
+        if let ModelState::Xpbd(constraints) = &mut cloth.model
+            && cloth.fabric.stencil.is_none()
+        {
+            constraints.sync(&cloth.fabric.springs);
+        }
+        refresh_tethers(cloth, self);
+    }
+
+    /// Gravity, wind and drag only: the springs are constraints.
+    fn forces(&self, cloth: &mut ClothSolver, env: &Environment) {
+        cloth.external_forces(env);
+    }
+
+    /// The prediction `v += h f/m`, `x += h v`, whatever the integrator setting.
+    fn integrate(&self, cloth: &mut ClothSolver) {
+        symplectic_euler(&mut cloth.particles, cloth.clock.h);
+    }
+
+    /// Every spring's constraint projected once, the strain limit with the structural and
+    /// shear ones, then the tethers, last so the bound they keep holds at the end of the
+    /// substep.
+    fn constrain(&self, cloth: &mut ClothSolver) {
+        let ModelState::Xpbd(constraints) = &mut cloth.model else {
+            return;
+        };
+        let h = cloth.clock.h;
+        let (springs, limit) = (&cloth.params.springs, cloth.params.strain_limit);
+        let families = SpringKind::ALL.map(|kind| {
+            let k = family_stiffness(springs, kind);
+            let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
+            xpbd::Family::new(k, springs.damping, h, limit.filter(|_| limited))
+        });
+        match &mut cloth.fabric.stencil {
+            Some(stencil) => stencil.project_xpbd(&mut cloth.particles, &families, h),
+            None => constraints.project(&mut cloth.particles, &families, h),
+        }
+        let pins = &cloth.drivers.pins;
+        constraints.tethers.project(&mut cloth.particles, pins, h);
+    }
+
+    fn end(&self, cloth: &mut ClothSolver) {
+        cloth.tear_overstretched();
+    }
+}
+
+/// Builds the tethers to the pins again when the pins, the torn springs or the
+/// material's bounds changed (`tethers.rs`); drops them when switched off. A family's
+/// length is bounded when it is inextensible (the tether's slack 0) or strain limited
+/// (the slack the limit); the slack is the larger of the bounded families'.
+fn refresh_tethers(cloth: &mut ClothSolver, params: &XpbdParams) {
+    let bounds = [
+        cloth.family_bound(SpringKind::Structural),
+        cloth.family_bound(SpringKind::Shear),
+    ];
+    let ModelState::Xpbd(constraints) = &mut cloth.model else {
+        return;
+    };
+    let on = params.tethers && bounds[0].is_some();
+    let pins: &[u32] = if on { &cloth.drivers.pins } else { &[] };
+    let slack = bounds.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
+    constraints.tethers.refresh(
+        &cloth.fabric.springs,
+        cloth.fabric.torn_count,
+        pins,
+        bounds.map(|b| b.is_some()),
+        slack,
+        cloth.particles.len(),
+    );
+}
