@@ -144,28 +144,38 @@ impl StageTimes {
 #[derive(Clone, Debug, Default)]
 pub(super) struct Checkpoint {
     position: Vec<Vec3>,
-    /// Where the next checkpoint is written before it is known to be finite.
-    spare: Vec<Vec3>,
     time: f32,
 }
 
 impl Checkpoint {
-    /// Takes `position` and `velocity` at `time` as the new checkpoint when every one of
-    /// them is finite; returns whether they were. One pass over both.
+    /// Takes `position` at `time` as the new checkpoint when every position and
+    /// velocity is finite; returns whether they were.
     pub fn take(&mut self, position: &[Vec3], velocity: &[Vec3], time: f32) -> bool {
-        self.spare.clear();
-        let mut finite = true;
-        self.spare
-            .extend(position.iter().zip(velocity).map(|(x, v)| {
-                finite &= x.is_finite() & v.is_finite();
-                *x
-            }));
+        let finite = all_finite(position) && all_finite(velocity);
         if finite {
-            std::mem::swap(&mut self.position, &mut self.spare);
+            self.position.clear();
+            self.position.extend_from_slice(position);
             self.time = time;
         }
         finite
     }
+}
+
+/// Whether every component of `v` is finite, without a branch per element: `x·0` is 0
+/// for a finite `x` and NaN otherwise, and a sum of zeros stays 0 (four sums, so the
+/// additions do not wait on each other).
+fn all_finite(v: &[Vec3]) -> bool {
+    let mut sums = [Vec3::ZERO; 4];
+    let chunks = v.chunks_exact(4);
+    for x in chunks.remainder() {
+        sums[0] += *x * 0.0;
+    }
+    for chunk in chunks {
+        for (sum, x) in sums.iter_mut().zip(chunk) {
+            *sum += *x * 0.0;
+        }
+    }
+    sums.into_iter().sum::<Vec3>() == Vec3::ZERO
 }
 
 impl ClothSolver {
