@@ -924,3 +924,63 @@ fn a_cloth_that_goes_non_finite_is_paused_with_the_reason_and_recovers() {
             .is_finite()
     );
 }
+
+/// How many times the game's substep system ran.
+#[derive(Resource, Default)]
+struct SubstepCalls(u32);
+
+/// A game system between two stages: adds no force, only counts.
+fn count_substeps(mut calls: ResMut<SubstepCalls>, mut cloths: Query<&mut ClothSimulation>) {
+    calls.0 += 1;
+    for mut sim in &mut cloths {
+        sim.solver.add_force(0, Vec3::ZERO);
+    }
+}
+
+/// A game's system put between the stages (`ClothSubstepSystems`) runs once per substep;
+/// without one, the plugin steps each cloth's substeps in one task. Both ways the cloths
+/// end on the same bits.
+#[test]
+fn a_system_between_the_stages_runs_every_substep_and_the_bits_do_not_depend_on_it() {
+    let run = |with_system: bool| {
+        let mut app = app();
+        app.init_resource::<SubstepCalls>();
+        if with_system {
+            app.add_systems(
+                ClothSubstep,
+                count_substeps
+                    .after(ClothSubstepSystems::AccumulateForces)
+                    .before(ClothSubstepSystems::Integrate),
+            );
+        }
+        let params = ClothParams {
+            substeps: Substeps::Fixed(5),
+            ..quiet_params()
+        };
+        let cloths: Vec<Entity> = (0..3)
+            .map(|k| {
+                let cloth = Cloth::grid(6, 5, 0.1).with_params(params);
+                let at = Transform::from_xyz(k as f32, 2.0, 0.0);
+                app.world_mut().spawn((cloth, at, ClothSleep::never())).id()
+            })
+            .collect();
+        for _ in 0..30 {
+            app.update();
+        }
+        let steps = (sim_time(&app, cloths[0]) / 0.016).round() as u32;
+        let positions: Vec<Vec<Vec3>> = cloths
+            .iter()
+            .map(|&e| {
+                let sim = app.world().get::<ClothSimulation>(e).unwrap();
+                sim.solver.positions().to_vec()
+            })
+            .collect();
+        (positions, steps, app.world().resource::<SubstepCalls>().0)
+    };
+    let (alone, steps, none) = run(false);
+    let (with_system, _, calls) = run(true);
+    assert_eq!(none, 0);
+    assert!(steps > 20, "{steps} steps");
+    assert_eq!(calls, 5 * steps, "once per substep");
+    assert_eq!(alone, with_system);
+}

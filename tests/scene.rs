@@ -276,3 +276,24 @@ fn a_box_collider_reads_from_a_scene_and_scales_with_its_transform() {
     let e = ClothScene::parse(&flat, std::path::Path::new("c.ron")).unwrap_err();
     assert!(e.to_string().contains("half_height"), "{e}");
 }
+
+/// The README's quick start is `examples/quickstart.rs` (which `cargo test` compiles),
+/// without the example's doc comment.
+#[test]
+fn the_readme_quick_start_is_the_quickstart_example() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let example = std::fs::read_to_string(format!("{root}/examples/quickstart.rs")).unwrap();
+    let code: String = example
+        .lines()
+        .filter(|l| !l.starts_with("//!"))
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
+    let start = readme.find("```rust\n").expect("a Rust block") + "```rust\n".len();
+    let block = &readme[start..start + readme[start..].find("```").unwrap()];
+    assert_eq!(
+        block,
+        code.trim_start(),
+        "README.md's quick start differs from the example"
+    );
+}

@@ -849,13 +849,55 @@ fn begin_steps(
     }
 }
 
-fn run_substeps(world: &mut World) {
+/// The plugin's own systems in the [`ClothSubstep`] schedule (one per stage).
+const OWN_SUBSTEP_SYSTEMS: usize = 4;
+
+/// Runs the step's substeps. When a game has put systems between the stages
+/// ([`ClothSubstepSystems`]), every substep runs the [`ClothSubstep`] schedule, each
+/// stage over all cloths in parallel. Otherwise each cloth takes all its substeps in one
+/// task on the compute pool: the same calls in the same order per cloth (the same bits),
+/// one fork-join per step instead of four per substep, which is what many small cloths
+/// cost most.
+fn run_substeps(
+    world: &mut World,
+    mut cloths: Local<Option<QueryState<ActiveCloth, Without<ClothInvalid>>>>,
+) {
     let count = world.resource::<ClothSubstepPlan>().count;
-    for index in 0..count {
-        world.resource_mut::<ClothSubstepPlan>().index = index;
-        world.run_schedule(ClothSubstep);
+    if count == 0 {
+        return;
     }
+    let schedules = world.resource::<Schedules>();
+    let others = schedules
+        .get(ClothSubstep)
+        .is_none_or(|s| s.systems_len() != OWN_SUBSTEP_SYSTEMS);
+    if others {
+        for index in 0..count {
+            world.resource_mut::<ClothSubstepPlan>().index = index;
+            world.run_schedule(ClothSubstep);
+        }
+        return;
+    }
+    let env = **world.resource::<ClothEnvironment>();
+    let cloths = cloths.get_or_insert_with(|| world.query_filtered());
+    // The solver's pool, not `Query::par_iter_mut`: on two cores Bevy gives its compute
+    // pool one thread, and `par_iter_mut` then runs on the calling thread alone; a scope
+    // has the calling thread work beside the pool's.
+    let active = cloths.iter_mut(world);
+    solver::task_pool().scope(|scope| {
+        for (mut sim, mut progress) in active {
+            scope.spawn(async move {
+                let start = Instant::now();
+                for _ in 0..progress.substeps {
+                    sim.solver.substep(&env);
+                }
+                progress.elapsed += start.elapsed();
+            });
+        }
+    });
 }
+
+/// A cloth that takes part in the step: its simulation and progress.
+type ActiveCloth = (&'static mut ClothSimulation, &'static mut StepProgress);
 
 /// Runs one solver phase on every cloth that takes part in the current substep, in
 /// parallel, adding the time it took to that cloth's step time.
@@ -873,8 +915,7 @@ fn for_each_active(
     });
 }
 
-type ActiveCloths<'w, 's> =
-    Query<'w, 's, (&'static mut ClothSimulation, &'static mut StepProgress), Without<ClothInvalid>>;
+type ActiveCloths<'w, 's> = Query<'w, 's, ActiveCloth, Without<ClothInvalid>>;
 
 fn accumulate_forces(
     plan: Res<ClothSubstepPlan>,
