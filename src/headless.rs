@@ -165,7 +165,7 @@ pub fn headless_app_in(assets: impl Into<String>) -> App {
             file_path: assets.into(),
             ..default()
         },
-        ClothPlugin::default(),
+        ClothPlugin::default().with_timestep(Duration::from_millis(16)),
     ))
     .init_asset::<Mesh>()
     .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(

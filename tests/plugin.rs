@@ -984,3 +984,18 @@ fn a_system_between_the_stages_runs_every_substep_and_the_bits_do_not_depend_on_
     assert_eq!(calls, 5 * steps, "once per substep");
     assert_eq!(alone, with_system);
 }
+
+/// `ClothPlugin::default()` leaves the game's fixed rate alone; `with_timestep` sets it.
+#[test]
+fn the_plugin_changes_the_fixed_timestep_only_when_asked() {
+    let build = |plugin: ClothPlugin| {
+        let mut app = App::new();
+        app.add_plugins((MinimalPlugins, AssetPlugin::default(), plugin));
+        app.world().resource::<Time<Fixed>>().timestep()
+    };
+    let bevy_default = Time::<Fixed>::default().timestep();
+    assert_eq!(build(ClothPlugin::default()), bevy_default);
+    let asked = std::time::Duration::from_millis(16);
+    assert_ne!(asked, bevy_default);
+    assert_eq!(build(ClothPlugin::default().with_timestep(asked)), asked);
+}

@@ -55,7 +55,7 @@ pub fn app(title: &str, args: ExampleArgs) -> App {
         DefaultPlugins.set(window_plugin(title)),
         EguiPlugin::default(),
         PanOrbitCameraPlugin,
-        ClothPlugin::default(),
+        ClothPlugin::default().with_timestep(std::time::Duration::from_millis(16)),
         ClothControlsPlugin,
         inspector::InspectorPlugin,
         ScreenshotPlugin,
