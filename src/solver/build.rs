@@ -5,7 +5,7 @@ use bevy::math::{Affine3A, Vec3};
 use super::clock::Clock;
 use super::contact::Contact;
 use super::drivers::Drivers;
-use super::fabric::Fabric;
+use super::structure::Structure;
 use super::{ClothSolver, Layout, ModelState, Particles, check_model_fits};
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model};
@@ -29,7 +29,7 @@ impl ClothSolver {
         crate::limits::check_work(count, params)?;
         let mut cloth = ClothSolver {
             particles: Particles::with_len(count),
-            fabric: Fabric::new(layout),
+            structure: Structure::new(layout),
             drivers: Drivers::new(pins, frame),
             contact: Contact::default(),
             clock: Clock::default(),
@@ -59,7 +59,7 @@ impl ClothSolver {
         }
         let mass = self.params.node_mass;
         let p = &mut self.particles;
-        for (i, local) in self.fabric.local_rest.iter().enumerate() {
+        for (i, local) in self.structure.local_rest.iter().enumerate() {
             let x = self.drivers.frame.transform_point3(*local);
             p.position[i] = x;
             p.previous[i] = x;
@@ -71,7 +71,7 @@ impl ClothSolver {
         }
         // Attachments are dropped (their owner attaches again on its next step).
         self.drivers.reset(p);
-        self.fabric.mend();
+        self.structure.mend();
         self.clock.reset();
         self.report = Default::default();
         self.save_checkpoint();
@@ -81,12 +81,12 @@ impl ClothSolver {
     /// already torn or does not exist.
     pub fn tear(&mut self, s: u32) -> bool {
         let k = s as usize;
-        if k >= self.fabric.springs.len() || !self.fabric.springs.alive[k] {
+        if k >= self.structure.springs.len() || !self.structure.springs.alive[k] {
             return false;
         }
         self.disturbed = true;
-        self.fabric.tear(k);
-        self.fabric.torn_count += 1;
+        self.structure.tear(k);
+        self.structure.torn_count += 1;
         true
     }
 
@@ -94,7 +94,7 @@ impl ClothSolver {
     /// 000 §3.2): the models whose springs act on the particles (mass-spring, XPBD).
     pub(super) fn tear_overstretched(&mut self) {
         if let Some(ratio) = self.params.tear_ratio {
-            self.fabric
+            self.structure
                 .tear_overstretched(&self.particles.position, ratio);
         }
     }

@@ -70,7 +70,7 @@ impl ClothSolver {
     /// `springs`; an inextensible family (XPBD's `k = inf`) stores none.
     fn spring_energy(&self, springs: &SpringParams) -> f32 {
         let x = &self.particles.position;
-        let s = &self.fabric.springs;
+        let s = &self.structure.springs;
         let mut energy = 0.0;
         for kind in SpringKind::ALL {
             let k = family_stiffness(springs, kind);
@@ -110,7 +110,7 @@ impl ClothSolver {
     /// Stretch of the whole structural springs.
     pub fn strain(&self) -> Strain {
         let x = &self.particles.position;
-        let s = &self.fabric.springs;
+        let s = &self.structure.springs;
         let mut max = f32::NEG_INFINITY;
         let (mut sum, mut count) = (0.0f32, 0usize);
         for k in s.ranges[SpringKind::Structural as usize].clone() {
@@ -136,13 +136,13 @@ impl ClothSolver {
     /// cloth (whose tasks are the only allocation).
     pub fn normals_into(&self, out: &mut [Vec3]) {
         let x = &self.particles.position;
-        let (triangles, visible) = (&self.fabric.triangles, &self.fabric.triangle_visible);
+        let (triangles, visible) = (&self.structure.triangles, &self.structure.triangle_visible);
         // Gathered per particle over its triangles in increasing order: the same sums, in
         // the same order, as scattering each triangle's normal onto its corners, and a
         // particle's normal is written by one piece only.
         parallel::for_each_indexed(out, |i, n| {
             let mut sum = Vec3::ZERO;
-            for &t in self.fabric.vertex_faces.of(i) {
+            for &t in self.structure.vertex_faces.of(i) {
                 if visible[t as usize] {
                     let [a, b, c] = triangles[t as usize].map(|v| v as usize);
                     sum += (x[b] - x[a]).cross(x[c] - x[a]);

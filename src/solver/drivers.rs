@@ -165,10 +165,10 @@ impl ClothSolver {
         } else {
             1.0
         };
-        let seams = self.fabric.springs.ranges[SpringKind::Seam as usize].clone();
-        for (rest, &start) in self.fabric.springs.rest_length[seams]
+        let seams = self.structure.springs.ranges[SpringKind::Seam as usize].clone();
+        for (rest, &start) in self.structure.springs.rest_length[seams]
             .iter_mut()
-            .zip(&self.fabric.seam_start)
+            .zip(&self.structure.seam_start)
         {
             *rest = start + (s.seam_rest_length - start) * progress;
         }
@@ -176,7 +176,7 @@ impl ClothSolver {
 
     /// True while the seams of a garment are still being sewn (see `sew_time`).
     pub fn sewing(&self) -> bool {
-        !self.fabric.seam_start.is_empty()
+        !self.structure.seam_start.is_empty()
             && self.clock.time < self.params.springs.sew_time
             && self.params.springs.seam.effective() > 0.0
     }

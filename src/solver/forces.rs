@@ -48,9 +48,9 @@ impl ClothSolver {
     /// Adds every acting spring's force (on a grid, by its stencil, `lattice.rs`).
     pub(super) fn spring_forces(&mut self) {
         let damping = self.params.springs.damping;
-        if self.fabric.stencil.is_some() {
+        if self.structure.stencil.is_some() {
             let k = SpringKind::ALL.map(|kind| self.stiffness(kind));
-            if let Some(stencil) = &mut self.fabric.stencil {
+            if let Some(stencil) = &mut self.structure.stencil {
                 stencil.spring_forces(&mut self.particles, |kind| k[kind as usize], damping);
             }
             return;
@@ -60,11 +60,11 @@ impl ClothSolver {
             if k == 0.0 {
                 continue;
             }
-            let range = self.fabric.springs.ranges[kind as usize].clone();
+            let range = self.structure.springs.ranges[kind as usize].clone();
             // A particle cloth's springs all take their family's constant; only the patch
             // model's part lattice scales them one by one. Two instances of one loop, so
             // the common case reads no per-spring factor.
-            let (s, p) = (&self.fabric.springs, &mut self.particles);
+            let (s, p) = (&self.structure.springs, &mut self.particles);
             match s.stiffness_scale.as_deref() {
                 None => spring_forces(s, p, range, k, damping, |_| 1.0),
                 Some(scale) => spring_forces(s, p, range, k, damping, |i| scale[i]),

@@ -96,12 +96,12 @@ impl ClothSolver {
     /// faces along them stop being drawn.
     pub fn cut(&mut self, a: Vec3, b: Vec3, c: Vec3) -> usize {
         let mut count = 0;
-        for s in 0..self.fabric.springs.len() {
-            if !self.fabric.springs.alive[s] {
+        for s in 0..self.structure.springs.len() {
+            if !self.structure.springs.alive[s] {
                 continue;
             }
-            let p = self.particles.position[self.fabric.springs.a[s] as usize];
-            let q = self.particles.position[self.fabric.springs.b[s] as usize];
+            let p = self.particles.position[self.structure.springs.a[s] as usize];
+            let q = self.particles.position[self.structure.springs.b[s] as usize];
             if segment_crosses_triangle(p, q, a, b, c) && self.tear(s as u32) {
                 count += 1;
             }

@@ -3,7 +3,7 @@
 //!
 //! A step is a pipeline of stages (`steps/mod.rs` describes it; one file per model under
 //! `steps/`). A cloth's state is kept by concern: its particles ([`Particles`]), what it
-//! is made of (`fabric.rs`), what holds it from outside (`drivers.rs`), what it touches
+//! is made of (`structure.rs`), what holds it from outside (`drivers.rs`), what it touches
 //! (`contact.rs`), its clock (`clock.rs`) and the active model's own state.
 
 mod build;
@@ -12,7 +12,6 @@ mod collide;
 mod contact;
 mod diagnostics;
 mod drivers;
-mod fabric;
 mod forces;
 mod integrate;
 mod interact;
@@ -24,6 +23,7 @@ mod queries;
 pub mod shape_matching;
 mod state;
 mod steps;
+mod structure;
 mod substeps;
 mod switch;
 mod tethers;
@@ -53,7 +53,7 @@ pub struct ClothSolver {
     /// Every particle's state.
     particles: Particles,
     /// Rest shape, springs, faces, pieces, tears.
-    fabric: fabric::Fabric,
+    structure: structure::Structure,
     /// Pins, attachments, the frame, a grab.
     drivers: drivers::Drivers,
     /// Colliders and the contact stage's scratch.
@@ -128,7 +128,7 @@ impl ClothSolver {
     /// refused with an error and the old parameters stay.
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
-        check_model_fits(params, self.fabric.grid)?;
+        check_model_fits(params, self.structure.grid)?;
         crate::limits::check_work(self.particles.len(), params)?;
         self.apply_params(params);
         Ok(())

@@ -275,7 +275,7 @@ impl Patches {
             frame,
         )?;
         parts.particles.lump = split.lumps;
-        scale_for_aspect(&mut parts.fabric.springs, nx, part_size);
+        scale_for_aspect(&mut parts.structure.springs, nx, part_size);
         parts.reset();
         let targets: Vec<Vec3> = local_rest
             .iter()

@@ -58,27 +58,27 @@ impl ClothSolver {
 
     /// The springs, torn ones included (see `Springs::alive`).
     pub fn springs(&self) -> &Springs {
-        &self.fabric.springs
+        &self.structure.springs
     }
 
     /// All triangles, hidden ones included.
     pub fn triangles(&self) -> &[[u32; 3]] {
-        &self.fabric.triangles
+        &self.structure.triangles
     }
 
     /// For each triangle, the springs along its edges (`u32::MAX` where none).
     pub fn triangle_springs(&self) -> &[[u32; 3]] {
-        &self.fabric.triangle_springs
+        &self.structure.triangle_springs
     }
 
     /// Whether each triangle is still drawn (false once a spring on its edge tore).
     pub fn triangle_visible(&self) -> &[bool] {
-        &self.fabric.triangle_visible
+        &self.structure.triangle_visible
     }
 
     /// True once after faces were hidden (or on a new cloth); clears the flag.
     pub fn take_faces_changed(&mut self) -> bool {
-        std::mem::take(&mut self.fabric.faces_changed)
+        std::mem::take(&mut self.structure.faces_changed)
     }
 
     /// The indices of the pinned particles.
@@ -89,12 +89,12 @@ impl ClothSolver {
     /// The name and particle range of each garment piece (one range holding every
     /// particle for other cloths).
     pub fn pieces(&self) -> &[(String, std::ops::Range<u32>)] {
-        &self.fabric.pieces
+        &self.structure.pieces
     }
 
     /// The particles of the named run (a garment file's `runs`), or `None`.
     pub fn run(&self, name: &str) -> Option<&[u32]> {
-        self.fabric
+        self.structure
             .runs
             .iter()
             .find(|(n, _)| n == name)
@@ -103,7 +103,7 @@ impl ClothSolver {
 
     /// `(width, height)` for a grid cloth.
     pub fn grid_size(&self) -> Option<(u32, u32)> {
-        self.fabric.grid
+        self.structure.grid
     }
 
     /// Number of particles.
@@ -120,9 +120,9 @@ impl ClothSolver {
             .into_iter()
             .filter(|&k| self.stiffness(k) > 0.0)
             .map(|k| {
-                self.fabric.springs.ranges[k as usize]
+                self.structure.springs.ranges[k as usize]
                     .clone()
-                    .filter(|&s| self.fabric.springs.alive[s])
+                    .filter(|&s| self.structure.springs.alive[s])
                     .count()
             })
             .sum()
@@ -130,12 +130,12 @@ impl ClothSolver {
 
     /// The springs torn by the last `end_step`.
     pub fn last_torn(&self) -> &[u32] {
-        &self.fabric.torn_this_step
+        &self.structure.torn_this_step
     }
 
     /// Number of springs torn since the last reset.
     pub fn torn_count(&self) -> usize {
-        self.fabric.torn_count + self.model.patches().map_or(0, Patches::torn_count)
+        self.structure.torn_count + self.model.patches().map_or(0, Patches::torn_count)
     }
 
     /// Simulated time since the last reset, in s.

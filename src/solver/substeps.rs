@@ -154,8 +154,8 @@ impl ClothSolver {
     /// substeps with `h ≤ √(target · L / (2 R g))`.
     pub(super) fn xpbd_substeps(&self, dt: f32, target: f32) -> u32 {
         const G: f32 = 9.81;
-        let size = super::collide::Bounds::around(&self.fabric.local_rest).size();
-        let l = self.fabric.length_scale.max(f32::EPSILON);
+        let size = super::collide::Bounds::around(&self.structure.local_rest).size();
+        let l = self.structure.length_scale.max(f32::EPSILON);
         let across = size.max_element().max(l) / l;
         let h = (target * l / (2.0 * across * G)).sqrt();
         let n = (dt / h).ceil();
@@ -211,7 +211,7 @@ impl ClothSolver {
     /// when none is stretched).
     pub(super) fn structural_strain(&self) -> f32 {
         let (x, w) = (&self.particles.position, &self.particles.inv_mass);
-        let s = &self.fabric.springs;
+        let s = &self.structure.springs;
         let mut worst = 0.0f32;
         for k in s.ranges[SpringKind::Structural as usize].clone() {
             let (a, b) = (s.a[k] as usize, s.b[k] as usize);
@@ -256,7 +256,7 @@ impl ClothSolver {
     /// most failures of a crumpled cloth at p = 0.5 and 3 went away at 4× the substeps.)
     fn pull_omega2(&self, targets: &[Vec3], stiffness: f32, exponent: f32) -> f32 {
         let p = &self.particles;
-        let l = self.fabric.length_scale;
+        let l = self.structure.length_scale;
         (0..p.len())
             .filter(|&i| p.inv_mass[i] > 0.0)
             .map(|i| {
@@ -290,7 +290,7 @@ impl ClothSolver {
     /// (`c I`, see [`Self::lattice_eigenvalue`]) the lightest, softest one went unstable.
     fn spring_frequency(&self) -> (f32, f32) {
         let (omega2_bound, gamma_bound) = self.spring_gershgorin();
-        if self.fabric.grid.is_none() {
+        if self.structure.grid.is_none() {
             return (omega2_bound, gamma_bound);
         }
         let damping = self.params.springs.damping;
@@ -329,10 +329,10 @@ impl ClothSolver {
             if k == 0.0 && c == 0.0 {
                 continue;
             }
-            for s in self.fabric.springs.ranges[kind as usize].clone() {
-                if self.fabric.springs.alive[s] {
-                    for p in [self.fabric.springs.a[s], self.fabric.springs.b[s]] {
-                        k_sum[p as usize] += k * self.fabric.springs.scale(s);
+            for s in self.structure.springs.ranges[kind as usize].clone() {
+                if self.structure.springs.alive[s] {
+                    for p in [self.structure.springs.a[s], self.structure.springs.b[s]] {
+                        k_sum[p as usize] += k * self.structure.springs.scale(s);
                         c_sum[p as usize] += c;
                     }
                 }
@@ -409,7 +409,7 @@ impl ClothSolver {
         coefficient: impl Fn(SpringKind) -> f32,
         transverse: bool,
     ) -> Vec<(usize, usize, Vec3, f32, f32)> {
-        let (p, s) = (&self.particles, &self.fabric.springs);
+        let (p, s) = (&self.particles, &self.structure.springs);
         SpringKind::ALL
             .into_iter()
             .map(|kind| (kind, coefficient(kind)))

@@ -43,7 +43,7 @@ impl ClothSolver {
     /// within `(1 + limit + tolerance)·l0`.
     fn limit_strain(&mut self, limit: f32, h: f32) {
         let sweeps = self.params.strain_limit_iterations;
-        if let Some(stencil) = &mut self.fabric.stencil {
+        if let Some(stencil) = &mut self.structure.stencil {
             let springs = self.params.springs;
             let enabled = |kind| match kind {
                 SpringKind::Structural => springs.structural.enabled,
@@ -78,7 +78,7 @@ impl ClothSolver {
     /// spring was longer than `past·l0` (not yet converged); the fixed-sweep limiter
     /// compiles without that test.
     fn limit_strain_sweep<const TRACK: bool>(&mut self, limit: f32, past: f32, h: f32) -> bool {
-        let s = &self.fabric.springs;
+        let s = &self.structure.springs;
         let p = &mut self.particles;
         let mut unconverged = false;
         for kind in [SpringKind::Structural, SpringKind::Shear] {

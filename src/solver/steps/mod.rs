@@ -219,8 +219,8 @@ impl ClothSolver {
         let ratio = self.clock.begin(dt, n);
         steps.begin(self, dt, ratio);
         let p = &self.particles.position;
-        self.drivers.begin_step(p, &self.fabric.local_rest);
-        self.fabric.torn_this_step.clear();
+        self.drivers.begin_step(p, &self.structure.local_rest);
+        self.structure.torn_this_step.clear();
         self.contact
             .collider_impulses
             .fill(super::collide::ColliderImpulse::default());
@@ -318,7 +318,7 @@ impl ClothSolver {
         } else {
             self.restore_checkpoint();
         }
-        self.report.torn = self.fabric.torn_this_step.len()
+        self.report.torn = self.structure.torn_this_step.len()
             + self
                 .model
                 .patches()

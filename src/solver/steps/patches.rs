@@ -73,7 +73,7 @@ impl ModelSteps for PatchParams {
         if self.tiles {
             return;
         }
-        let (l, exponent) = (cloth.fabric.length_scale, self.exponent);
+        let (l, exponent) = (cloth.structure.length_scale, self.exponent);
         let p = &mut cloth.particles;
         let (targets, target_velocity) = (&patches.targets, &patches.target_velocity);
         let (x, v, mass) = (&p.position, &p.velocity, &p.mass);
@@ -137,18 +137,18 @@ impl ModelSteps for PatchParams {
             return;
         };
         patches.parts.end_step();
-        let lattice = &patches.parts.fabric.springs;
-        let fabric = &mut cloth.fabric;
+        let lattice = &patches.parts.structure.springs;
+        let structure = &mut cloth.structure;
         for &k in patches.parts.last_torn() {
             let (a, b) = (
                 lattice.a[k as usize] as usize,
                 lattice.b[k as usize] as usize,
             );
-            for (t, tri) in fabric.triangles.iter().enumerate() {
+            for (t, tri) in structure.triangles.iter().enumerate() {
                 let parts = tri.map(|v| patches.part_of(v));
                 if parts.contains(&a) && parts.contains(&b) {
-                    fabric.triangle_visible[t] = false;
-                    fabric.faces_changed = true;
+                    structure.triangle_visible[t] = false;
+                    structure.faces_changed = true;
                 }
             }
         }
@@ -158,10 +158,10 @@ impl ModelSteps for PatchParams {
 /// A part lattice for the cloth's rest shape and pins, taking over the particles' motion
 /// (`None` for a cloth that is not a grid).
 fn build_lattice(cloth: &ClothSolver, patch: &PatchParams) -> Option<Patches> {
-    let grid = cloth.fabric.grid?;
+    let grid = cloth.structure.grid?;
     let pins = &cloth.drivers.pins;
     let frame = cloth.drivers.frame;
-    let local = &cloth.fabric.local_rest;
+    let local = &cloth.structure.local_rest;
     let mut patches = Patches::new(local, grid, pins, &cloth.params, patch, frame).ok()?;
     let moved = cloth.clock.time > 0.0;
     patches.adopt_state(&cloth.particles, pins, cloth.clock.last_h, patch, moved);

@@ -20,9 +20,9 @@ impl ModelSteps for ShapeMatchingParams {
             .is_none_or(|s| s.built_for != k);
         if built {
             let state = ShapeMatching::new(
-                &cloth.fabric.local_rest,
+                &cloth.structure.local_rest,
                 &cloth.particles.mass,
-                cloth.fabric.grid,
+                cloth.structure.grid,
                 k,
             );
             cloth.model = ModelState::ShapeMatching(state);
@@ -86,7 +86,7 @@ fn goal_forces(cloth: &mut ClothSolver, sm: &ShapeMatchingParams) {
     let (Some(state), true) = (cloth.model.shape_matching(), force_update) else {
         return;
     };
-    let (l, exponent) = (cloth.fabric.length_scale, sm.exponent);
+    let (l, exponent) = (cloth.structure.length_scale, sm.exponent);
     if exponent == 1.0 {
         // The offsets already sum to zero (mean removed per cluster).
         for i in 0..p.position.len() {

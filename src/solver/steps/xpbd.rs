@@ -16,8 +16,8 @@ impl ModelSteps for XpbdParams {
         if !matches!(cloth.model, ModelState::Xpbd(_)) {
             let n = cloth.particles.len();
             // A grid is projected on its stencil: no constraint lists.
-            let general = cloth.fabric.stencil.is_none();
-            let constraints = xpbd::Constraints::new(&cloth.fabric.springs, n, general);
+            let general = cloth.structure.stencil.is_none();
+            let constraints = xpbd::Constraints::new(&cloth.structure.springs, n, general);
             cloth.model = ModelState::Xpbd(Box::new(constraints));
         }
     }
@@ -25,9 +25,9 @@ impl ModelSteps for XpbdParams {
     /// This step's seam lengths, torn springs and pins.
     fn prepare(&self, cloth: &mut ClothSolver, _dt: f32) {
         if let ModelState::Xpbd(constraints) = &mut cloth.model
-            && cloth.fabric.stencil.is_none()
+            && cloth.structure.stencil.is_none()
         {
-            constraints.sync(&cloth.fabric.springs);
+            constraints.sync(&cloth.structure.springs);
         }
         refresh_tethers(cloth, self);
     }
@@ -56,7 +56,7 @@ impl ModelSteps for XpbdParams {
             let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
             xpbd::Family::new(k, springs.damping, h, limit.filter(|_| limited))
         });
-        match &mut cloth.fabric.stencil {
+        match &mut cloth.structure.stencil {
             Some(stencil) => stencil.project_xpbd(&mut cloth.particles, &families, h),
             None => constraints.project(&mut cloth.particles, &families, h),
         }
@@ -85,8 +85,8 @@ fn refresh_tethers(cloth: &mut ClothSolver, params: &XpbdParams) {
     let pins: &[u32] = if on { &cloth.drivers.pins } else { &[] };
     let slack = bounds.iter().flatten().fold(0.0f32, |a, &b| a.max(b));
     constraints.tethers.refresh(
-        &cloth.fabric.springs,
-        cloth.fabric.torn_count,
+        &cloth.structure.springs,
+        cloth.structure.torn_count,
         pins,
         bounds.map(|b| b.is_some()),
         slack,

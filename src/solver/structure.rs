@@ -12,7 +12,7 @@ use super::topology::{self, SpringKind, Springs, VertexFaces};
 
 /// A cloth's make-up (see the module doc).
 #[derive(Clone, Debug)]
-pub(super) struct Fabric {
+pub(super) struct Structure {
     pub springs: Springs,
     /// Particle positions in the cloth's own frame before any motion (for reset, pins).
     pub local_rest: Vec<Vec3>,
@@ -40,7 +40,7 @@ pub(super) struct Fabric {
     pub torn_count: usize,
 }
 
-impl Fabric {
+impl Structure {
     /// The make-up of a validated layout.
     pub fn new(layout: Layout) -> Self {
         let Layout {
@@ -64,7 +64,7 @@ impl Fabric {
         } else {
             springs.rest_length[structural.clone()].iter().sum::<f32>() / structural.len() as f32
         };
-        Fabric {
+        Structure {
             torn_this_step: Vec::with_capacity(springs.len()),
             springs,
             local_rest: local,
