@@ -3,10 +3,11 @@
 //! plugin in an [`App`] with no window and manual time ([`headless_app`], for App tests
 //! and frame timings).
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bevy::asset::AssetPlugin;
 use bevy::mesh::Mesh;
+use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;

@@ -15,12 +15,13 @@
 //! `.after(ClothSubstepSystems::AccumulateForces).before(ClothSubstepSystems::Integrate)` in
 //! [`ClothSubstep`]. Each phase runs over all cloths in parallel.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bevy::app::FixedUpdate;
 use bevy::asset::{AssetEventSystems, AssetLoadError, LoadState};
 use bevy::ecs::intern::Interned;
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+use bevy::platform::time::Instant;
 use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 

@@ -25,9 +25,10 @@ mod patches;
 mod shape_matching;
 mod xpbd;
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use bevy::math::Vec3;
+use bevy::platform::time::Instant;
 
 use super::{ClothSolver, SpringKind};
 use crate::params::{Environment, Model, Substeps};
