@@ -85,7 +85,7 @@ fn setup(
     let pole = commands
         .spawn((
             Transform::from_xyz(1.0, POLE_TOP * 0.5, 0.0),
-            ClothCollider::capsule(POLE_RADIUS, half_length).with_thickness(0.01),
+            ClothCollider::capsule(POLE_RADIUS, 2.0 * half_length).with_thickness(0.01),
             Carried {
                 radius: 1.0,
                 speed: 0.5,

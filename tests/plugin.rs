@@ -707,7 +707,7 @@ fn a_cloth_lying_on_a_moving_collider_entity_is_carried_along() {
     let platform = app
         .world_mut()
         .spawn((
-            ClothCollider::cuboid(Vec3::new(1.0, 0.1, 1.0)).with_friction(0.8),
+            ClothCollider::cuboid(2.0, 0.2, 2.0).with_friction(0.8),
             Transform::default(),
         ))
         .id();
@@ -998,4 +998,40 @@ fn the_plugin_changes_the_fixed_timestep_only_when_asked() {
     let asked = std::time::Duration::from_millis(16);
     assert_ne!(asked, bevy_default);
     assert_eq!(build(ClothPlugin::default().with_timestep(asked)), asked);
+}
+
+/// Collider constructors take the sizes Bevy's primitives take, and the primitives
+/// convert into the same colliders.
+#[test]
+fn colliders_take_the_sizes_of_bevys_primitives() {
+    let cuboid = ClothCollider::cuboid(2.0, 0.2, 1.0);
+    assert_eq!(
+        cuboid.shape,
+        ColliderKind::Cuboid {
+            half_extents: Vec3::new(1.0, 0.1, 0.5)
+        }
+    );
+    assert_eq!(ClothCollider::from(Cuboid::new(2.0, 0.2, 1.0)), cuboid);
+    let capsule = ClothCollider::capsule(0.1, 0.6);
+    assert_eq!(
+        capsule.shape,
+        ColliderKind::Capsule {
+            radius: 0.1,
+            half_length: 0.3
+        }
+    );
+    assert_eq!(ClothCollider::from(Capsule3d::new(0.1, 0.6)), capsule);
+    let cylinder = ClothCollider::cylinder(0.2, 1.0);
+    assert_eq!(
+        cylinder.shape,
+        ColliderKind::Cylinder {
+            radius: 0.2,
+            half_height: 0.5
+        }
+    );
+    assert_eq!(ClothCollider::from(Cylinder::new(0.2, 1.0)), cylinder);
+    assert_eq!(
+        ClothCollider::from(Sphere::new(0.3)),
+        ClothCollider::sphere(0.3)
+    );
 }

@@ -193,6 +193,35 @@ impl Default for ClothCollider {
     }
 }
 
+impl From<Sphere> for ClothCollider {
+    fn from(s: Sphere) -> Self {
+        Self::sphere(s.radius)
+    }
+}
+
+impl From<Capsule3d> for ClothCollider {
+    fn from(c: Capsule3d) -> Self {
+        Self::capsule(c.radius, 2.0 * c.half_length)
+    }
+}
+
+impl From<Cuboid> for ClothCollider {
+    fn from(c: Cuboid) -> Self {
+        Self::new(ColliderKind::Cuboid {
+            half_extents: c.half_size,
+        })
+    }
+}
+
+impl From<Cylinder> for ClothCollider {
+    fn from(c: Cylinder) -> Self {
+        Self::new(ColliderKind::Cylinder {
+            radius: c.radius,
+            half_height: c.half_height,
+        })
+    }
+}
+
 impl ClothCollider {
     /// The thickness a collider has unless set, m (also avian colliders').
     pub const THICKNESS: f32 = 0.005;
@@ -213,24 +242,29 @@ impl ClothCollider {
         Self::new(ColliderKind::Sphere { radius })
     }
 
-    /// A capsule along local y of `radius` m and axis length `2·half_length` m.
-    pub fn capsule(radius: f32, half_length: f32) -> Self {
+    /// A capsule along local y of `radius` m whose axis segment (without the caps) is
+    /// `length` m long: the sizes Bevy's `Capsule3d::new(radius, length)` and avian's
+    /// `Collider::capsule` take.
+    pub fn capsule(radius: f32, length: f32) -> Self {
         Self::new(ColliderKind::Capsule {
             radius,
-            half_length,
+            half_length: length / 2.0,
         })
     }
 
-    /// A box of `half_extents` m along local x, y and z.
-    pub fn cuboid(half_extents: Vec3) -> Self {
+    /// A box `x_length × y_length × z_length` m about the origin: the sizes Bevy's
+    /// `Cuboid::new` and avian's `Collider::cuboid` take.
+    pub fn cuboid(x_length: f32, y_length: f32, z_length: f32) -> Self {
+        let half_extents = Vec3::new(x_length, y_length, z_length) / 2.0;
         Self::new(ColliderKind::Cuboid { half_extents })
     }
 
-    /// A cylinder along local y of `radius` m and height `2·half_height` m.
-    pub fn cylinder(radius: f32, half_height: f32) -> Self {
+    /// A cylinder along local y of `radius` m and `height` m: the sizes Bevy's
+    /// `Cylinder::new` and avian's `Collider::cylinder` take.
+    pub fn cylinder(radius: f32, height: f32) -> Self {
         Self::new(ColliderKind::Cylinder {
             radius,
-            half_height,
+            half_height: height / 2.0,
         })
     }
 
