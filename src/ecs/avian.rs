@@ -22,6 +22,38 @@ pub struct HullCache {
 }
 
 impl HullCache {
+    /// The hull made from `polyhedron`, the shape named `key`: the kept one, or made now
+    /// and kept; `None` (with a warning, once) for a hull the cloth cannot use.
+    fn get_or_make(
+        &mut self,
+        key: usize,
+        polyhedron: &avian3d::parry::shape::ConvexPolyhedron,
+    ) -> Option<Arc<ConvexHull>> {
+        if let Some((hull, used)) = self.hulls.get_mut(&key) {
+            *used = true;
+            return Some(hull.clone());
+        }
+        let corners = polyhedron.vertices_adj_to_face();
+        let faces = polyhedron
+            .faces()
+            .iter()
+            .map(|f| {
+                let first = f.first_vertex_or_edge as usize;
+                let n = f.num_vertices_or_edges as usize;
+                (f.normal, corners[first..first + n].to_vec())
+            })
+            .collect();
+        let hull = match ConvexHull::new(polyhedron.points().to_vec(), faces) {
+            Ok(hull) => Arc::new(hull),
+            Err(e) => {
+                warn_once!("an avian convex hull the cloth cannot use: {e}");
+                return None;
+            }
+        };
+        self.hulls.insert(key, (hull.clone(), true));
+        Some(hull)
+    }
+
     /// Drops the hulls no collider used since the last call.
     pub fn end_step(&mut self) {
         self.hulls.retain(|_, (_, used)| std::mem::take(used));
@@ -70,33 +102,7 @@ pub fn to_solver_collider(
         // The shape's own allocation names it (avian keeps a scaled shape until the scale
         // changes).
         let key = Arc::as_ptr(&shape.0) as *const () as usize;
-        let hull = match hulls.hulls.get_mut(&key) {
-            Some((hull, used)) => {
-                *used = true;
-                hull.clone()
-            }
-            None => {
-                let corners = polyhedron.vertices_adj_to_face();
-                let faces = polyhedron
-                    .faces()
-                    .iter()
-                    .map(|f| {
-                        let first = f.first_vertex_or_edge as usize;
-                        let n = f.num_vertices_or_edges as usize;
-                        (f.normal, corners[first..first + n].to_vec())
-                    })
-                    .collect();
-                let hull = match ConvexHull::new(polyhedron.points().to_vec(), faces) {
-                    Ok(hull) => Arc::new(hull),
-                    Err(e) => {
-                        warn_once!("an avian convex hull the cloth cannot use: {e}");
-                        return None;
-                    }
-                };
-                hulls.hulls.insert(key, (hull.clone(), true));
-                hull
-            }
-        };
+        let hull = hulls.get_or_make(key, polyhedron)?;
         ColliderShape::Convex {
             center: translation,
             rotation,

@@ -160,57 +160,18 @@ impl Plugin for ClothPlugin {
             self.schedule,
             ClothSystems::Prepare.after(avian3d::prelude::PhysicsSystems::Last),
         );
-        app.register_type::<Cloth>()
-            .register_type::<ClothShape>()
-            .register_type::<Pins>()
-            .register_type::<ClothCollider>()
-            .register_type::<crate::ecs::components::ColliderKind>()
-            .register_type::<ClothParams>()
-            .register_type::<SpringParams>()
-            .register_type::<SpringFamily>()
-            .register_type::<Integrator>()
-            .register_type::<Substeps>()
-            .register_type::<Model>()
-            .register_type::<ShapeMatchingParams>()
-            .register_type::<PatchParams>()
-            .register_type::<crate::params::PatchTargets>()
-            .register_type::<RotationMethod>()
-            .register_type::<GoalUpdate>()
-            .register_type::<Environment>()
-            .register_type::<Wind>()
-            .register_type::<WindField>()
-            .register_type::<ClothEnvironment>()
-            .register_type::<ClothPause>()
-            .init_resource::<ClothEnvironment>()
+        register_types(app);
+        app.init_resource::<ClothEnvironment>()
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
             .init_resource::<PlacedColliders>()
             .add_message::<ClothTorn>()
             .add_message::<ClothWake>()
-            .register_type::<ClothSleep>()
-            .register_type::<ClothLod>()
             .init_asset::<Garment>()
             .register_asset_loader(GarmentLoader)
             .add_systems(Update, watch_garments);
 
-        let mut substep = Schedule::new(ClothSubstep);
-        substep.set_executor(SingleThreadedExecutor::new());
-        substep.configure_sets(
-            (
-                ClothSubstepSystems::AccumulateForces,
-                ClothSubstepSystems::Integrate,
-                ClothSubstepSystems::FitTargets,
-                ClothSubstepSystems::Constrain,
-            )
-                .chain(),
-        );
-        substep.add_systems((
-            accumulate_forces.in_set(ClothSubstepSystems::AccumulateForces),
-            integrate.in_set(ClothSubstepSystems::Integrate),
-            fit_targets.in_set(ClothSubstepSystems::FitTargets),
-            constrain.in_set(ClothSubstepSystems::Constrain),
-        ));
-        app.add_schedule(substep);
+        app.add_schedule(substep_schedule());
 
         app.configure_sets(
             self.schedule,
@@ -253,6 +214,57 @@ impl Plugin for ClothPlugin {
                 .in_set(ClothSystems::Finish),
         );
     }
+}
+
+/// The [`ClothSubstep`] schedule: the four stages in their sets, in order, on one thread
+/// (each stage runs its cloths in parallel itself).
+fn substep_schedule() -> Schedule {
+    let mut substep = Schedule::new(ClothSubstep);
+    substep.set_executor(SingleThreadedExecutor::new());
+    substep.configure_sets(
+        (
+            ClothSubstepSystems::AccumulateForces,
+            ClothSubstepSystems::Integrate,
+            ClothSubstepSystems::FitTargets,
+            ClothSubstepSystems::Constrain,
+        )
+            .chain(),
+    );
+    substep.add_systems((
+        accumulate_forces.in_set(ClothSubstepSystems::AccumulateForces),
+        integrate.in_set(ClothSubstepSystems::Integrate),
+        fit_targets.in_set(ClothSubstepSystems::FitTargets),
+        constrain.in_set(ClothSubstepSystems::Constrain),
+    ));
+    substep
+}
+
+/// Registers the plugin's parameter, shape and component types for reflection (the
+/// inspector, scene files).
+fn register_types(app: &mut App) {
+    app.register_type::<Cloth>()
+        .register_type::<ClothShape>()
+        .register_type::<Pins>()
+        .register_type::<ClothCollider>()
+        .register_type::<crate::ecs::components::ColliderKind>()
+        .register_type::<ClothParams>()
+        .register_type::<SpringParams>()
+        .register_type::<SpringFamily>()
+        .register_type::<Integrator>()
+        .register_type::<Substeps>()
+        .register_type::<Model>()
+        .register_type::<ShapeMatchingParams>()
+        .register_type::<PatchParams>()
+        .register_type::<crate::params::PatchTargets>()
+        .register_type::<RotationMethod>()
+        .register_type::<GoalUpdate>()
+        .register_type::<Environment>()
+        .register_type::<Wind>()
+        .register_type::<WindField>()
+        .register_type::<ClothEnvironment>()
+        .register_type::<ClothPause>()
+        .register_type::<ClothSleep>()
+        .register_type::<ClothLod>();
 }
 
 /// Where a cloth's layout comes from when its description is not enough: the entity's
@@ -854,7 +866,8 @@ fn begin_steps(
     }
 }
 
-/// The plugin's own systems in the [`ClothSubstep`] schedule (one per stage).
+/// The plugin's own systems in the [`ClothSubstep`] schedule (`substep_schedule`'s four, one
+/// per stage).
 const OWN_SUBSTEP_SYSTEMS: usize = 4;
 
 /// Runs the step's substeps. When a game has put systems between the stages
