@@ -51,12 +51,18 @@ impl Contact {
 
     /// Whether a collider that the last [`Contact::replace`] changed or removed reaches
     /// the box `cloth`: only such a change can move the cloth.
+    /// Colliders are compared place by place, in linear time (the plugin places them in
+    /// the same order every step; a reordered list counts as changed, which only wakes).
     pub fn change_reaches(&self, cloth: &Bounds) -> bool {
         let (now, before) = (&self.colliders, &self.colliders_spare);
         let near = |c: &Collider| c.bounds().overlaps(cloth);
-        let changed = now.iter().filter(|c| !before.contains(c));
-        let gone = before.iter().filter(|c| !now.contains(c));
-        changed.chain(gone).any(near)
+        let mut changed = now.iter().zip(before).filter(|(n, b)| n != b);
+        let changed = changed.any(|(n, b)| near(n) || near(b));
+        let added_or_gone = now
+            .iter()
+            .skip(before.len())
+            .chain(before.iter().skip(now.len()));
+        changed || added_or_gone.into_iter().any(near)
     }
 
     /// Places the moving colliders where they are at the end of the current substep:
