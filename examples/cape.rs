@@ -18,6 +18,7 @@ use avian3d::prelude::{
     Collider, Friction, LinearVelocity, LockedAxes, PhysicsPlugins, RigidBody, Rotation,
 };
 use bevy::prelude::*;
+use bevy_cloth::params::{Wind, WindField};
 use bevy_cloth::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 
@@ -51,14 +52,14 @@ struct Runner {
 fn main() {
     let args = common::ExampleArgs::parse("");
     common::app("bevy_cloth — cape", args)
-        .add_plugins(PhysicsPlugins::default())
+        .add_plugins((PhysicsPlugins::default(), ClothAvianPlugin::default()))
         .insert_resource(common::inspector::Help(
             "W/A/S/D or arrows run (the loop after 2 s without) · left-drag orbit · wheel zoom · \
 O/P wind · G gravity · Space pause · N step · R reset · Esc quit",
         ))
         .add_systems(Startup, setup)
         // The character's velocity is set before avian's step (in `FixedPostUpdate`); the
-        // cloth steps after it (`ClothPlugin`'s default with the `avian` feature).
+        // cloth steps after it (`ClothAvianPlugin` orders it so).
         .add_systems(FixedUpdate, run)
         .add_systems(Update, follow)
         .run();
@@ -205,7 +206,7 @@ fn setup(
     let place = Transform::from_translation(start).with_rotation(Quat::from_rotation_y(heading));
     commands.spawn((
         Cloth::grid(CAPE_WIDTH, CAPE_HEIGHT, CAPE_SPACING)
-            .with_pins(Pins::None)
+            .with_pins(ClothPins::None)
             // Light, with air drag enough to fly behind a runner: at 3.5 m/s the drag
             // (0.0012 N·s/m per particle) is 0.86 times the weight of a 0.5 g particle.
             .with_params(ClothParams {

@@ -13,6 +13,7 @@ mod common;
 use bevy::asset::RenderAssetUsages;
 use bevy::prelude::*;
 use bevy::render::render_resource::{Extent3d, TextureDimension, TextureFormat};
+use bevy_cloth::params::{Wind, WindField};
 use bevy_cloth::prelude::*;
 
 /// The flag: particles across and down, and their spacing (m).
@@ -102,7 +103,7 @@ fn setup(
     let edge: Vec<u32> = (0..HEIGHT).map(|j| j * WIDTH).collect();
     commands.spawn((
         Cloth::grid(WIDTH, HEIGHT, SPACING)
-            .with_pins(Pins::None)
+            .with_pins(ClothPins::None)
             .with_params(ClothParams {
                 node_mass: 3e-4,
                 ..default()

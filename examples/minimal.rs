@@ -23,7 +23,7 @@ fn setup(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>
     ));
     commands.spawn((
         // 32×32 particles 5 cm apart; the transform places the middle of the top edge.
-        Cloth::grid(32, 32, 0.05).with_pins(Pins::TopCorners),
+        Cloth::grid(32, 32, 0.05).with_pins(ClothPins::TopCorners),
         MeshMaterial3d(materials.add(StandardMaterial {
             double_sided: true,
             cull_mode: None,

@@ -1,9 +1,13 @@
 //! Typed errors for bad input: they name what is wrong and never panic.
 
+use bevy::reflect::Reflect;
 use thiserror::Error;
 
 /// What can be wrong with a cloth description.
-#[derive(Clone, Debug, Error, PartialEq)]
+///
+/// (Reflected as an opaque value: an inspector shows it whole.)
+#[derive(Clone, Debug, Error, PartialEq, Reflect)]
+#[reflect(opaque, Debug, PartialEq, Clone)]
 pub enum ClothError {
     /// A number outside its allowed range (or not finite).
     #[error("`{field}` must be {expected}, got {value}")]

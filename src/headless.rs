@@ -12,7 +12,7 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
 
-use crate::ecs::plugin::ClothPlugin;
+use crate::ClothPlugin;
 use crate::error::ClothError;
 use crate::params::Environment;
 use crate::scene::ClothScene;

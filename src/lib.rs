@@ -4,7 +4,7 @@
 //! "Model elastične tkanine" (seed 000) and the BMSTU T-shirt course work (seed 002),
 //! with a measured solver that runs the same way in a game, a test and a benchmark.
 //!
-//! Add [`ClothPlugin`](ecs::plugin::ClothPlugin) and spawn a [`Cloth`](ecs::components::Cloth):
+//! Add [`ClothPlugin`] and spawn a [`Cloth`]:
 //!
 //! ```no_run
 //! use bevy::prelude::*;
@@ -19,21 +19,23 @@
 //!
 //! fn setup(mut commands: Commands, mut materials: ResMut<Assets<StandardMaterial>>) {
 //!     commands.spawn((
-//!         Cloth::grid(32, 32, 0.05).with_pins(Pins::TopCorners),
+//!         Cloth::grid(32, 32, 0.05).with_pins(ClothPins::TopCorners),
 //!         MeshMaterial3d(materials.add(StandardMaterial { double_sided: true, cull_mode: None, ..default() })),
 //!         Transform::from_xyz(0.0, 2.0, 0.0),
 //!     ));
 //! }
 //! ```
 //!
-//! Layers, top to bottom: [`scene`] files and Rust builders → [`ecs`] (the
-//! [`Cloth`](ecs::components::Cloth) component, the plugin's systems, mesh write-back) →
-//! [`layout`] (grids, pattern and garment files → a layout) → [`solver`] (pure Rust, no
-//! ECS: [`solver::ClothSolver`] steps a [`solver::Layout`]).
+//! Layers, top to bottom: [`scene`] files and Rust builders → the Bevy layer (the
+//! [`Cloth`] component, [`ClothPlugin`]'s systems, one file per feature, mesh
+//! write-back; its items are at this crate's root) → [`layout`] (grids, pattern and
+//! garment files → a layout) → [`solver`] (pure Rust, no ECS: [`solver::ClothSolver`]
+//! steps a [`solver::Layout`]). [`headless`] runs scenes without a window for tests and
+//! measurements.
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-pub mod ecs;
+mod ecs;
 pub mod error;
 pub mod headless;
 pub mod layout;
@@ -43,22 +45,28 @@ pub mod scene;
 pub mod solver;
 pub mod stats;
 
-/// The types a user needs to add cloth to an app.
+#[cfg(feature = "avian")]
+pub use ecs::avian;
+pub use ecs::*;
+pub use error::ClothError;
+pub use layout::shape::{ClothPins, ClothShape};
+pub use params::ClothParams;
+pub use scene::ClothScene;
+
+/// What a game uses to add cloth: the plugin, the components, the events, the shape,
+/// pins and parameters of a cloth. The model's parameter types (`Model`, `XpbdParams`,
+/// `Wind`, …) are in [`params`], so that their names stay out of a game's namespace.
 pub mod prelude {
-    pub use crate::ecs::components::{
-        AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothCollider, ClothEnvironment,
-        ClothInvalid, ClothLod, ClothPause, ClothSimulation, ClothSleep, ClothStats, ClothTorn,
-        ClothWake, ColliderKind, StatSample,
+    #[cfg(feature = "avian")]
+    pub use crate::ecs::avian::ClothAvianPlugin;
+    pub use crate::ecs::{
+        AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBecameInvalid,
+        ClothBuilt, ClothCollider, ClothControlsPlugin, ClothEnvironment, ClothFellAsleep,
+        ClothInvalid, ClothLod, ClothPause, ClothPlugin, ClothSimulation, ClothSleep, ClothStats,
+        ClothSubstep, ClothSubstepSystems, ClothSystems, ClothTorn, ClothWake,
     };
-    pub use crate::ecs::controls::{ClothControls, ClothControlsPlugin};
-    pub use crate::ecs::plugin::{ClothPlugin, ClothSubstep, ClothSubstepSystems, ClothSystems};
     pub use crate::error::ClothError;
-    pub use crate::headless::{SceneRun, headless_app};
-    pub use crate::layout::shape::{ClothShape, Pins};
-    pub use crate::params::{
-        ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
-        PatchTargets, RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps,
-        Wind, WindField, XpbdParams,
-    };
-    pub use crate::scene::{ClothScene, SceneCloth, SceneCollider, SceneError, SpawnedScene};
+    pub use crate::layout::shape::{ClothPins, ClothShape};
+    pub use crate::params::ClothParams;
+    pub use crate::scene::ClothScene;
 }

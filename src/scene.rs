@@ -23,8 +23,8 @@ use bevy::ecs::name::Name;
 use bevy::ecs::system::Commands;
 use bevy::time::{Fixed, Time};
 
-use crate::ecs::components::{Cloth, ClothCollider, ClothEnvironment, ClothLod, ClothStats};
 use crate::params::Environment;
+use crate::{Cloth, ClothCollider, ClothEnvironment, ClothLod, ClothStats};
 
 /// A scene: the cloths, their world and the timestep.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -100,7 +100,7 @@ pub struct SceneCloth {
     #[serde(default)]
     pub piece_colors: Vec<[f32; 3]>,
     /// Level of detail (a grid cloth's model from its size on screen, see
-    /// [`crate::ecs::components::ClothLod`]) with its default thresholds.
+    /// [`crate::ClothLod`]) with its default thresholds.
     #[serde(default)]
     pub lod: bool,
 }

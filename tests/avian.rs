@@ -8,7 +8,8 @@ mod common;
 use avian3d::prelude::{Collider, Friction};
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy::prelude::{GlobalTransform, Transform};
-use bevy_cloth::ecs::avian::{HullCache, THICKNESS, to_solver_collider};
+use bevy_cloth::avian::{HullCache, THICKNESS, to_solver_collider};
+use bevy_cloth::params::Environment;
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Layout};
 
@@ -151,7 +152,11 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
     // that way for 0.8 s (the cape swings round its side). Every step every cape particle
     // stays outside the body, and while running the cape trails behind it.
     let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((TransformPlugin, PhysicsPlugins::default()));
+    app.add_plugins((
+        TransformPlugin,
+        PhysicsPlugins::default(),
+        ClothAvianPlugin::default(),
+    ));
     // As `App::run` does (avian sets up some of its resources there).
     app.finish();
     app.cleanup();
@@ -175,7 +180,7 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
     let cape = app
         .world_mut()
         .spawn((
-            Cloth::grid(width, height, 0.05).with_pins(Pins::None),
+            Cloth::grid(width, height, 0.05).with_pins(ClothPins::None),
             // The grid hangs from the middle of its top edge, here 2 cm behind the back.
             Transform::from_xyz(0.0, 1.25, radius + 0.02),
             ClothAttachments(vec![ClothAttachment::indices(body, (0..width).collect())]),
@@ -239,6 +244,17 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
 
 #[test]
 fn a_ball_dropped_on_a_hammock_is_held_by_the_cloths_push_back() {
+    hammock_holds_a_ball(false);
+}
+
+/// The same ball, its collider a child entity of its body (avian attaches it to the
+/// body): the push goes to the body.
+#[test]
+fn a_child_colliders_push_reaches_its_body() {
+    hammock_holds_a_ball(true);
+}
+
+fn hammock_holds_a_ball(child_collider: bool) {
     use avian3d::prelude::{Mass, PhysicsPlugins, RigidBody};
     use bevy::prelude::*;
     // A 60 g avian ball (radius 0.1) dropped from 0.3 m onto a 0.75 m square cloth
@@ -249,7 +265,11 @@ fn a_ball_dropped_on_a_hammock_is_held_by_the_cloths_push_back() {
     // air drag (0.02 N·s/m a particle): with the default 0.0005 the ball keeps bouncing
     // (y 0.82–1.0 for the 19 s measured), the reaction reaching it a step late.
     let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((TransformPlugin, PhysicsPlugins::default()));
+    app.add_plugins((
+        TransformPlugin,
+        PhysicsPlugins::default(),
+        ClothAvianPlugin::default(),
+    ));
     app.finish();
     app.cleanup();
     let n = 16;
@@ -257,7 +277,7 @@ fn a_ball_dropped_on_a_hammock_is_held_by_the_cloths_push_back() {
         .world_mut()
         .spawn((
             Cloth::grid(n, n, 0.05)
-                .with_pins(Pins::Indices(vec![0, n - 1, n * (n - 1), n * n - 1]))
+                .with_pins(ClothPins::Indices(vec![0, n - 1, n * (n - 1), n * n - 1]))
                 .with_params(ClothParams {
                     drag: 0.02,
                     ..ClothParams::default()
@@ -267,15 +287,28 @@ fn a_ball_dropped_on_a_hammock_is_held_by_the_cloths_push_back() {
         ))
         .id();
     let mass = 0.06;
-    let ball = app
-        .world_mut()
-        .spawn((
-            RigidBody::Dynamic,
-            Collider::sphere(0.1),
-            Mass(mass),
-            Transform::from_xyz(0.0, 1.3, 0.0),
-        ))
-        .id();
+    let ball = if child_collider {
+        let ball = app
+            .world_mut()
+            .spawn((
+                RigidBody::Dynamic,
+                Mass(mass),
+                Transform::from_xyz(0.0, 1.3, 0.0),
+            ))
+            .id();
+        app.world_mut()
+            .spawn((Collider::sphere(0.1), Transform::default(), ChildOf(ball)));
+        ball
+    } else {
+        app.world_mut()
+            .spawn((
+                RigidBody::Dynamic,
+                Collider::sphere(0.1),
+                Mass(mass),
+                Transform::from_xyz(0.0, 1.3, 0.0),
+            ))
+            .id()
+    };
     let dt = 0.016;
     let mut support = Vec::new();
     let frames = 250;
@@ -311,7 +344,11 @@ fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
     // cloth lying on it: the plugin gives the avian body its motion from its transforms,
     // and friction carries the cloth (less the ~1.6 cm it slips getting up to speed).
     let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((TransformPlugin, PhysicsPlugins::default()));
+    app.add_plugins((
+        TransformPlugin,
+        PhysicsPlugins::default(),
+        ClothAvianPlugin::default(),
+    ));
     app.finish();
     app.cleanup();
     let platform = app
@@ -346,4 +383,101 @@ fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
         "the cloth moved {moved}, the platform {carried}"
     );
     assert!(moved.y.abs() < 3e-3, "stays on top: {moved}");
+}
+
+#[test]
+fn sensors_disabled_colliders_and_other_layers_do_not_touch_the_cloth() {
+    use avian3d::prelude::{ColliderDisabled, CollisionLayers, PhysicsPlugins, RigidBody, Sensor};
+    use bevy::prelude::*;
+    // Five small cloths dropped from 0.3 m, each over its own static box (top at y = 0):
+    // an ordinary box holds its cloth, a sensor, a disabled collider and a box on another
+    // layer let theirs fall through; a cloth with its own layers is held by a box on them.
+    let mut app = bevy_cloth::headless::headless_app();
+    app.add_plugins((
+        TransformPlugin,
+        PhysicsPlugins::default(),
+        ClothAvianPlugin::default(),
+    ));
+    app.finish();
+    app.cleanup();
+    let other = CollisionLayers::from_bits(0b10, 0b10);
+    let cases: [(&str, bool); 5] = [
+        ("ordinary", true),
+        ("sensor", false),
+        ("disabled", false),
+        ("another layer", false),
+        ("the cloth's own layer", true),
+    ];
+    let mut cloths = Vec::new();
+    for (k, (name, _)) in cases.iter().enumerate() {
+        let x = 3.0 * k as f32;
+        let mut collider = app.world_mut().spawn((
+            RigidBody::Static,
+            Collider::cuboid(1.0, 0.2, 1.0),
+            Transform::from_xyz(x, -0.1, 0.0),
+        ));
+        match *name {
+            "sensor" => {
+                collider.insert(Sensor);
+            }
+            "disabled" => {
+                collider.insert(ColliderDisabled);
+            }
+            "another layer" | "the cloth's own layer" => {
+                collider.insert(other);
+            }
+            _ => {}
+        }
+        let mut cloth = app
+            .world_mut()
+            .spawn(common::lying_cloth(Vec3::new(x, 0.3, 0.0)));
+        if *name == "the cloth's own layer" {
+            cloth.insert(other);
+        }
+        cloths.push(cloth.id());
+    }
+    for _ in 0..60 {
+        app.update();
+    }
+    for ((name, held), cloth) in cases.iter().zip(cloths) {
+        let y = common::entity_centroid(&app, cloth).y;
+        eprintln!("{name}: the cloth at y = {y}");
+        if *held {
+            assert!(
+                y > 0.0 && y < 0.02,
+                "{name}: held on the box's top, y = {y}"
+            );
+        } else {
+            assert!(y < -1.0, "{name}: fell through, y = {y}");
+        }
+    }
+}
+
+#[test]
+fn the_cloth_falls_under_avians_gravity_unless_told_not_to() {
+    use avian3d::prelude::{Gravity, PhysicsPlugins};
+    use bevy::prelude::*;
+    for follow in [true, false] {
+        let mut app = bevy_cloth::headless::headless_app();
+        app.add_plugins((
+            TransformPlugin,
+            PhysicsPlugins::default(),
+            ClothAvianPlugin {
+                follow_gravity: follow,
+            },
+        ));
+        app.finish();
+        app.cleanup();
+        app.insert_resource(Gravity(Vec3::new(0.0, -1.62, 0.0)));
+        // (The first update's clock has not advanced: no fixed step runs in it.)
+        app.update();
+        app.update();
+        let gravity = app.world().resource::<ClothEnvironment>().gravity;
+        let expected = if follow {
+            Vec3::new(0.0, -1.62, 0.0)
+        } else {
+            Environment::default().gravity
+        };
+        assert_eq!(gravity, expected, "follow_gravity: {follow}");
+    }
 }

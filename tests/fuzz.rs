@@ -11,8 +11,10 @@ use std::path::Path;
 
 use bevy::math::Affine3A;
 use bevy::prelude::*;
+use bevy_cloth::headless::SceneRun;
 use bevy_cloth::layout::garment::GarmentLayout;
 use bevy_cloth::layout::pattern::Pattern;
+use bevy_cloth::params::{Environment, Model, Substeps};
 use bevy_cloth::prelude::*;
 use bevy_cloth::scene::set_field;
 use bevy_cloth::solver::ClothSolver;
@@ -417,7 +419,7 @@ fn random_edits_of_a_running_cloth_never_panic_and_invalid_ones_recover() {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(12, 10, 0.05).with_pins(Pins::TopRow),
+            Cloth::grid(12, 10, 0.05).with_pins(ClothPins::TopRow),
             Transform::from_xyz(0.0, 2.0, 0.0),
         ))
         .id();

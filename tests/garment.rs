@@ -9,6 +9,7 @@ use bevy::prelude::App;
 use bevy_cloth::headless::SceneRun;
 use bevy_cloth::layout::garment::{GarmentLayout, asset_path};
 use bevy_cloth::layout::pattern::{MAX_PATTERN_NODES, Pattern, PatternErrorKind};
+use bevy_cloth::params::{Environment, Model, SpringParams, Substeps, XpbdParams};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Collider, ColliderShape, Layout, SpringKind};
 

@@ -1,6 +1,7 @@
 //! Grab and cut, headless: what the curtain's mouse tools do.
 
 use bevy::math::{Affine3A, Vec3};
+use bevy_cloth::params::{Environment, Model, XpbdParams};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::ClothSolver;
 
@@ -20,7 +21,7 @@ fn curtain_of(model: Model) -> ClothSolver {
         height: 8,
         spacing: 0.1,
     }
-    .build_solver(&Pins::TopRow, &params, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::TopRow, &params, Affine3A::IDENTITY)
     .unwrap()
 }
 

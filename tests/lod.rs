@@ -3,6 +3,7 @@
 
 use bevy::camera::{Camera, PerspectiveProjection, Projection};
 use bevy::prelude::*;
+use bevy_cloth::params::{Environment, Model, PatchParams};
 use bevy_cloth::prelude::*;
 
 fn level(app: &App, e: Entity) -> usize {
@@ -32,7 +33,7 @@ fn scene(distance: f32) -> (App, Entity, Entity) {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(24, 24, 0.05).with_pins(Pins::TopRow),
+            Cloth::grid(24, 24, 0.05).with_pins(ClothPins::TopRow),
             ClothLod::default(),
             ClothSleep::never(),
             Transform::from_xyz(0.0, 2.0, 0.0),
@@ -208,7 +209,11 @@ fn a_settled_cloth_switches_without_a_jump() {
             model: model(from),
             ..ClothParams::default()
         };
-        let build = || shape.build_solver(&Pins::TopRow, &params, frame).unwrap();
+        let build = || {
+            shape
+                .build_solver(&ClothPins::TopRow, &params, frame)
+                .unwrap()
+        };
         let (mut cloth, mut twin) = (build(), build());
         for _ in 0..600 {
             cloth.step(0.016, &env);

@@ -5,6 +5,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use bevy::math::{Affine3A, Vec3};
+use bevy_cloth::params::{Environment, Model, PatchParams, SpringParams, Wind, WindField};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::ClothSolver;
 
@@ -45,7 +46,7 @@ fn grid_cloth(params: &ClothParams) -> ClothSolver {
         spacing: 0.05,
     };
     shape
-        .build_solver(&Pins::TopCorners, params, Affine3A::IDENTITY)
+        .build_solver(&ClothPins::TopCorners, params, Affine3A::IDENTITY)
         .unwrap()
 }
 

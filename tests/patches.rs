@@ -2,6 +2,9 @@
 //! under rigid motion (ghost centres at the edges), tiles, and a hanging curtain.
 
 use bevy::math::{Affine3A, Quat, Vec3};
+use bevy_cloth::params::{
+    Environment, Model, PatchParams, PatchTargets, SpringParams, Substeps, Wind, WindField,
+};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Layout};
 
@@ -15,7 +18,13 @@ fn patch(w: u32, h: u32) -> PatchParams {
     }
 }
 
-fn grid(width: u32, height: u32, params: ClothParams, pins: Pins, frame: Affine3A) -> ClothSolver {
+fn grid(
+    width: u32,
+    height: u32,
+    params: ClothParams,
+    pins: ClothPins,
+    frame: Affine3A,
+) -> ClothSolver {
     ClothShape::Grid {
         width,
         height,
@@ -60,7 +69,7 @@ fn one_by_one_parts_reduce_to_the_mass_spring_model() {
         },
         ..Environment::default()
     };
-    let mut springs = grid(12, 10, base, Pins::TopCorners, Affine3A::IDENTITY);
+    let mut springs = grid(12, 10, base, ClothPins::TopCorners, Affine3A::IDENTITY);
     let mut parts = grid(
         12,
         10,
@@ -68,7 +77,7 @@ fn one_by_one_parts_reduce_to_the_mass_spring_model() {
             model: Model::Patches(patch(1, 1)),
             ..base
         },
-        Pins::TopCorners,
+        ClothPins::TopCorners,
         Affine3A::IDENTITY,
     );
     let mut worst = 0.0f32;
@@ -81,9 +90,9 @@ fn one_by_one_parts_reduce_to_the_mass_spring_model() {
     assert!(worst < 1e-4, "1×1 parts drift {worst} m from mass-spring");
     // And the cloth really moved.
     assert!(
-        springs.positions()[12 * 9]
-            .distance(grid(12, 10, base, Pins::TopCorners, Affine3A::IDENTITY).positions()[12 * 9])
-            > 0.05
+        springs.positions()[12 * 9].distance(
+            grid(12, 10, base, ClothPins::TopCorners, Affine3A::IDENTITY).positions()[12 * 9]
+        ) > 0.05
     );
 }
 
@@ -110,7 +119,7 @@ fn undeformed_targets_are_the_rest_positions() {
                         model: Model::Patches(p),
                         ..ClothParams::default()
                     },
-                    Pins::None,
+                    ClothPins::None,
                     Affine3A::IDENTITY,
                 );
                 let error = max_target_error(&mut c);
@@ -150,7 +159,7 @@ fn rigidly_moved_cloths_have_targets_on_their_particles() {
                     model: Model::Patches(patch(w, h)),
                     ..ClothParams::default()
                 },
-                Pins::None,
+                ClothPins::None,
                 motion,
             );
             let error = max_target_error(&mut c);
@@ -299,7 +308,7 @@ fn switching_to_patches_mid_motion_keeps_the_cloth_in_place_and_grabs_pull_parts
         16,
         12,
         ClothParams::default(),
-        Pins::TopCorners,
+        ClothPins::TopCorners,
         Affine3A::IDENTITY,
     );
     let env = Environment::default();
@@ -340,7 +349,7 @@ fn torn_part_springs_split_the_drawn_cloth() {
         strain_limit: None,
         ..ClothParams::default()
     };
-    let mut c = grid(16, 16, params, Pins::TopRow, Affine3A::IDENTITY);
+    let mut c = grid(16, 16, params, ClothPins::TopRow, Affine3A::IDENTITY);
     let env = Environment {
         gravity: Vec3::new(0.0, -3000.0, 0.0),
         ..Environment::default()
@@ -369,7 +378,7 @@ fn a_free_falling_patch_cloth_falls_like_the_mass_spring_cloth() {
         ..ClothParams::default()
     };
     let env = Environment::default();
-    let start = grid(16, 16, base, Pins::None, Affine3A::IDENTITY)
+    let start = grid(16, 16, base, ClothPins::None, Affine3A::IDENTITY)
         .positions()
         .to_vec();
     for size in [2, 4, 8] {
@@ -380,10 +389,10 @@ fn a_free_falling_patch_cloth_falls_like_the_mass_spring_cloth() {
                 model: Model::Patches(patch(size, size)),
                 ..base
             },
-            Pins::None,
+            ClothPins::None,
             Affine3A::IDENTITY,
         );
-        let mut reference = grid(16, 16, base, Pins::None, Affine3A::IDENTITY);
+        let mut reference = grid(16, 16, base, ClothPins::None, Affine3A::IDENTITY);
         let steps = (1.0 / DT).round() as usize;
         for _ in 0..steps {
             reference.step(DT, &env);
@@ -417,8 +426,8 @@ fn tiles_skip_the_pull_and_take_only_the_lattices_substeps() {
         ..ClothParams::default()
     };
     let env = Environment::default();
-    let mut pulled = grid(16, 16, params(false), Pins::TopRow, Affine3A::IDENTITY);
-    let mut tiled = grid(16, 16, params(true), Pins::TopRow, Affine3A::IDENTITY);
+    let mut pulled = grid(16, 16, params(false), ClothPins::TopRow, Affine3A::IDENTITY);
+    let mut tiled = grid(16, 16, params(true), ClothPins::TopRow, Affine3A::IDENTITY);
     pulled.step(DT, &env);
     tiled.step(DT, &env);
     let lattice = tiled.patches().unwrap().parts.stable_substeps(DT);
@@ -453,7 +462,7 @@ fn a_cloth_one_part_across_resists_stretch_along_that_axis() {
             model: Model::Patches(patch(4, 4)),
             ..ClothParams::default()
         },
-        Pins::None,
+        ClothPins::None,
         Affine3A::IDENTITY,
     );
     let height = |c: &ClothSolver| {
@@ -491,7 +500,7 @@ fn sag(model: Model) -> f32 {
         },
         ..ClothParams::default()
     };
-    let mut c = grid(16, 16, params, Pins::TopRow, Affine3A::IDENTITY);
+    let mut c = grid(16, 16, params, ClothPins::TopRow, Affine3A::IDENTITY);
     let bottom = |c: &ClothSolver| c.positions()[16 * 15..].iter().map(|p| p.y).sum::<f32>() / 16.0;
     let rest = bottom(&c);
     let env = Environment::default();
@@ -539,7 +548,7 @@ fn pins_hold_particles_and_their_parts_swing_about_them() {
             model: Model::Patches(patch(8, 8)),
             ..ClothParams::default()
         },
-        Pins::TopCorners,
+        ClothPins::TopCorners,
         Affine3A::IDENTITY,
     );
     let rest = c.positions().to_vec();
@@ -586,7 +595,7 @@ fn part_centres_meet_the_colliders() {
             model: Model::Patches(patch(4, 4)),
             ..ClothParams::default()
         },
-        Pins::None,
+        ClothPins::None,
         flat,
     );
     c.set_colliders([Collider {

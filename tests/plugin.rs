@@ -5,6 +5,8 @@ mod common;
 use bevy::ecs::message::Messages;
 use bevy::mesh::{Mesh, Mesh3d, VertexAttributeValues};
 use bevy::prelude::*;
+use bevy_cloth::ColliderKind;
+use bevy_cloth::params::{Model, SpringParams, Substeps};
 use bevy_cloth::prelude::*;
 
 fn app() -> App {
@@ -150,7 +152,7 @@ fn gravity_toggle_changes_the_next_step() {
     let mut app = app();
     let e = app
         .world_mut()
-        .spawn(Cloth::grid(4, 4, 0.1).with_pins(Pins::None))
+        .spawn(Cloth::grid(4, 4, 0.1).with_pins(ClothPins::None))
         .id();
     app.world_mut()
         .resource_mut::<ClothEnvironment>()
@@ -210,7 +212,7 @@ fn torn_springs_send_messages() {
         .world_mut()
         .spawn(
             Cloth::grid(5, 5, 0.1)
-                .with_pins(Pins::TopRow)
+                .with_pins(ClothPins::TopRow)
                 .with_params(params),
         )
         .id();
@@ -248,7 +250,7 @@ fn invalid_cloths_are_logged_and_skipped_not_panicked() {
         .id();
     let bad_pin = app
         .world_mut()
-        .spawn(Cloth::grid(4, 4, 0.1).with_pins(Pins::Indices(vec![99])))
+        .spawn(Cloth::grid(4, 4, 0.1).with_pins(ClothPins::Indices(vec![99])))
         .id();
     let tiny = app.world_mut().spawn(Cloth::grid(1, 4, 0.1)).id();
     let good = app.world_mut().spawn(Cloth::grid(4, 4, 0.1)).id();
@@ -456,11 +458,11 @@ fn stiffness_edits_change_the_next_step() {
     let mut app = app();
     let a = app
         .world_mut()
-        .spawn(Cloth::grid(5, 5, 0.1).with_pins(Pins::TopRow))
+        .spawn(Cloth::grid(5, 5, 0.1).with_pins(ClothPins::TopRow))
         .id();
     let b = app
         .world_mut()
-        .spawn(Cloth::grid(5, 5, 0.1).with_pins(Pins::TopRow))
+        .spawn(Cloth::grid(5, 5, 0.1).with_pins(ClothPins::TopRow))
         .id();
     for _ in 0..5 {
         app.update();
@@ -491,7 +493,7 @@ fn collider_entities_keep_cloth_out_and_follow_their_transform() {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(8, 8, 0.05).with_pins(Pins::None),
+            Cloth::grid(8, 8, 0.05).with_pins(ClothPins::None),
             Transform::from_xyz(0.0, 1.0, 0.0)
                 .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
         ))
@@ -637,7 +639,7 @@ fn an_attached_cloth_follows_its_moving_entity_with_no_lag_beyond_a_step() {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(8, 6, 0.05).with_pins(Pins::None),
+            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
             Transform::from_xyz(0.0, 2.0, 0.0),
             ClothAttachments(vec![
                 ClothAttachment::indices(shoulder, vec![0]),
@@ -827,7 +829,7 @@ fn particles_attached_at_local_offsets_go_there_and_follow() {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(8, 6, 0.05).with_pins(Pins::None),
+            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
             Transform::from_xyz(0.0, 1.8, 0.0),
             ClothAttachments(vec![ClothAttachment::at(bar, offsets.clone())]),
         ))
@@ -1034,4 +1036,207 @@ fn colliders_take_the_sizes_of_bevys_primitives() {
         ClothCollider::from(Sphere::new(0.3)),
         ClothCollider::sphere(0.3)
     );
+}
+
+#[test]
+fn planes_and_half_spaces_convert_with_their_normals_and_offsets() {
+    let identity = GlobalTransform::IDENTITY;
+    let plane = |c: ClothCollider| match c.to_world(&identity).shape {
+        bevy_cloth::solver::ColliderShape::Plane { point, normal } => (point, normal),
+        other => panic!("not a plane: {other:?}"),
+    };
+    // Bevy's infinite plane: the solid behind it, like avian's `Collider::half_space`.
+    let tilted = Vec3::new(1.0, 1.0, 0.0).normalize();
+    let (point, normal) = plane(InfinitePlane3d::new(tilted).into());
+    assert!(point.length() < 1e-6 && (normal - tilted).length() < 1e-6);
+    assert_eq!(
+        plane(InfinitePlane3d::new(Vec3::Y).into()),
+        plane(ClothCollider::plane())
+    );
+    // Bevy's half-space is the solid, its normal pointing in: y > 0.5 here, a ceiling.
+    let ceiling = bevy::math::primitives::HalfSpace::new(Vec4::new(0.0, 1.0, 0.0, -0.5));
+    let (point, normal) = plane(ceiling.into());
+    assert!(
+        (point - Vec3::new(0.0, 0.5, 0.0)).length() < 1e-6,
+        "{point}"
+    );
+    assert!((normal - Vec3::NEG_Y).length() < 1e-6, "{normal}");
+    // A zero normal is refused; thickness and friction take their defaults in a file.
+    assert!(
+        ClothCollider::half_space(Vec3::ZERO, 0.0)
+            .validate()
+            .is_err()
+    );
+    let from_file: ClothCollider = ron::from_str("(shape: Sphere(radius: 0.2))").unwrap();
+    assert_eq!(from_file, ClothCollider::sphere(0.2));
+    assert!(
+        ron::from_str::<ClothCollider>("(thickness: 0.01)").is_err(),
+        "no shape"
+    );
+}
+
+/// `value` is registered (with `ReflectComponent` when `component`) and comes back equal
+/// from its reflected copy.
+fn round_trips<T>(app: &App, value: T, component: bool)
+where
+    T: Reflect + FromReflect + TypePath + PartialEq + std::fmt::Debug,
+{
+    let registry = app.world().resource::<AppTypeRegistry>().read();
+    let name = T::type_path();
+    let registration = registry
+        .get(std::any::TypeId::of::<T>())
+        .unwrap_or_else(|| panic!("{name} is not registered"));
+    if component {
+        assert!(
+            registration.data::<ReflectComponent>().is_some(),
+            "{name} has no ReflectComponent"
+        );
+    }
+    let copy = T::from_reflect(value.to_dynamic().as_partial_reflect())
+        .unwrap_or_else(|| panic!("{name} does not come back from reflection"));
+    assert_eq!(copy, value, "{name}");
+}
+
+#[test]
+fn every_public_component_resource_message_and_event_is_reflected_and_registered() {
+    let mut app = app();
+    app.add_plugins(ClothControlsPlugin);
+    let e = Entity::from_raw_u32(7).unwrap();
+    round_trips(&app, Cloth::grid(4, 3, 0.1), true);
+    round_trips(
+        &app,
+        ClothCollider::capsule(0.1, 0.5).with_friction(0.7),
+        true,
+    );
+    round_trips(&app, ClothSleep::never(), true);
+    round_trips(&app, ClothLod::default(), true);
+    round_trips(
+        &app,
+        ClothAttachments(vec![
+            ClothAttachment::nearest(e, Vec3::Y, 3),
+            ClothAttachment::run(e, "collar"),
+        ]),
+        true,
+    );
+    round_trips(
+        &app,
+        ClothInvalid(bevy_cloth::ClothError::EmptyGarment),
+        true,
+    );
+    round_trips(&app, ClothEnvironment::default(), false);
+    round_trips(&app, ClothPause::default(), false);
+    round_trips(&app, bevy_cloth::ClothControls::default(), false);
+    round_trips(&app, bevy_cloth::StatSample::default(), false);
+    round_trips(&app, ClothWake(e), false);
+    round_trips(
+        &app,
+        ClothTorn {
+            cloth: e,
+            spring: 3,
+            particles: [1, 2],
+        },
+        false,
+    );
+    round_trips(&app, ClothAwoke { entity: e }, false);
+    round_trips(&app, ClothFellAsleep { entity: e }, false);
+    round_trips(&app, ClothBuilt { entity: e }, false);
+    round_trips(
+        &app,
+        ClothBecameInvalid {
+            entity: e,
+            error: bevy_cloth::ClothError::EmptyGarment,
+        },
+        false,
+    );
+    // Reflected without their solver state (not reflectable), for inspectors.
+    let registry = app.world().resource::<AppTypeRegistry>().read();
+    for (name, id) in [
+        ("ClothSimulation", std::any::TypeId::of::<ClothSimulation>()),
+        ("ClothStats", std::any::TypeId::of::<ClothStats>()),
+    ] {
+        let registration = registry.get(id).unwrap_or_else(|| panic!("{name}"));
+        assert!(registration.data::<ReflectComponent>().is_some(), "{name}");
+    }
+}
+
+/// What the observers on one cloth saw.
+#[derive(Resource, Default, Debug)]
+struct Seen {
+    built: usize,
+    torn: Vec<u32>,
+    asleep: usize,
+    awoke: usize,
+    invalid: Vec<bevy_cloth::ClothError>,
+}
+
+#[test]
+fn observers_on_a_cloth_see_it_built_torn_asleep_woken_and_invalid() {
+    let mut app = app();
+    app.init_resource::<Seen>();
+    let params = ClothParams {
+        tear_ratio: Some(1.3),
+        strain_limit: None,
+        ..ClothParams::default()
+    };
+    let e = app
+        .world_mut()
+        .spawn(
+            Cloth::grid(5, 5, 0.1)
+                .with_pins(ClothPins::TopRow)
+                .with_params(params),
+        )
+        .observe(|_: On<ClothBuilt>, mut seen: ResMut<Seen>| seen.built += 1)
+        .observe(|torn: On<ClothTorn>, mut seen: ResMut<Seen>| seen.torn.push(torn.spring))
+        .observe(|_: On<ClothFellAsleep>, mut seen: ResMut<Seen>| seen.asleep += 1)
+        .observe(|_: On<ClothAwoke>, mut seen: ResMut<Seen>| seen.awoke += 1)
+        .observe(|bad: On<ClothBecameInvalid>, mut seen: ResMut<Seen>| {
+            seen.invalid.push(bad.error.clone())
+        })
+        .id();
+    // Torn: gravity far past what the springs hold.
+    app.world_mut().resource_mut::<ClothEnvironment>().gravity = Vec3::new(0.0, -30_000.0, 0.0);
+    for _ in 0..30 {
+        app.update();
+    }
+    let torn = app
+        .world()
+        .get::<ClothSimulation>(e)
+        .unwrap()
+        .solver
+        .torn_count();
+    let seen = app.world().resource::<Seen>();
+    assert_eq!(seen.built, 1, "{seen:?}");
+    assert!(
+        !seen.torn.is_empty() && seen.torn.len() == torn,
+        "{seen:?}, {torn} torn"
+    );
+    // Asleep: no gravity, the pieces come to rest within a few seconds and sleep.
+    app.world_mut()
+        .resource_mut::<ClothEnvironment>()
+        .gravity_enabled = false;
+    app.world_mut()
+        .get_mut::<ClothSimulation>(e)
+        .unwrap()
+        .reset();
+    for _ in 0..400 {
+        app.update();
+        if app.world().resource::<Seen>().asleep > 0 {
+            break;
+        }
+    }
+    assert_eq!(app.world().resource::<Seen>().asleep, 1);
+    // Woken by the game's message.
+    app.world_mut().write_message(ClothWake(e));
+    app.update();
+    assert_eq!(app.world().resource::<Seen>().awoke, 1);
+    // Invalid: a negative mass.
+    app.world_mut()
+        .get_mut::<Cloth>(e)
+        .unwrap()
+        .params
+        .node_mass = -1.0;
+    app.update();
+    let seen = app.world().resource::<Seen>();
+    assert_eq!(seen.invalid.len(), 1, "{seen:?}");
+    assert!(app.world().get::<ClothInvalid>(e).is_some());
 }

@@ -3,7 +3,11 @@
 use std::path::Path;
 
 use bevy::prelude::{GlobalTransform, Vec3};
+use bevy_cloth::params::{
+    Integrator, Model, ModelKind, PatchTargets, Substeps, WindField, XpbdParams,
+};
 use bevy_cloth::prelude::*;
+use bevy_cloth::scene::SceneError;
 
 #[test]
 fn shipped_scenes_load() {
@@ -14,7 +18,7 @@ fn shipped_scenes_load() {
     }
     let curtain = ClothScene::load("assets/scenes/curtain.ron").unwrap();
     assert_eq!(curtain.timestep, 0.016);
-    assert_eq!(curtain.cloths[0].cloth.pins, Pins::TopCorners);
+    assert_eq!(curtain.cloths[0].cloth.pins, ClothPins::TopCorners);
 }
 
 fn parse(text: &str) -> Result<ClothScene, SceneError> {
@@ -98,7 +102,7 @@ fn overrides_set_fields_by_path_and_refuse_bad_ones() {
     assert_eq!(cloth.params.substeps, Substeps::Fixed(12));
     assert_eq!(cloth.params.tear_ratio, Some(2.5));
     assert_eq!(cloth.params.integrator, Integrator::SemiImplicitEuler);
-    assert_eq!(cloth.pins, Pins::TopRow);
+    assert_eq!(cloth.pins, ClothPins::TopRow);
     assert!(matches!(cloth.shape, ClothShape::Grid { width: 12, .. }));
     assert_eq!(scene.timestep, 0.01);
 

@@ -2,6 +2,9 @@
 //! degenerate shapes, return to rest, the two rotation methods, the force exponent.
 
 use bevy::math::{Affine3A, Quat, Vec3};
+use bevy_cloth::params::{
+    Environment, GoalUpdate, Model, RotationMethod, ShapeMatchingParams, Wind, WindField,
+};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Layout};
 
@@ -38,7 +41,7 @@ fn sm(rotation: RotationMethod) -> ShapeMatchingParams {
 }
 
 /// A playing card, 6.3 × 8.8 cm, as an 8 × 11 grid, pinned nowhere.
-fn card(params: ShapeMatchingParams, pins: Pins) -> ClothSolver {
+fn card(params: ShapeMatchingParams, pins: ClothPins) -> ClothSolver {
     let cloth = ClothParams {
         model: Model::ShapeMatching(params),
         node_mass: 2e-5,
@@ -82,7 +85,7 @@ fn the_rest_shape_is_a_fixed_point() {
                     clusters,
                     ..sm(rotation)
                 },
-                Pins::None,
+                ClothPins::None,
             );
             let error = goal_error_after(&mut c, Affine3A::IDENTITY);
             assert!(error < 1e-6, "{rotation:?}, {clusters}×{clusters}: {error}");
@@ -104,7 +107,7 @@ fn rigidly_moved_cards_have_goals_on_their_particles() {
                     clusters,
                     ..sm(POLAR)
                 },
-                Pins::None,
+                ClothPins::None,
             );
             let error = goal_error_after(&mut c, motion);
             assert!(
@@ -117,7 +120,7 @@ fn rigidly_moved_cards_have_goals_on_their_particles() {
         // offset turns by the same arc); see `rotation_methods_agree_for_small_rotations`
         // for other axes.
         let about_normal = Affine3A::from_rotation_translation(Quat::from_rotation_z(angle), shift);
-        let mut c = card(sm(QUATERNION), Pins::None);
+        let mut c = card(sm(QUATERNION), ClothPins::None);
         let error = goal_error_after(&mut c, about_normal);
         assert!(
             error < 1e-4 * CARD_SIZE,
@@ -136,7 +139,7 @@ fn degenerate_shapes_give_finite_goals() {
                 ..sm(rotation)
             };
             // A flat card (rank-2 A_pq), turned 180° about an in-plane axis.
-            let mut flat = card(params, Pins::None);
+            let mut flat = card(params, ClothPins::None);
             goal_error_after(&mut flat, Affine3A::from_rotation_x(std::f32::consts::PI));
             assert!(flat.goals().unwrap().iter().all(|g| g.is_finite()));
             // A straight strip of particles (rank-1 A_pq).
@@ -161,7 +164,7 @@ fn degenerate_shapes_give_finite_goals() {
                 "{rotation:?}"
             );
             // A card folded onto itself: the bottom half mirrored onto the top half.
-            let mut folded = card(params, Pins::None);
+            let mut folded = card(params, ClothPins::None);
             let p = folded.particles_mut();
             for x in p.position.iter_mut() {
                 if x.y < -0.045 {
@@ -175,7 +178,7 @@ fn degenerate_shapes_give_finite_goals() {
                 "{rotation:?}, β {beta}"
             );
             // Every particle at one point.
-            let mut collapsed = card(params, Pins::None);
+            let mut collapsed = card(params, ClothPins::None);
             collapsed.particles_mut().position.fill(Vec3::ONE);
             collapsed.update_goals();
             assert!(collapsed.goals().unwrap().iter().all(|g| g.is_finite()));
@@ -217,7 +220,7 @@ fn a_strongly_deformed_card_returns_to_its_rest_shape() {
                 stiffness,
                 ..sm(rotation)
             },
-            Pins::None,
+            ClothPins::None,
         );
         // Crumple it: random offsets of up to a quarter of the card.
         let mut rng = Lcg(3);
@@ -247,8 +250,8 @@ fn method_gap(axis: Vec3, degrees: f32) -> f32 {
         axis.normalize(),
         degrees.to_radians(),
     ));
-    let mut polar = card(sm(POLAR), Pins::None);
-    let mut quaternion = card(sm(QUATERNION), Pins::None);
+    let mut polar = card(sm(POLAR), ClothPins::None);
+    let mut quaternion = card(sm(QUATERNION), ClothPins::None);
     goal_error_after(&mut polar, motion);
     goal_error_after(&mut quaternion, motion);
     let (a, b) = (polar.goals().unwrap(), quaternion.goals().unwrap());
@@ -312,7 +315,7 @@ fn halving_time(exponent: f32, offset: f32) -> f32 {
         ..sm(POLAR)
     };
     let free = 5 * 8 + 4;
-    let pins = Pins::Indices((0..88).filter(|&i| i != free).collect());
+    let pins = ClothPins::Indices((0..88).filter(|&i| i != free).collect());
     let mut c = card(params, pins);
     let env = Environment {
         gravity_enabled: false,
@@ -426,7 +429,7 @@ fn shape_matching_works_with_pins_gravity_and_wind_and_never_tears() {
         height: 11,
         spacing: 0.009,
     }
-    .build_solver(&Pins::Indices(vec![0]), &cloth, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::Indices(vec![0]), &cloth, Affine3A::IDENTITY)
     .unwrap();
     let env = Environment {
         wind: Wind {

@@ -29,7 +29,7 @@ fn sleeping_curtain() -> (App, Entity, Entity) {
         .world_mut()
         .spawn((
             Cloth::grid(6, 5, 0.1)
-                .with_pins(Pins::TopRow)
+                .with_pins(ClothPins::TopRow)
                 .with_params(params),
             ClothStats::default(),
             Transform::from_xyz(0.0, 2.0, 0.0),

@@ -2,6 +2,10 @@
 //! period, energy conservation, rest, tearing, the explicit stability bound.
 
 use bevy::math::{Affine3A, Quat, Vec3};
+use bevy_cloth::params::{
+    Environment, Integrator, Model, PatchParams, SpringFamily, SpringParams, Substeps, Wind,
+    WindField, XpbdParams,
+};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Layout, SpringKind};
 
@@ -55,7 +59,9 @@ fn free_particles_at(integrator: Integrator, substeps: u32, frame: Affine3A) -> 
         height: 2,
         spacing: 0.1,
     };
-    shape.build_solver(&Pins::None, &params, frame).unwrap()
+    shape
+        .build_solver(&ClothPins::None, &params, frame)
+        .unwrap()
 }
 
 #[test]
@@ -181,7 +187,7 @@ fn swinging_cloth(params: &ClothParams) -> ClothSolver {
         height: 8,
         spacing: 0.1,
     }
-    .build_solver(&Pins::TopCorners, params, frame)
+    .build_solver(&ClothPins::TopCorners, params, frame)
     .unwrap()
 }
 
@@ -286,7 +292,7 @@ fn tear_test_cloth(model: Model, tear_ratio: f32, gravity: f32) -> (ClothSolver,
         height: 6,
         spacing: 0.1,
     }
-    .build_solver(&Pins::TopRow, &params, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::TopRow, &params, Affine3A::IDENTITY)
     .unwrap();
     let env = Environment {
         gravity: Vec3::new(0.0, -gravity, 0.0),
@@ -358,7 +364,11 @@ fn seed_002_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
         height: 4,
         spacing: 0.05,
     }
-    .build_solver(&Pins::TopCorners, &params, Affine3A::from_rotation_x(-1.2))
+    .build_solver(
+        &ClothPins::TopCorners,
+        &params,
+        Affine3A::from_rotation_x(-1.2),
+    )
     .unwrap();
     let env = Environment {
         wind: Wind {
@@ -476,7 +486,7 @@ fn grid_topology_matches_the_seed() {
         spacing: 0.1,
     }
     .build_solver(
-        &Pins::TopRow,
+        &ClothPins::TopRow,
         &ClothParams {
             springs: SpringParams {
                 bend_diagonal: SpringFamily::new(10.0),
@@ -518,7 +528,7 @@ fn a_pinned_cloth_at_rest_stays_at_rest_without_gravity() {
         spacing: 0.1,
     }
     .build_solver(
-        &Pins::TopCorners,
+        &ClothPins::TopCorners,
         &conservative(Integrator::Verlet),
         Affine3A::IDENTITY,
     )
@@ -545,7 +555,7 @@ fn bad_parameters_return_their_error() {
         spacing: 0.1,
     };
     let ok = ClothParams::default();
-    let build = |shape: &ClothShape, pins: &Pins, params: &ClothParams| {
+    let build = |shape: &ClothShape, pins: &ClothPins, params: &ClothParams| {
         shape.build_solver(pins, params, Affine3A::IDENTITY).err()
     };
     let field = |e: Option<ClothError>| match e {
@@ -555,7 +565,7 @@ fn bad_parameters_return_their_error() {
     assert_eq!(
         field(build(
             &grid,
-            &Pins::None,
+            &ClothPins::None,
             &ClothParams {
                 node_mass: -1.0,
                 ..ok
@@ -566,7 +576,7 @@ fn bad_parameters_return_their_error() {
     assert_eq!(
         field(build(
             &grid,
-            &Pins::None,
+            &ClothPins::None,
             &ClothParams {
                 node_mass: f32::NAN,
                 ..ok
@@ -577,7 +587,7 @@ fn bad_parameters_return_their_error() {
     assert_eq!(
         field(build(
             &grid,
-            &Pins::None,
+            &ClothPins::None,
             &ClothParams {
                 node_mass: 0.0,
                 ..ok
@@ -588,22 +598,26 @@ fn bad_parameters_return_their_error() {
     let mut stiff = ok;
     stiff.springs.shear.stiffness = -5.0;
     assert_eq!(
-        field(build(&grid, &Pins::None, &stiff)),
+        field(build(&grid, &ClothPins::None, &stiff)),
         "springs.shear.stiffness"
     );
     stiff.springs.shear.stiffness = f32::INFINITY;
     assert_eq!(
-        field(build(&grid, &Pins::None, &stiff)),
+        field(build(&grid, &ClothPins::None, &stiff)),
         "springs.shear.stiffness"
     );
     assert_eq!(
-        field(build(&grid, &Pins::None, &ClothParams { drag: -0.1, ..ok })),
+        field(build(
+            &grid,
+            &ClothPins::None,
+            &ClothParams { drag: -0.1, ..ok }
+        )),
         "drag"
     );
     assert_eq!(
         field(build(
             &grid,
-            &Pins::None,
+            &ClothPins::None,
             &ClothParams {
                 tear_ratio: Some(0.9),
                 ..ok
@@ -614,7 +628,7 @@ fn bad_parameters_return_their_error() {
     assert_eq!(
         field(build(
             &grid,
-            &Pins::None,
+            &ClothPins::None,
             &ClothParams {
                 substeps: Substeps::Fixed(0),
                 ..ok
@@ -628,7 +642,7 @@ fn bad_parameters_return_their_error() {
             height: 4,
             spacing,
         };
-        assert_eq!(field(build(&shape, &Pins::None, &ok)), "shape.spacing");
+        assert_eq!(field(build(&shape, &ClothPins::None, &ok)), "shape.spacing");
     }
     let thin = ClothShape::Grid {
         width: 1,
@@ -636,14 +650,14 @@ fn bad_parameters_return_their_error() {
         spacing: 0.1,
     };
     assert_eq!(
-        build(&thin, &Pins::None, &ok),
+        build(&thin, &ClothPins::None, &ok),
         Some(ClothError::GridTooSmall {
             width: 1,
             height: 5
         })
     );
     assert_eq!(
-        build(&grid, &Pins::Indices(vec![3, 16]), &ok),
+        build(&grid, &ClothPins::Indices(vec![3, 16]), &ok),
         Some(ClothError::PinOutOfRange {
             index: 16,
             count: 16
@@ -651,7 +665,7 @@ fn bad_parameters_return_their_error() {
     );
     // A running cloth refuses bad parameters and keeps its old ones.
     let mut cloth = grid
-        .build_solver(&Pins::None, &ok, Affine3A::IDENTITY)
+        .build_solver(&ClothPins::None, &ok, Affine3A::IDENTITY)
         .unwrap();
     assert!(
         cloth
@@ -693,7 +707,7 @@ fn hang_mesh(positions: &[Vec3], triangles: &[[u32; 3]]) -> (ClothSolver, f32) {
         ..ClothParams::default()
     };
     let layout = Layout::from_mesh(positions, triangles).unwrap();
-    let pins = Pins::TopRow.resolve_for(&layout).unwrap();
+    let pins = ClothPins::TopRow.resolve_for(&layout).unwrap();
     let mut c = ClothSolver::new(layout, &pins, &params, Affine3A::IDENTITY).unwrap();
     for _ in 0..125 {
         c.step(DT, &no_wind());
@@ -761,7 +775,7 @@ fn stencil_and_general_at(params: &ClothParams, at: Vec3) -> (ClothSolver, Cloth
         spacing: 0.05,
     };
     let layout = shape.layout().unwrap();
-    let pins = Pins::TopCorners.resolve_for(&layout).unwrap();
+    let pins = ClothPins::TopCorners.resolve_for(&layout).unwrap();
     let general = Layout {
         grid: None,
         ..layout.clone()
@@ -921,7 +935,7 @@ fn corner_hung_grid_with(width: u32, height: u32, params: &ClothParams) -> Cloth
         height,
         spacing: 0.02,
     }
-    .build_solver(&Pins::TopCorners, params, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::TopCorners, params, Affine3A::IDENTITY)
     .unwrap()
 }
 
@@ -1031,7 +1045,7 @@ fn an_attached_particle_reaches_its_target_every_step_and_falls_when_let_go() {
             height: 6,
             spacing: 0.05,
         }
-        .build_solver(&Pins::None, &params, Affine3A::IDENTITY)
+        .build_solver(&ClothPins::None, &params, Affine3A::IDENTITY)
         .unwrap();
         let env = Environment::default();
         for step in 0..60 {
@@ -1086,7 +1100,7 @@ fn a_step_that_goes_non_finite_reports_it_keeps_the_last_good_state_and_recovers
         height: 8,
         spacing: 0.05,
     }
-    .build_solver(&Pins::TopRow, &sane, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::TopRow, &sane, Affine3A::IDENTITY)
     .unwrap();
     let env = Environment::default();
     for _ in 0..10 {
@@ -1163,7 +1177,7 @@ fn the_step_report_counts_substeps_times_stages_and_measures_xpbd_strain() {
         height: 12,
         spacing: 0.05,
     }
-    .build_solver(&Pins::TopCorners, &params, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::TopCorners, &params, Affine3A::IDENTITY)
     .unwrap();
     let env = Environment::default();
     let mut report = cloth.step(DT, &env);

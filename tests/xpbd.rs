@@ -2,6 +2,7 @@
 //! static stretch, an inextensible chain, a pendulum's period, a free cloth's energy.
 
 use bevy::math::{Affine3A, Vec3};
+use bevy_cloth::params::{Environment, Model, SpringFamily, SpringParams, Substeps, XpbdParams};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Layout};
 
@@ -303,7 +304,7 @@ fn the_energy_of_a_free_undamped_cloth_does_not_grow_over_ten_thousand_steps() {
         spacing: 0.05,
     };
     let mut cloth = shape
-        .build_solver(&Pins::None, &params, Affine3A::IDENTITY)
+        .build_solver(&ClothPins::None, &params, Affine3A::IDENTITY)
         .unwrap();
     for (i, x) in cloth.particles_mut().position.iter_mut().enumerate() {
         let offset = |axis| bevy_cloth::solver::unit_hash(i, axis) * 0.01;
@@ -336,7 +337,7 @@ fn hung_cloth(params: &ClothParams) -> ClothSolver {
         height: 24,
         spacing: 0.05,
     }
-    .build_solver(&Pins::TopRow, params, Affine3A::IDENTITY)
+    .build_solver(&ClothPins::TopRow, params, Affine3A::IDENTITY)
     .unwrap()
 }
 

@@ -4,6 +4,11 @@
 //! Every widget has a range and clamps what is typed into it.
 
 use bevy::prelude::*;
+use bevy_cloth::StatSample;
+use bevy_cloth::params::{
+    Environment, GoalUpdate, Integrator, Model, ModelKind, PatchTargets, RotationMethod,
+    ShapeMatchingParams, SpringFamily, SpringParams, Substeps, WindField,
+};
 use bevy_cloth::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use bevy_inspector_egui::quick::WorldInspectorPlugin;
@@ -357,9 +362,9 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
     egui::ComboBox::from_label("pins")
         .selected_text(format!("{:?}", cloth.pins))
         .show_ui(ui, |ui| {
-            ui.selectable_value(&mut cloth.pins, Pins::TopCorners, "TopCorners");
-            ui.selectable_value(&mut cloth.pins, Pins::TopRow, "TopRow");
-            ui.selectable_value(&mut cloth.pins, Pins::None, "None");
+            ui.selectable_value(&mut cloth.pins, ClothPins::TopCorners, "TopCorners");
+            ui.selectable_value(&mut cloth.pins, ClothPins::TopRow, "TopRow");
+            ui.selectable_value(&mut cloth.pins, ClothPins::None, "None");
         });
     let p = &mut cloth.params;
     let mut grams = p.node_mass * 1e3;

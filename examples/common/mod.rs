@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured, save_to_disk};
+use bevy_cloth::ColliderKind;
 use bevy_cloth::prelude::*;
 use bevy_egui::EguiPlugin;
 use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
@@ -200,6 +201,13 @@ pub fn spawn_scene(
                     half_height,
                 } => Cylinder::new(radius, 2.0 * half_height).mesh().build(),
                 ColliderKind::Plane => Plane3d::default().mesh().size(4.0, 4.0).build(),
+                ColliderKind::HalfSpace { normal, distance } => {
+                    let normal = Dir3::new(normal).unwrap_or(Dir3::Y);
+                    Plane3d::new(*normal, Vec2::splat(2.0))
+                        .mesh()
+                        .build()
+                        .translated_by(*normal * distance)
+                }
             };
             commands.entity(entity).insert((
                 Mesh3d(meshes.add(mesh)),

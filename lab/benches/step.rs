@@ -5,7 +5,7 @@
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
-use bevy_cloth::prelude::Environment;
+use bevy_cloth::params::Environment;
 use bevy_cloth_lab::{SEED_MODELS, bench_cloth};
 
 fn step(c: &mut Criterion) {

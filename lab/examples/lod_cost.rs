@@ -42,7 +42,7 @@ fn run(distance: f32) -> (f32, usize, f32) {
         let cloth = app
             .world_mut()
             .spawn((
-                Cloth::grid(48, 40, 0.04).with_pins(Pins::TopRow),
+                Cloth::grid(48, 40, 0.04).with_pins(ClothPins::TopRow),
                 ClothLod::default(),
                 ClothSleep::never(),
                 Transform::from_xyz(0.0, 2.2, 0.0),

@@ -10,9 +10,8 @@ use std::time::Instant;
 use bevy::math::Affine3A;
 use bevy::prelude::*;
 use bevy_cloth::headless::headless_app;
-use bevy_cloth::prelude::{
-    Cloth, ClothParams, ClothShape, ClothSleep, Environment, Model, Pins, Substeps, XpbdParams,
-};
+use bevy_cloth::params::{Environment, Model, Substeps, XpbdParams};
+use bevy_cloth::prelude::{Cloth, ClothParams, ClothPins, ClothShape, ClothSleep};
 use bevy_cloth_lab::median;
 
 const CLOTHS: usize = 100;
@@ -30,7 +29,7 @@ fn app_ms() -> f64 {
     for k in 0..CLOTHS {
         app.world_mut().spawn((
             Cloth::grid(15, 20, 0.05)
-                .with_pins(Pins::TopRow)
+                .with_pins(ClothPins::TopRow)
                 .with_params(params()),
             Transform::from_xyz((k % 10) as f32, 2.0, (k / 10) as f32),
             ClothSleep::never(),
@@ -59,7 +58,11 @@ fn loop_ms() -> f64 {
         .map(|k| {
             let at = Vec3::new((k % 10) as f32, 2.0, (k / 10) as f32);
             shape
-                .build_solver(&Pins::TopRow, &params(), Affine3A::from_translation(at))
+                .build_solver(
+                    &ClothPins::TopRow,
+                    &params(),
+                    Affine3A::from_translation(at),
+                )
                 .expect("a valid cloth")
         })
         .collect();

@@ -6,6 +6,7 @@
 //! garment would), not the grid's stencil.
 //!
 //! `cargo run -p bevy_cloth_lab --example prof`
+use bevy_cloth::params::{Environment, Substeps};
 use bevy_cloth::prelude::*;
 use std::time::Instant;
 fn main() {
@@ -26,7 +27,7 @@ fn main() {
             spacing: 0.05,
         };
         let mut layout = shape.layout().unwrap();
-        let pins = Pins::TopRow.resolve_for(&layout).unwrap();
+        let pins = ClothPins::TopRow.resolve_for(&layout).unwrap();
         if general {
             layout.grid = None; // the same springs, told it is not a grid
         }

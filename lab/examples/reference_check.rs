@@ -6,6 +6,7 @@
 //!
 //! `cargo run -p bevy_cloth_lab --example reference_check`
 use bevy::math::Vec3;
+use bevy_cloth::params::{Wind, WindField};
 use bevy_cloth::prelude::*;
 use bevy_cloth_lab::accuracy::{Case, REFERENCE_FACTOR};
 

@@ -17,7 +17,7 @@ fn app_with(cloth: bool) -> (App, Option<Entity>) {
     let entity = cloth.then(|| {
         app.world_mut()
             .spawn((
-                Cloth::grid(128, 128, 0.05).with_pins(Pins::TopRow),
+                Cloth::grid(128, 128, 0.05).with_pins(ClothPins::TopRow),
                 Transform::from_xyz(0.0, 2.0, 0.0),
             ))
             .id()

@@ -11,7 +11,7 @@ use std::time::Instant;
 
 use bevy::prelude::*;
 use bevy_cloth::headless::headless_app;
-use bevy_cloth::prelude::{Cloth, ClothSimulation, ClothSleep, Pins};
+use bevy_cloth::prelude::{Cloth, ClothPins, ClothSimulation, ClothSleep};
 use bevy_cloth_lab::median;
 use bevy_cloth_lab::peers::ours_params;
 
@@ -24,7 +24,7 @@ fn main() {
                 .world_mut()
                 .spawn((
                     Cloth::grid(256, 256, 0.05)
-                        .with_pins(Pins::TopRow)
+                        .with_pins(ClothPins::TopRow)
                         .with_params(ours_params(substeps, true)),
                     Transform::from_xyz(0.0, 2.0, 0.0),
                     ClothSleep::never(),

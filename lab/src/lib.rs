@@ -18,7 +18,7 @@ use bevy::math::Affine3A;
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
-use bevy_cloth::layout::shape::{ClothShape, Pins};
+use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{
     ClothParams, Environment, Model, PatchParams, ShapeMatchingParams, XpbdParams,
 };
@@ -137,7 +137,7 @@ impl BenchCell {
 /// 20 N/m material cannot carry a curtain of 128×128 or more from two points, and every
 /// model passed 100% strain within half a second there (mass-spring at step 30), so the
 /// table would time cloths that tear. From the top row a 256×256 curtain holds at 13%.
-pub const BENCH_PINS: Pins = Pins::TopRow;
+pub const BENCH_PINS: ClothPins = ClothPins::TopRow;
 
 /// The timing table's curtain (see [`BENCH_PINS`]).
 pub fn bench_cloth(model: &str, count: usize) -> Result<solver::ClothSolver, ClothError> {
@@ -346,7 +346,7 @@ mod tests {
         };
         let params = seed_model_params("1").unwrap();
         let mut cloth = shape
-            .build_solver(&Pins::TopCorners, &params, Affine3A::IDENTITY)
+            .build_solver(&ClothPins::TopCorners, &params, Affine3A::IDENTITY)
             .unwrap();
         let (times, max_strain, failed) = timed_steps(&mut cloth, &Environment::default(), 3, 9);
         assert_eq!(times.len(), 9);

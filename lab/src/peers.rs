@@ -24,7 +24,7 @@ use bevy::math::{Affine3A, Quat, Vec3};
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
-use bevy_cloth::layout::shape::{ClothShape, Pins};
+use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{ClothParams, Environment, Model, SpringFamily, Substeps, XpbdParams};
 use bevy_cloth::stats::median;
 
@@ -396,7 +396,7 @@ impl Ours {
             _ => Quat::IDENTITY,
         };
         let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
-        let pins = Pins::Indices(hang.pins(side));
+        let pins = ClothPins::Indices(hang.pins(side));
         let cloth = shape
             .build_solver(&pins, &ours_params(substeps, tethers), frame)
             .map_err(|e: ClothError| e.to_string())?;

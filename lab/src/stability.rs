@@ -28,7 +28,7 @@ use bevy::math::{Affine3A, Vec3};
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
-use bevy_cloth::layout::shape::{ClothShape, Pins};
+use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{
     ClothParams, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchParams,
     ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, XpbdParams,
@@ -259,7 +259,7 @@ fn rest_lattice(params: &ClothParams) -> Result<solver::ClothSolver, ClothError>
         height: PROBE_SIZE,
         spacing: SPACING,
     };
-    shape.build_solver(&Pins::None, params, Affine3A::IDENTITY)
+    shape.build_solver(&ClothPins::None, params, Affine3A::IDENTITY)
 }
 
 /// Measures the threshold of cloths from `make` and fills in the table row.
@@ -421,11 +421,11 @@ pub fn regime_cloth(
         height: PROBE_SIZE,
         spacing: SPACING,
     };
-    let free = |p: &ClothParams| shape.build_solver(&Pins::None, p, Affine3A::IDENTITY);
+    let free = |p: &ClothParams| shape.build_solver(&ClothPins::None, p, Affine3A::IDENTITY);
     Ok(match regime {
         Regime::Linear => (probe_cloth(params)?, quiet()),
         Regime::Hanging => {
-            let cloth = shape.build_solver(&Pins::TopCorners, &limited, Affine3A::IDENTITY)?;
+            let cloth = shape.build_solver(&ClothPins::TopCorners, &limited, Affine3A::IDENTITY)?;
             let env = Environment {
                 wind: Wind {
                     strength: 0.0,

@@ -3,6 +3,7 @@
 //! metric of a known displacement, and the full app's frame loop.
 
 use bevy::math::Vec3;
+use bevy_cloth::params::{Integrator, Model, Substeps};
 use bevy_cloth::prelude::*;
 use bevy_cloth_lab::accuracy::{Case, SAMPLE_INTERVAL, Trajectory};
 use bevy_cloth_lab::stability::Regime;

@@ -17,7 +17,7 @@
 use bevy::math::{Quat, Vec3};
 use bevy::prelude::*;
 
-use crate::ecs::components::{ClothEnvironment, ClothPause, ClothSimulation};
+use crate::ecs::cloth::{ClothEnvironment, ClothPause, ClothSimulation};
 
 /// Adds the keyboard controls. Needs a `ButtonInput<KeyCode>` resource (from
 /// `InputPlugin`, part of `DefaultPlugins`).

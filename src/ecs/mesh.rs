@@ -3,6 +3,9 @@
 use bevy::asset::RenderAssetUsages;
 use bevy::math::Vec3;
 use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
+use bevy::prelude::{Assets, Mesh3d, Query, ResMut, Visibility};
+
+use crate::ecs::cloth::ClothSimulation;
 
 use crate::error::ClothError;
 use crate::solver;
@@ -136,4 +139,28 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
         triangles,
         uvs,
     })
+}
+
+/// Writes each stepped cloth's positions and normals into its mesh. A cloth whose own
+/// `Visibility` is `Hidden` is not written; it keeps its new state pending and is
+/// written when shown. (Not for a hidden parent, whose effect is known only where
+/// Bevy's visibility systems run; and not for frustum culling: Bevy takes a mesh's
+/// bounding box from what was written, so an unwritten cloth that swings into view
+/// would stay culled.)
+pub(crate) fn write_meshes(
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut cloths: Query<(&mut ClothSimulation, &Mesh3d, Option<&Visibility>)>,
+) {
+    for (mut sim, mesh3d, visibility) in &mut cloths {
+        if !sim.mesh_dirty || visibility == Some(&Visibility::Hidden) {
+            continue;
+        }
+        let Some(mut mesh) = meshes.get_mut(&mesh3d.0) else {
+            continue;
+        };
+        let sim = &mut *sim;
+        let faces_changed = sim.solver.take_faces_changed();
+        write_mesh(&mut mesh, &sim.solver, &mut sim.normals, faces_changed);
+        sim.mesh_dirty = false;
+    }
 }

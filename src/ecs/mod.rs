@@ -1,10 +1,30 @@
-//! The Bevy layer: the cloth components, `ClothPlugin` with its system sets and systems,
-//! the render mesh written in place, and the opt-in keyboard controls. It owns each
-//! solver inside a component and knows nothing of how a layout is made.
+//! The Bevy layer, one file per feature: the cloth components, `ClothPlugin` with its
+//! system sets and systems, the render mesh written in place, and the opt-in keyboard
+//! controls. It owns each solver inside a component and knows nothing of how a layout is
+//! made. Its public items are re-exported at the crate's root.
 
+pub(crate) mod attach;
 #[cfg(feature = "avian")]
 pub mod avian;
-pub mod components;
-pub mod controls;
-pub mod mesh;
-pub mod plugin;
+pub(crate) mod build;
+pub(crate) mod cloth;
+pub(crate) mod colliders;
+pub(crate) mod controls;
+pub(crate) mod events;
+pub(crate) mod lod;
+pub(crate) mod mesh;
+pub(crate) mod plugin;
+pub(crate) mod sleep;
+pub(crate) mod stats;
+pub(crate) mod step;
+
+pub use attach::{AttachParticles, ClothAttachment, ClothAttachments};
+pub use cloth::{Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation};
+pub use colliders::{ClothCollider, ColliderKind, TELEPORT_SPEED};
+pub use controls::{ClothControls, ClothControlsPlugin};
+pub use events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
+pub use lod::ClothLod;
+pub use plugin::{ClothPlugin, ClothSubstepSystems, ClothSystems};
+pub use sleep::{ClothSleep, ClothWake};
+pub use stats::{ClothStats, StatSample};
+pub use step::{ClothSubstep, ClothSubstepPlan};

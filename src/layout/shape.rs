@@ -90,7 +90,7 @@ impl ClothShape {
     /// The solver cloth of a grid shape, pinned by `pins`, placed by `frame`.
     pub fn build_solver(
         &self,
-        pins: &Pins,
+        pins: &ClothPins,
         params: &ClothParams,
         frame: Affine3A,
     ) -> Result<solver::ClothSolver, ClothError> {
@@ -141,7 +141,7 @@ impl ClothShape {
 /// Which particles are held in place. Pinned particles follow the cloth's frame (for an
 /// entity, its transform), so moving the frame moves the cloth.
 #[derive(Clone, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
-pub enum Pins {
+pub enum ClothPins {
     /// Nothing is pinned: the cloth falls.
     None,
     /// The whole top row of a grid (j = 0).
@@ -153,8 +153,8 @@ pub enum Pins {
     Indices(Vec<u32>),
 }
 
-impl Pins {
-    /// The pinned particle indices of `layout` (see [`Pins::resolve`]).
+impl ClothPins {
+    /// The pinned particle indices of `layout` (see [`ClothPins::resolve`]).
     pub fn resolve_for(&self, layout: &Layout) -> Result<Vec<u32>, ClothError> {
         self.resolve(&layout.positions, layout.grid.map(|g| g.0))
     }
@@ -169,10 +169,10 @@ impl Pins {
     ) -> Result<Vec<u32>, ClothError> {
         let count = positions.len();
         let indices: Vec<u32> = match (self, grid_width) {
-            (Pins::None, _) => Vec::new(),
-            (Pins::TopRow, Some(w)) => (0..w).collect(),
-            (Pins::TopCorners, Some(w)) => vec![0, w - 1],
-            (Pins::TopRow | Pins::TopCorners, None) => {
+            (ClothPins::None, _) => Vec::new(),
+            (ClothPins::TopRow, Some(w)) => (0..w).collect(),
+            (ClothPins::TopCorners, Some(w)) => vec![0, w - 1],
+            (ClothPins::TopRow | ClothPins::TopCorners, None) => {
                 let top = positions
                     .iter()
                     .map(|p| p.y)
@@ -181,7 +181,7 @@ impl Pins {
                 let row: Vec<u32> = (0..count as u32)
                     .filter(|&i| positions[i as usize].y >= top - eps)
                     .collect();
-                if matches!(self, Pins::TopCorners) && row.len() > 2 {
+                if matches!(self, ClothPins::TopCorners) && row.len() > 2 {
                     let by_x = |a: &&u32, b: &&u32| {
                         positions[**a as usize]
                             .x
@@ -194,7 +194,7 @@ impl Pins {
                     row
                 }
             }
-            (Pins::Indices(list), _) => list.clone(),
+            (ClothPins::Indices(list), _) => list.clone(),
         };
         if let Some(&index) = indices.iter().find(|&&i| i as usize >= count) {
             return Err(ClothError::PinOutOfRange { index, count });

@@ -8,7 +8,7 @@ use super::{ClothSolver, SpringKind, family_stiffness};
 use crate::params::{Environment, SpringParams};
 
 /// Energies of a cloth in J, for measurement (see [`ClothSolver::energy`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bevy::reflect::Reflect)]
 pub struct Energy {
     /// `Σ ½ m v²` over free particles.
     pub kinetic: f32,

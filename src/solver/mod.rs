@@ -54,7 +54,7 @@ pub struct ClothSolver {
     particles: Particles,
     /// Rest shape, springs, faces, pieces, tears.
     structure: structure::Structure,
-    /// Pins, attachments, the frame, a grab.
+    /// ClothPins, attachments, the frame, a grab.
     drivers: drivers::Drivers,
     /// Colliders and the contact stage's scratch.
     contact: contact::Contact,

@@ -10,7 +10,7 @@ use bevy_cloth::solver::ClothSolver;
 /// it at the platform's 5 mm thickness and 1 mm.
 pub fn lying_cloth(centre: Vec3) -> (Cloth, Transform) {
     let cloth = Cloth::grid(6, 6, 0.04)
-        .with_pins(Pins::None)
+        .with_pins(ClothPins::None)
         .with_params(ClothParams {
             drag: 0.0,
             ..ClothParams::default()

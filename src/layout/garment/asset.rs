@@ -46,7 +46,7 @@ impl Garment {
 
 /// Loads [`Garment`]s. Only an unreadable garment file fails the load: a malformed
 /// garment or pattern loads (so Bevy watches every file it read) and the cloth built from
-/// it is [`crate::ecs::components::ClothInvalid`] with the file, line and column at fault,
+/// it is [`crate::ClothInvalid`] with the file, line and column at fault,
 /// until an edit fixes it.
 #[derive(TypePath, Default)]
 pub struct GarmentLoader;

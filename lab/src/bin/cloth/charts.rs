@@ -5,7 +5,7 @@
 use std::ops::Range;
 use std::path::Path;
 
-use bevy_cloth::prelude::Integrator;
+use bevy_cloth::params::Integrator;
 use bevy_cloth_lab::accuracy::Row;
 use bevy_cloth_lab::fps::{AppFrame, SEED_002_FPS};
 use bevy_cloth_lab::peers::PeerRow;

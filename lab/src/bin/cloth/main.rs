@@ -45,6 +45,7 @@ use std::process::ExitCode;
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
+use bevy_cloth::params::{Integrator, Model, ModelKind};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver;
 use bevy_cloth_lab::accuracy::{self, Case};

@@ -1,0 +1,224 @@
+//! The cloth itself: the [`Cloth`] description a game spawns, the [`ClothSimulation`] the
+//! plugin adds, why a cloth is not simulated ([`ClothInvalid`]), and the resources every
+//! cloth shares ([`ClothEnvironment`], [`ClothPause`]).
+
+use bevy::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use crate::ecs::colliders::Layers;
+use crate::ecs::events::ClothBecameInvalid;
+use crate::ecs::sleep::ClothSleep;
+use crate::error::ClothError;
+use crate::layout::garment::{GarmentLayout, asset_path};
+use crate::layout::shape::{ClothPins, ClothShape};
+use crate::params::{ClothParams, Environment};
+use crate::solver;
+
+/// A cloth: its shape, its pins and its model parameters. Spawn it on an entity and the
+/// plugin builds the simulation and a mesh for it; the entity's transform places the
+/// cloth and moves its pins.
+///
+/// Edit `params` at run time and the next step uses them; edit `shape` or `pins` and the
+/// cloth is rebuilt.
+///
+/// ```
+/// use bevy_cloth::prelude::*;
+/// let cloth = Cloth::grid(24, 16, 0.05).with_pins(ClothPins::TopRow);
+/// assert!(cloth.validate().is_ok());
+/// ```
+#[derive(Component, Clone, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
+#[reflect(Component, Default)]
+#[require(Transform, Visibility, ClothSleep)]
+#[serde(default, deny_unknown_fields)]
+pub struct Cloth {
+    /// The initial layout.
+    pub shape: ClothShape,
+    /// Which particles are held.
+    pub pins: ClothPins,
+    /// The model's parameters.
+    pub params: ClothParams,
+}
+
+impl Cloth {
+    /// A `width × height` grid with `spacing` m between neighbours, pinned at its top corners.
+    pub fn grid(width: u32, height: u32, spacing: f32) -> Self {
+        Self {
+            shape: ClothShape::Grid {
+                width,
+                height,
+                spacing,
+            },
+            ..default()
+        }
+    }
+
+    /// A cloth made of the entity's own `Mesh3d` (what bevy_silk users know): vertices
+    /// become particles, edges springs. Pinned at its highest vertices by default.
+    pub fn from_mesh() -> Self {
+        Self {
+            shape: ClothShape::Mesh,
+            pins: ClothPins::TopRow,
+            ..default()
+        }
+    }
+
+    /// Replaces the pins.
+    pub fn with_pins(mut self, pins: ClothPins) -> Self {
+        self.pins = pins;
+        self
+    }
+
+    /// Replaces the model parameters.
+    pub fn with_params(mut self, params: ClothParams) -> Self {
+        self.params = params;
+        self
+    }
+
+    /// Checks shape and parameters (pins are checked when the cloth is built, against its
+    /// particle count).
+    pub fn validate(&self) -> Result<(), ClothError> {
+        self.shape.validate()?;
+        self.params.validate()?;
+        // A grid's work per step is known from its size (the others' when built).
+        if let ClothShape::Grid { width, height, .. } = self.shape {
+            crate::limits::check_work(width as usize * height as usize, &self.params)?;
+        }
+        Ok(())
+    }
+
+    /// A garment from a garment file under `assets/` (see [`crate::layout::garment`]), at
+    /// resolution 1, pinned nowhere.
+    pub fn garment(file: impl Into<String>) -> Self {
+        Self {
+            shape: ClothShape::Garment {
+                file: file.into(),
+                resolution: 1,
+            },
+            pins: ClothPins::None,
+            ..default()
+        }
+    }
+
+    /// Builds the solver for this cloth placed by `frame`: grids directly, garments from
+    /// their files read from disk (the plugin loads them as assets instead). Mesh shapes
+    /// are built by the plugin from the entity's mesh.
+    pub fn build(&self, frame: bevy::math::Affine3A) -> Result<solver::ClothSolver, ClothError> {
+        match &self.shape {
+            ClothShape::Garment { file, resolution } => {
+                self.build_garment(GarmentLayout::load(&asset_path(file), *resolution)?, frame)
+            }
+            _ => self.shape.build_solver(&self.pins, &self.params, frame),
+        }
+    }
+
+    /// Builds the solver of a garment cloth from its laid-out garment, logging the
+    /// patterns' warnings.
+    pub fn build_garment(
+        &self,
+        layout: GarmentLayout,
+        frame: bevy::math::Affine3A,
+    ) -> Result<solver::ClothSolver, ClothError> {
+        for warning in &layout.warnings {
+            warn!("{warning}");
+        }
+        if layout.positions.is_empty() || layout.triangles.is_empty() {
+            return Err(ClothError::EmptyGarment);
+        }
+        let layout = layout.into_layout();
+        let pins = self.pins.resolve_for(&layout)?;
+        solver::ClothSolver::new(layout, &pins, &self.params, frame)
+    }
+}
+
+/// The running simulation of a [`Cloth`], added by the plugin. Read it for positions,
+/// energies and statistics; mutate it for tools such as grabbing or cutting.
+///
+/// (Reflected for inspectors without its solver, which is not reflectable.)
+#[derive(Component, Debug, Reflect)]
+#[reflect(Component, Debug, from_reflect = false)]
+pub struct ClothSimulation {
+    /// The solver state.
+    #[reflect(ignore)]
+    pub solver: solver::ClothSolver,
+    /// The shape and pins it was built from (a change of either rebuilds).
+    #[reflect(ignore)]
+    pub(crate) built_from: (ClothShape, ClothPins),
+    /// True when the solver moved since the mesh was last written.
+    pub(crate) mesh_dirty: bool,
+    /// Scratch buffer for normals, kept to avoid allocating per frame.
+    #[reflect(ignore)]
+    pub(crate) normals: Vec<Vec3>,
+    /// The collision layers it meets (avian's `CollisionLayers` on the cloth entity).
+    #[reflect(ignore)]
+    pub(crate) layers: Layers,
+    /// Which of the step's placed colliders each of the solver's colliders is.
+    #[reflect(ignore)]
+    pub(crate) colliders_from: Vec<u32>,
+    /// Wall-clock time of the last fixed step, in ms.
+    pub last_step_ms: f32,
+}
+
+impl ClothSimulation {
+    pub(crate) fn new(solver: solver::ClothSolver, cloth: &Cloth) -> Self {
+        let n = solver.particle_count();
+        Self {
+            solver,
+            built_from: (cloth.shape.clone(), cloth.pins.clone()),
+            mesh_dirty: true,
+            normals: vec![Vec3::ZERO; n],
+            layers: Layers::DEFAULT,
+            colliders_from: Vec::new(),
+            last_step_ms: 0.0,
+        }
+    }
+
+    /// Puts the cloth back at rest in its initial layout, with every spring whole.
+    pub fn reset(&mut self) {
+        self.solver.reset();
+        self.mesh_dirty = true;
+    }
+}
+
+/// Why a cloth is not simulated: the plugin puts this on a cloth whose description is
+/// invalid (and logs it), and removes it once the description is fixed.
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Debug, PartialEq)]
+pub struct ClothInvalid(pub ClothError);
+
+/// Gravity and wind for every cloth.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Reflect, Deref, DerefMut)]
+#[reflect(Resource, Default)]
+pub struct ClothEnvironment(pub Environment);
+
+/// Pauses every cloth; while paused, `step_once` lets exactly one fixed step through.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq, Reflect)]
+#[reflect(Resource, Default)]
+pub struct ClothPause {
+    /// No cloth moves while true (the fixed schedule still runs).
+    pub paused: bool,
+    /// Fixed steps still to run while paused.
+    pub pending_steps: u32,
+}
+
+impl ClothPause {
+    /// Pauses, or resumes.
+    pub fn toggle(&mut self) {
+        self.paused = !self.paused;
+        self.pending_steps = 0;
+    }
+
+    /// While paused, runs one more fixed step.
+    pub fn step_once(&mut self) {
+        if self.paused {
+            self.pending_steps += 1;
+        }
+    }
+}
+
+/// Stops simulating a cloth and says why: logs `error`, marks the entity
+/// [`ClothInvalid`] and triggers [`ClothBecameInvalid`] on it.
+pub(crate) fn pause_invalid(commands: &mut Commands, entity: Entity, error: ClothError) {
+    error!("cloth {entity} is not simulated: {error}");
+    commands.entity(entity).insert(ClothInvalid(error.clone()));
+    commands.trigger(ClothBecameInvalid { entity, error });
+}

@@ -1,0 +1,482 @@
+//! Colliders: the [`ClothCollider`] component, and the system that gives every cloth the
+//! colliders where their entities are now, each with its motion since the last step.
+
+use bevy::prelude::*;
+use bevy::transform::helper::TransformHelper;
+use serde::{Deserialize, Serialize};
+
+use crate::ecs::cloth::ClothSimulation;
+use crate::error::ClothError;
+use crate::solver;
+
+/// A solid the cloths are kept out of, placed by its entity's transform: spheres,
+/// capsules and planes with a thickness and friction. Every cloth collides with every
+/// collider, every substep.
+///
+/// ```
+/// use bevy::prelude::*;
+/// use bevy_cloth::prelude::*;
+/// # let mut world = World::new();
+/// world.spawn((ClothCollider::sphere(0.3), Transform::from_xyz(0.0, 1.0, 0.0)));
+/// world.spawn(ClothCollider::plane().with_friction(0.8)); // the ground, y = 0
+/// ```
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[reflect(Component, Debug, PartialEq)]
+#[require(Transform)]
+#[serde(deny_unknown_fields)]
+pub struct ClothCollider {
+    /// The solid, in the entity's local frame.
+    pub shape: ColliderKind,
+    /// How far outside the surface particles stay, m.
+    #[serde(default = "ClothCollider::default_thickness")]
+    pub thickness: f32,
+    /// Coulomb friction coefficient (0 = ice; a particle sticks on a slope while
+    /// tan θ ≤ friction).
+    #[serde(default = "ClothCollider::default_friction")]
+    pub friction: f32,
+}
+
+/// The solid of a [`ClothCollider`], in its entity's local frame (the same conventions as
+/// Bevy's `Sphere`, `Capsule3d` and `Plane3d` meshes).
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+pub enum ColliderKind {
+    /// A ball about the origin.
+    Sphere {
+        /// Radius, m.
+        radius: f32,
+    },
+    /// A capsule along local y: all points within `radius` of the segment from
+    /// `(0, −half_length, 0)` to `(0, half_length, 0)`.
+    Capsule {
+        /// Radius, m.
+        radius: f32,
+        /// Half the length of the axis segment (without the caps), m.
+        half_length: f32,
+    },
+    /// A box about the origin, `half_extents` along local x, y and z (scaled per axis by
+    /// the transform).
+    Cuboid {
+        /// Half its size along local x, y, z, m.
+        #[serde(with = "crate::params::vec3_serde")]
+        half_extents: Vec3,
+    },
+    /// A cylinder along local y about the origin, `radius` from its axis and
+    /// `half_height` up and down it (Bevy's `Cylinder`).
+    Cylinder {
+        /// Radius, m.
+        radius: f32,
+        /// Half its height, m.
+        half_height: f32,
+    },
+    /// The half-space below the local xz plane (normal +y): a ground or a wall.
+    Plane,
+    /// The half-space `normal · x < distance` (local): behind the plane `distance` m
+    /// from the origin along its outward `normal` (made unit when placed).
+    HalfSpace {
+        /// The plane's normal, pointing out of the solid.
+        #[serde(with = "crate::params::vec3_serde")]
+        normal: Vec3,
+        /// The plane's distance from the origin along `normal`, m.
+        distance: f32,
+    },
+}
+
+impl From<InfinitePlane3d> for ClothCollider {
+    /// The solid behind the plane (its `normal` points out of it), like avian's
+    /// `Collider::half_space`.
+    fn from(p: InfinitePlane3d) -> Self {
+        Self::half_space(*p.normal, 0.0)
+    }
+}
+
+impl From<bevy::math::primitives::HalfSpace> for ClothCollider {
+    /// Bevy's half-space is the solid, its normal pointing into it.
+    fn from(h: bevy::math::primitives::HalfSpace) -> Self {
+        Self::half_space(-Vec3::from(h.normal()), h.d())
+    }
+}
+
+impl From<Sphere> for ClothCollider {
+    fn from(s: Sphere) -> Self {
+        Self::sphere(s.radius)
+    }
+}
+
+impl From<Capsule3d> for ClothCollider {
+    fn from(c: Capsule3d) -> Self {
+        Self::capsule(c.radius, 2.0 * c.half_length)
+    }
+}
+
+impl From<Cuboid> for ClothCollider {
+    fn from(c: Cuboid) -> Self {
+        Self::new(ColliderKind::Cuboid {
+            half_extents: c.half_size,
+        })
+    }
+}
+
+impl From<Cylinder> for ClothCollider {
+    fn from(c: Cylinder) -> Self {
+        Self::new(ColliderKind::Cylinder {
+            radius: c.radius,
+            half_height: c.half_height,
+        })
+    }
+}
+
+impl ClothCollider {
+    /// The thickness a collider has unless set, m (also avian colliders').
+    pub const THICKNESS: f32 = 0.005;
+    /// The friction coefficient a collider has unless set (also avian colliders' without
+    /// a `Friction`).
+    pub const FRICTION: f32 = 0.3;
+
+    fn new(shape: ColliderKind) -> Self {
+        Self {
+            shape,
+            thickness: Self::THICKNESS,
+            friction: Self::FRICTION,
+        }
+    }
+
+    /// A sphere of `radius` m.
+    pub fn sphere(radius: f32) -> Self {
+        Self::new(ColliderKind::Sphere { radius })
+    }
+
+    /// A capsule along local y of `radius` m whose axis segment (without the caps) is
+    /// `length` m long: the sizes Bevy's `Capsule3d::new(radius, length)` and avian's
+    /// `Collider::capsule` take.
+    pub fn capsule(radius: f32, length: f32) -> Self {
+        Self::new(ColliderKind::Capsule {
+            radius,
+            half_length: length / 2.0,
+        })
+    }
+
+    /// A box `x_length × y_length × z_length` m about the origin: the sizes Bevy's
+    /// `Cuboid::new` and avian's `Collider::cuboid` take.
+    pub fn cuboid(x_length: f32, y_length: f32, z_length: f32) -> Self {
+        let half_extents = Vec3::new(x_length, y_length, z_length) / 2.0;
+        Self::new(ColliderKind::Cuboid { half_extents })
+    }
+
+    /// A cylinder along local y of `radius` m and `height` m: the sizes Bevy's
+    /// `Cylinder::new` and avian's `Collider::cylinder` take.
+    pub fn cylinder(radius: f32, height: f32) -> Self {
+        Self::new(ColliderKind::Cylinder {
+            radius,
+            half_height: height / 2.0,
+        })
+    }
+
+    /// A plane through the origin with normal +y (a ground): the solid is below it.
+    pub fn plane() -> Self {
+        Self::new(ColliderKind::Plane)
+    }
+
+    /// The solid `normal · x < distance`, behind the plane `distance` m from the origin
+    /// along its outward `normal`.
+    pub fn half_space(normal: Vec3, distance: f32) -> Self {
+        Self::new(ColliderKind::HalfSpace { normal, distance })
+    }
+
+    fn default_thickness() -> f32 {
+        Self::THICKNESS
+    }
+
+    fn default_friction() -> f32 {
+        Self::FRICTION
+    }
+
+    /// Replaces the thickness (m).
+    pub fn with_thickness(mut self, thickness: f32) -> Self {
+        self.thickness = thickness;
+        self
+    }
+
+    /// Replaces the friction coefficient.
+    pub fn with_friction(mut self, friction: f32) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// Checks sizes: radius > 0, half-length, thickness and friction ≥ 0, each within
+    /// [`crate::limits::MAX_POSITION`].
+    pub fn validate(&self) -> Result<(), ClothError> {
+        use crate::params::check;
+        const MAX: f32 = crate::limits::MAX_POSITION;
+        let size = |field, value: f32, least_excluded: bool, expected| {
+            let low = if least_excluded {
+                value > 0.0
+            } else {
+                value >= 0.0
+            };
+            check(field, value, low && value <= MAX, expected)
+        };
+        let radius = |r: f32| size("radius", r, true, "a radius from 0 (excluded) to 1e5 m");
+        match self.shape {
+            ColliderKind::Sphere { radius: r } => radius(r)?,
+            ColliderKind::Capsule {
+                radius: r,
+                half_length,
+            } => {
+                radius(r)?;
+                size(
+                    "half_length",
+                    half_length,
+                    false,
+                    "a half-length from 0 to 1e5 m",
+                )?;
+            }
+            ColliderKind::Cuboid { half_extents: h } => {
+                for (field, value) in [
+                    ("half_extents.x", h.x),
+                    ("half_extents.y", h.y),
+                    ("half_extents.z", h.z),
+                ] {
+                    size(
+                        field,
+                        value,
+                        true,
+                        "a half-extent from 0 (excluded) to 1e5 m",
+                    )?;
+                }
+            }
+            ColliderKind::Cylinder {
+                radius: r,
+                half_height,
+            } => {
+                radius(r)?;
+                size(
+                    "half_height",
+                    half_height,
+                    true,
+                    "a half-height from 0 (excluded) to 1e5 m",
+                )?;
+            }
+            ColliderKind::Plane => {}
+            ColliderKind::HalfSpace { normal, distance } => {
+                let length = normal.length();
+                check(
+                    "normal",
+                    length,
+                    length.is_finite() && length > 1e-6,
+                    "a finite, non-zero normal",
+                )?;
+                check(
+                    "distance",
+                    distance,
+                    distance.abs() <= MAX,
+                    "a distance within ±1e5 m",
+                )?;
+            }
+        }
+        size(
+            "thickness",
+            self.thickness,
+            false,
+            "a thickness from 0 to 1e5 m",
+        )?;
+        size(
+            "friction",
+            self.friction,
+            false,
+            "a friction coefficient from 0 to 1e5",
+        )
+    }
+
+    /// The collider in world space under `transform` (radii scale with the largest scale
+    /// factor). Negative sizes count as 0.
+    pub fn to_world(&self, transform: &GlobalTransform) -> solver::Collider {
+        use solver::ColliderShape;
+        let scale = transform.scale().abs().max_element();
+        let shape = match self.shape {
+            ColliderKind::Sphere { radius } => ColliderShape::Sphere {
+                center: transform.translation(),
+                radius: radius.max(0.0) * scale,
+            },
+            ColliderKind::Capsule {
+                radius,
+                half_length,
+            } => ColliderShape::Capsule {
+                a: transform.transform_point(Vec3::new(0.0, -half_length.max(0.0), 0.0)),
+                b: transform.transform_point(Vec3::new(0.0, half_length.max(0.0), 0.0)),
+                radius: radius.max(0.0) * scale,
+            },
+            ColliderKind::Cuboid { half_extents } => ColliderShape::cuboid(
+                transform.translation(),
+                transform.rotation(),
+                half_extents.max(Vec3::ZERO) * transform.scale().abs(),
+            ),
+            ColliderKind::Cylinder {
+                radius,
+                half_height,
+            } => {
+                // Its height scales with y, its radius with the larger of x and z.
+                let s = transform.scale().abs();
+                ColliderShape::Cylinder {
+                    center: transform.translation(),
+                    axis: transform.rotation() * Vec3::Y,
+                    half_height: half_height.max(0.0) * s.y,
+                    radius: radius.max(0.0) * s.x.max(s.z),
+                }
+            }
+            ColliderKind::Plane => ColliderShape::Plane {
+                point: transform.translation(),
+                normal: transform.rotation() * Vec3::Y,
+            },
+            // The plane turns with the entity; scale moves its point, not its normal.
+            ColliderKind::HalfSpace { normal, distance } => {
+                let normal = normal.normalize_or(Vec3::Y);
+                ColliderShape::Plane {
+                    point: transform.transform_point(normal * distance),
+                    normal: transform.rotation() * normal,
+                }
+            }
+        };
+        solver::Collider {
+            shape,
+            thickness: self.thickness.max(0.0),
+            friction: self.friction.max(0.0),
+            motion: solver::Motion::NONE,
+        }
+    }
+}
+
+/// A collider entity moving faster than this (m/s), or turning more than a quarter turn in
+/// a step, is taken to have jumped there (a respawn, a teleport): it gets no motion.
+pub const TELEPORT_SPEED: f32 = 100.0;
+
+/// Each collider entity's pose (rotation, translation) at the last step, from which the
+/// next step takes its motion.
+#[derive(Default)]
+struct ColliderPoses {
+    before: bevy::ecs::entity::EntityHashMap<(Quat, Vec3)>,
+    now: bevy::ecs::entity::EntityHashMap<(Quat, Vec3)>,
+}
+
+impl ColliderPoses {
+    /// The motion of `entity` from its last pose to `transform` over `dt` (none the first
+    /// time it is seen, or after a jump); remembers `transform` for the next step.
+    fn motion(&mut self, entity: Entity, transform: &GlobalTransform, dt: f32) -> solver::Motion {
+        let (_, rotation, translation) = transform.to_scale_rotation_translation();
+        self.now.insert(entity, (rotation, translation));
+        let Some(&before) = self.before.get(&entity) else {
+            return solver::Motion::NONE;
+        };
+        let motion = solver::Motion::between(before, (rotation, translation), dt);
+        let jumped = motion.linear.length() > TELEPORT_SPEED
+            || motion.angular.length() * dt > std::f32::consts::FRAC_PI_2;
+        if jumped { solver::Motion::NONE } else { motion }
+    }
+
+    /// Ends a step: its poses are the next step's `before`.
+    fn end_step(&mut self) {
+        std::mem::swap(&mut self.before, &mut self.now);
+        self.now.clear();
+    }
+}
+
+/// Collision layers as bit masks (avian's `CollisionLayers`, which the `avian` feature
+/// reads): a cloth meets a collider when each one's memberships meet the other's filters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Layers {
+    pub(crate) memberships: u32,
+    pub(crate) filters: u32,
+}
+
+impl Layers {
+    /// Avian's default: the first layer, meeting every layer.
+    pub(crate) const DEFAULT: Self = Self {
+        memberships: 1,
+        filters: u32::MAX,
+    };
+
+    fn meet(self, other: Self) -> bool {
+        self.memberships & other.filters != 0 && other.memberships & self.filters != 0
+    }
+}
+
+/// The colliders the cloths meet this step, in world space, in the order they were placed:
+/// each one's entity (whose motion is tracked), the body its reaction goes to and its
+/// layers. Filled by `place_colliders` (and the avian plugin), given to the cloths by
+/// `give_colliders`.
+#[derive(Resource, Default)]
+pub(crate) struct PlacedColliders {
+    colliders: Vec<solver::Collider>,
+    /// Per collider, the entity that gets the cloth's reaction (an avian collider's body).
+    pub(crate) bodies: Vec<Entity>,
+    layers: Vec<Layers>,
+    poses: ColliderPoses,
+    dt: f32,
+}
+
+impl PlacedColliders {
+    /// Places `collider` (in world space), the collider of `entity` now at `transform`,
+    /// with its motion since the last step; its reaction goes to `body`.
+    pub(crate) fn add(
+        &mut self,
+        entity: Entity,
+        body: Entity,
+        transform: &GlobalTransform,
+        collider: solver::Collider,
+        layers: Layers,
+    ) {
+        let motion = self.poses.motion(entity, transform, self.dt);
+        self.colliders.push(solver::Collider { motion, ..collider });
+        self.bodies.push(body);
+        self.layers.push(layers);
+    }
+}
+
+/// Starts the step's colliders with every [`ClothCollider`] where its entity is now (each
+/// placed once per step, then copied to every cloth).
+pub(crate) fn place_colliders(
+    time: Res<Time>,
+    transforms: TransformHelper,
+    colliders: Query<(Entity, &ClothCollider)>,
+    mut placed: ResMut<PlacedColliders>,
+) {
+    let placed = &mut *placed;
+    placed.dt = time.delta_secs();
+    placed.colliders.clear();
+    placed.bodies.clear();
+    placed.layers.clear();
+    for (entity, collider) in &colliders {
+        let Ok(transform) = transforms.compute_global_transform(entity) else {
+            continue;
+        };
+        let world = collider.to_world(&transform);
+        placed.add(entity, entity, &transform, world, Layers::DEFAULT);
+    }
+}
+
+/// Gives every cloth the colliders placed this step, each with its motion since the last
+/// step (so the solver sweeps it through the step and friction carries the cloth along):
+/// all of them, or the ones its layers meet.
+pub(crate) fn give_colliders(
+    mut placed: ResMut<PlacedColliders>,
+    mut cloths: Query<&mut ClothSimulation>,
+) {
+    placed.poses.end_step();
+    for mut sim in &mut cloths {
+        let sim = &mut *sim;
+        if placed.colliders.is_empty() && sim.solver.colliders().is_empty() {
+            continue;
+        }
+        sim.colliders_from.clear();
+        let layers = sim.layers;
+        if placed.layers.iter().all(|&l| l.meet(layers)) {
+            sim.colliders_from.extend(0..placed.colliders.len() as u32);
+            sim.solver.set_colliders(placed.colliders.iter().cloned());
+        } else {
+            let met = (0..placed.colliders.len()).filter(|&i| placed.layers[i].meet(layers));
+            sim.colliders_from.extend(met.map(|i| i as u32));
+            let from = &sim.colliders_from;
+            let colliders = from.iter().map(|&i| placed.colliders[i as usize].clone());
+            sim.solver.set_colliders(colliders);
+        }
+    }
+}

@@ -1,0 +1,278 @@
+//! Stepping: each fixed step begins every awake cloth's step (its substep count), runs the
+//! substeps (the [`ClothSubstep`] schedule, or one task per cloth when no game system
+//! sits between its stages), then ends each cloth's step and reports what happened.
+
+use std::time::Duration;
+
+use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
+use bevy::platform::time::Instant;
+use bevy::prelude::*;
+
+use crate::ecs::cloth::{
+    ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
+};
+use crate::ecs::events::{ClothFellAsleep, ClothTorn};
+use crate::ecs::plugin::ClothSubstepSystems;
+use crate::ecs::sleep::ClothSleep;
+use crate::ecs::stats::ClothStats;
+use crate::error::ClothError;
+use crate::solver;
+
+/// The schedule run once per substep inside [`ClothSystems::Substeps`].
+#[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct ClothSubstep;
+
+/// How many substeps this fixed step runs (the most any cloth needs) and which one is
+/// running; each cloth takes part in the first `n` of them, `n` being its own count.
+#[derive(Resource, Clone, Copy, Debug, Default)]
+pub struct ClothSubstepPlan {
+    /// Substeps to run in this step.
+    pub count: u32,
+    /// The substep running now.
+    pub index: u32,
+}
+
+/// The [`ClothSubstep`] schedule: the four stages in their sets, in order, on one thread
+/// (each stage runs its cloths in parallel itself).
+pub(crate) fn substep_schedule() -> Schedule {
+    let mut substep = Schedule::new(ClothSubstep);
+    substep.set_executor(SingleThreadedExecutor::new());
+    substep.configure_sets(
+        (
+            ClothSubstepSystems::AccumulateForces,
+            ClothSubstepSystems::Integrate,
+            ClothSubstepSystems::FitTargets,
+            ClothSubstepSystems::Constrain,
+        )
+            .chain(),
+    );
+    substep.add_systems((
+        accumulate_forces.in_set(ClothSubstepSystems::AccumulateForces),
+        integrate.in_set(ClothSubstepSystems::Integrate),
+        fit_targets.in_set(ClothSubstepSystems::FitTargets),
+        constrain.in_set(ClothSubstepSystems::Constrain),
+    ));
+    substep
+}
+
+/// Per-cloth bookkeeping of the step in progress.
+#[derive(Component, Clone, Copy, Debug, Default)]
+pub(crate) struct StepProgress {
+    /// Substeps this cloth takes in this step (0: it does not step).
+    pub(crate) substeps: u32,
+    elapsed: Duration,
+}
+
+/// A cloth paused because a step went non-finite runs again once it has been reset
+/// (its last report is no longer a failure); a valid change of its parameters lifts
+/// the pause too (`apply_params`).
+pub(crate) fn recover_cloths(
+    mut commands: Commands,
+    cloths: Query<(Entity, &ClothSimulation, &ClothInvalid)>,
+) {
+    for (entity, sim, invalid) in &cloths {
+        if matches!(invalid.0, ClothError::NonFinite { .. }) && sim.solver.last_report().finite {
+            commands.entity(entity).remove::<ClothInvalid>();
+        }
+    }
+}
+
+#[allow(clippy::type_complexity)]
+pub(crate) fn begin_steps(
+    mut commands: Commands,
+    time: Res<Time>,
+    mut pause: ResMut<ClothPause>,
+    mut plan: ResMut<ClothSubstepPlan>,
+    mut cloths: Query<
+        (
+            Entity,
+            &mut ClothSimulation,
+            Option<&mut StepProgress>,
+            Option<&ClothSleep>,
+        ),
+        Without<ClothInvalid>,
+    >,
+) {
+    let dt = time.delta_secs();
+    let run = !pause.paused || pause.pending_steps > 0;
+    if pause.paused && run {
+        pause.pending_steps -= 1;
+    }
+    plan.count = 0;
+    plan.index = 0;
+    for (entity, mut sim, progress, sleep) in &mut cloths {
+        let start = Instant::now();
+        let awake = sleep.is_none_or(|s| !s.asleep);
+        let substeps = if run && awake {
+            sim.solver.begin_step(dt)
+        } else {
+            0
+        };
+        let progress_now = StepProgress {
+            substeps,
+            elapsed: start.elapsed(),
+        };
+        match progress {
+            Some(mut p) => *p = progress_now,
+            None => {
+                commands.entity(entity).insert(progress_now);
+            }
+        }
+        plan.count = plan.count.max(substeps);
+    }
+}
+
+/// The plugin's own systems in the [`ClothSubstep`] schedule (`substep_schedule`'s four, one
+/// per stage).
+const OWN_SUBSTEP_SYSTEMS: usize = 4;
+
+/// Runs the step's substeps. When a game has put systems between the stages
+/// ([`ClothSubstepSystems`]), every substep runs the [`ClothSubstep`] schedule, each
+/// stage over all cloths in parallel. Otherwise each cloth takes all its substeps in one
+/// task on the compute pool: the same calls in the same order per cloth (the same bits),
+/// one fork-join per step instead of four per substep, which is what many small cloths
+/// cost most.
+pub(crate) fn run_substeps(
+    world: &mut World,
+    mut cloths: Local<Option<QueryState<ActiveCloth, Without<ClothInvalid>>>>,
+) {
+    let count = world.resource::<ClothSubstepPlan>().count;
+    if count == 0 {
+        return;
+    }
+    let schedules = world.resource::<Schedules>();
+    let others = schedules
+        .get(ClothSubstep)
+        .is_none_or(|s| s.systems_len() != OWN_SUBSTEP_SYSTEMS);
+    if others {
+        for index in 0..count {
+            world.resource_mut::<ClothSubstepPlan>().index = index;
+            world.run_schedule(ClothSubstep);
+        }
+        return;
+    }
+    let env = **world.resource::<ClothEnvironment>();
+    let cloths = cloths.get_or_insert_with(|| world.query_filtered());
+    // The solver's pool, not `Query::par_iter_mut`: on two cores Bevy gives its compute
+    // pool one thread, and `par_iter_mut` then runs on the calling thread alone; a scope
+    // has the calling thread work beside the pool's.
+    let active = cloths.iter_mut(world);
+    solver::task_pool().scope(|scope| {
+        for (mut sim, mut progress) in active {
+            scope.spawn(async move {
+                let start = Instant::now();
+                for _ in 0..progress.substeps {
+                    sim.solver.substep(&env);
+                }
+                progress.elapsed += start.elapsed();
+            });
+        }
+    });
+}
+
+/// A cloth that takes part in the step: its simulation and progress.
+type ActiveCloth = (&'static mut ClothSimulation, &'static mut StepProgress);
+
+/// Runs one solver phase on every cloth that takes part in the current substep, in
+/// parallel, adding the time it took to that cloth's step time.
+fn for_each_active(
+    plan: &ClothSubstepPlan,
+    cloths: &mut Query<(&mut ClothSimulation, &mut StepProgress), Without<ClothInvalid>>,
+    phase: impl Fn(&mut solver::ClothSolver) + Sync + Send,
+) {
+    cloths.par_iter_mut().for_each(|(mut sim, mut progress)| {
+        if plan.index < progress.substeps {
+            let start = Instant::now();
+            phase(&mut sim.solver);
+            progress.elapsed += start.elapsed();
+        }
+    });
+}
+
+type ActiveCloths<'w, 's> = Query<'w, 's, ActiveCloth, Without<ClothInvalid>>;
+
+fn accumulate_forces(
+    plan: Res<ClothSubstepPlan>,
+    env: Res<ClothEnvironment>,
+    mut cloths: ActiveCloths,
+) {
+    for_each_active(&plan, &mut cloths, |c| c.accumulate_forces(&env));
+}
+
+fn integrate(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    for_each_active(&plan, &mut cloths, solver::ClothSolver::integrate);
+}
+
+fn fit_targets(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    for_each_active(&plan, &mut cloths, solver::ClothSolver::fit_targets);
+}
+
+fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    for_each_active(&plan, &mut cloths, solver::ClothSolver::constrain);
+}
+
+#[allow(clippy::type_complexity)]
+pub(crate) fn finish_steps(
+    mut commands: Commands,
+    mut torn: MessageWriter<ClothTorn>,
+    env: Res<ClothEnvironment>,
+    time: Res<Time>,
+    mut cloths: Query<
+        (
+            Entity,
+            &mut ClothSimulation,
+            &StepProgress,
+            Option<&mut ClothStats>,
+            Option<&mut ClothSleep>,
+        ),
+        Without<ClothInvalid>,
+    >,
+) {
+    for (entity, mut sim, progress, stats, sleep) in &mut cloths {
+        if progress.substeps == 0 {
+            continue;
+        }
+        let start = Instant::now();
+        let sim = &mut *sim;
+        let report = sim.solver.end_step();
+        if !report.finite {
+            let error = ClothError::NonFinite {
+                time: sim.solver.time(),
+                substeps: report.substeps,
+            };
+            pause_invalid(&mut commands, entity, error);
+            sim.mesh_dirty = true;
+            continue;
+        }
+        for &spring in sim.solver.last_torn() {
+            let s = spring as usize;
+            let particles = [sim.solver.springs().a[s], sim.solver.springs().b[s]];
+            let event = ClothTorn {
+                cloth: entity,
+                spring,
+                particles,
+            };
+            torn.write(event);
+            commands.trigger(event);
+        }
+        let asleep = sleep.is_some_and(|mut sleep| {
+            let speed = if sleep.enabled {
+                sim.solver.max_speed()
+            } else {
+                f32::INFINITY
+            };
+            let was_asleep = sleep.asleep;
+            let asleep = sleep.observe(speed, time.delta_secs());
+            if asleep && !was_asleep {
+                commands.trigger(ClothFellAsleep { entity });
+            }
+            asleep
+        });
+        sim.last_step_ms = (progress.elapsed + start.elapsed()).as_secs_f32() * 1e3;
+        sim.mesh_dirty = true;
+        if let Some(mut stats) = stats {
+            stats.record(&sim.solver, &env, sim.last_step_ms);
+            stats.asleep = asleep;
+        }
+    }
+}
