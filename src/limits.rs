@@ -69,8 +69,6 @@ pub const MAX_SCENE_ITEMS: usize = 1 << 12;
 
 use std::io::Read;
 
-use crate::error::ClothError;
-
 /// Reads a file whole, refusing one over [`MAX_FILE_BYTES`] without reading more than
 /// that (a device such as `/dev/zero` reports no size and never ends).
 pub fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
@@ -91,43 +89,6 @@ pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     String::from_utf8(read_file(path)?)
         .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
 }
-use crate::params::{ClothParams, Model, Substeps};
-
-/// Refuses `params` on a cloth of `particles` when a step's fixed work is over
-/// [`MAX_WORK_PER_STEP`] (particles × fixed substeps) or [`MAX_SWEEP_WORK_PER_STEP`]
-/// (× fixed limiter sweeps). Automatic substeps are capped at the budget instead (see
-/// [`auto_substeps_cap`]).
-pub fn check_work(particles: usize, params: &ClothParams) -> Result<(), ClothError> {
-    let n = particles as u64;
-    let Substeps::Fixed(substeps) = params.substeps else {
-        return Ok(());
-    };
-    let work = n.saturating_mul(substeps as u64);
-    if work > MAX_WORK_PER_STEP {
-        return Err(ClothError::TooMuchWork {
-            field: "substeps",
-            particles,
-            per_particle: substeps as u64,
-            limit: MAX_WORK_PER_STEP,
-        });
-    }
-    let fixed_sweeps = params.strain_limit.is_some()
-        && params.strain_limit_tolerance.is_none()
-        && !matches!(params.model, Model::Xpbd(_));
-    if fixed_sweeps {
-        let per_particle = (substeps as u64).saturating_mul(params.strain_limit_iterations as u64);
-        if n.saturating_mul(per_particle) > MAX_SWEEP_WORK_PER_STEP {
-            return Err(ClothError::TooMuchWork {
-                field: "strain_limit_iterations",
-                particles,
-                per_particle,
-                limit: MAX_SWEEP_WORK_PER_STEP,
-            });
-        }
-    }
-    Ok(())
-}
-
 /// The most automatic substeps a cloth of `particles` may take per step: its `max`,
 /// lowered to keep particles × substeps within [`MAX_WORK_PER_STEP`] (at least 1).
 pub fn auto_substeps_cap(particles: usize, max: u32) -> u32 {

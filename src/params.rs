@@ -863,3 +863,38 @@ impl Environment {
         Ok(())
     }
 }
+
+/// Refuses `params` on a cloth of `particles` when a step's fixed work is over
+/// [`MAX_WORK_PER_STEP`](crate::limits::MAX_WORK_PER_STEP) (particles × fixed substeps) or [`MAX_SWEEP_WORK_PER_STEP`](crate::limits::MAX_SWEEP_WORK_PER_STEP)
+/// (× fixed limiter sweeps). Automatic substeps are capped at the budget instead (see
+/// [`auto_substeps_cap`](crate::limits::auto_substeps_cap)).
+pub fn check_work(particles: usize, params: &ClothParams) -> Result<(), ClothError> {
+    let n = particles as u64;
+    let Substeps::Fixed(substeps) = params.substeps else {
+        return Ok(());
+    };
+    let work = n.saturating_mul(substeps as u64);
+    if work > crate::limits::MAX_WORK_PER_STEP {
+        return Err(ClothError::TooMuchWork {
+            field: "substeps",
+            particles,
+            per_particle: substeps as u64,
+            limit: crate::limits::MAX_WORK_PER_STEP,
+        });
+    }
+    let fixed_sweeps = params.strain_limit.is_some()
+        && params.strain_limit_tolerance.is_none()
+        && !matches!(params.model, Model::Xpbd(_));
+    if fixed_sweeps {
+        let per_particle = (substeps as u64).saturating_mul(params.strain_limit_iterations as u64);
+        if n.saturating_mul(per_particle) > crate::limits::MAX_SWEEP_WORK_PER_STEP {
+            return Err(ClothError::TooMuchWork {
+                field: "strain_limit_iterations",
+                particles,
+                per_particle,
+                limit: crate::limits::MAX_SWEEP_WORK_PER_STEP,
+            });
+        }
+    }
+    Ok(())
+}

@@ -22,10 +22,8 @@ use bevy::platform::collections::HashMap;
 use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
-use crate::ecs::cloth::{ClothEnvironment, ClothInvalid, ClothSimulation};
-use crate::ecs::colliders::{
-    ClothCollider, Layers, PlacedColliders, give_colliders, place_colliders,
-};
+use crate::ecs::cloth::{ClothEnvironment, ClothInvalid, ClothSimulation, Layers};
+use crate::ecs::colliders::{ClothCollider, PlacedColliders, give_colliders, place_colliders};
 use crate::ecs::plugin::{ClothSchedule, ClothSystems};
 use crate::ecs::step::{StepProgress, finish_steps};
 use crate::solver::{self, ColliderShape, ConvexHull};

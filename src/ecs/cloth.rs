@@ -5,9 +5,7 @@
 use bevy::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use crate::ecs::colliders::Layers;
 use crate::ecs::events::ClothBecameInvalid;
-use crate::ecs::sleep::ClothSleep;
 use crate::error::ClothError;
 use crate::layout::garment::{GarmentLayout, asset_path};
 use crate::layout::shape::{ClothPins, ClothShape};
@@ -28,7 +26,7 @@ use crate::solver;
 /// ```
 #[derive(Component, Clone, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
 #[reflect(Component, Default)]
-#[require(Transform, Visibility, ClothSleep)]
+#[require(Transform, Visibility)]
 #[serde(default, deny_unknown_fields)]
 pub struct Cloth {
     /// The initial layout.
@@ -81,7 +79,7 @@ impl Cloth {
         self.params.validate()?;
         // A grid's work per step is known from its size (the others' when built).
         if let ClothShape::Grid { width, height, .. } = self.shape {
-            crate::limits::check_work(width as usize * height as usize, &self.params)?;
+            crate::params::check_work(width as usize * height as usize, &self.params)?;
         }
         Ok(())
     }
@@ -221,4 +219,24 @@ pub(crate) fn pause_invalid(commands: &mut Commands, entity: Entity, error: Clot
     error!("cloth {entity} is not simulated: {error}");
     commands.entity(entity).insert(ClothInvalid(error.clone()));
     commands.trigger(ClothBecameInvalid { entity, error });
+}
+
+/// Collision layers as bit masks (avian's `CollisionLayers`, which the `avian` feature
+/// reads): a cloth meets a collider when each one's memberships meet the other's filters.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Layers {
+    pub(crate) memberships: u32,
+    pub(crate) filters: u32,
+}
+
+impl Layers {
+    /// Avian's default: the first layer, meeting every layer.
+    pub(crate) const DEFAULT: Self = Self {
+        memberships: 1,
+        filters: u32::MAX,
+    };
+
+    pub(crate) fn meet(self, other: Self) -> bool {
+        self.memberships & other.filters != 0 && other.memberships & self.filters != 0
+    }
 }

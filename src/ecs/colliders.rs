@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 use serde::{Deserialize, Serialize};
 
-use crate::ecs::cloth::ClothSimulation;
+use crate::ecs::cloth::{ClothSimulation, Layers};
 use crate::error::ClothError;
 use crate::solver;
 
@@ -376,26 +376,6 @@ impl ColliderPoses {
     fn end_step(&mut self) {
         std::mem::swap(&mut self.before, &mut self.now);
         self.now.clear();
-    }
-}
-
-/// Collision layers as bit masks (avian's `CollisionLayers`, which the `avian` feature
-/// reads): a cloth meets a collider when each one's memberships meet the other's filters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(crate) struct Layers {
-    pub(crate) memberships: u32,
-    pub(crate) filters: u32,
-}
-
-impl Layers {
-    /// Avian's default: the first layer, meeting every layer.
-    pub(crate) const DEFAULT: Self = Self {
-        memberships: 1,
-        filters: u32::MAX,
-    };
-
-    fn meet(self, other: Self) -> bool {
-        self.memberships & other.filters != 0 && other.memberships & self.filters != 0
     }
 }
 

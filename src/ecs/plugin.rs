@@ -18,7 +18,7 @@
 //! A substep schedule (as avian's `SubstepSchedule`) makes each phase a real system set
 //! that runs every substep, so a game can add its own forces in a system ordered
 //! `.after(ClothSubstepSystems::AccumulateForces).before(ClothSubstepSystems::Integrate)` in
-//! [`ClothSubstep`].
+//! [`ClothSubstep`](crate::ClothSubstep).
 
 use std::time::Duration;
 
@@ -55,7 +55,7 @@ use crate::params::{
 pub enum ClothSystems {
     /// Build new cloths, rebuild changed ones, apply parameter edits, move pins.
     Prepare,
-    /// Run the [`ClothSubstep`] schedule as many times as the cloths need.
+    /// Run the [`ClothSubstep`](crate::ClothSubstep) schedule as many times as the cloths need.
     Substeps,
     /// End each step ([`ClothSolver::end_step`](crate::solver::ClothSolver::end_step)):
     /// tear over-stretched springs and report them, record step time; a cloth whose
@@ -63,30 +63,6 @@ pub enum ClothSystems {
     Finish,
     /// (In `PostUpdate`) write positions and normals into the meshes.
     WriteMesh,
-}
-
-/// The ordered system sets of one substep, in the [`ClothSubstep`] schedule only (a
-/// system put in them in another schedule would never run with the cloth's substeps,
-/// so they are a type of their own).
-#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ClothSubstepSystems {
-    /// [`ClothSolver::accumulate_forces`](crate::solver::ClothSolver::accumulate_forces):
-    /// every force from the old state (gravity, wind, drag; springs for mass-spring;
-    /// the goal pull for shape matching; for the patch model, the part lattice's forces
-    /// and the particles' pull toward their targets). Add forces after this set.
-    AccumulateForces,
-    /// [`ClothSolver::integrate`](crate::solver::ClothSolver::integrate): the prediction
-    /// (Verlet or semi-implicit Euler; XPBD always the latter; the patch model's part
-    /// lattice takes its whole substep here first).
-    Integrate,
-    /// [`ClothSolver::fit_targets`](crate::solver::ClothSolver::fit_targets): shape
-    /// matching's velocity update, the patch model's targets (nothing for mass-spring
-    /// and XPBD).
-    FitTargets,
-    /// [`ClothSolver::constrain`](crate::solver::ClothSolver::constrain): pins and grab
-    /// driven, the model's constraints (Provot's limit; XPBD's projection and tethers),
-    /// contact with the colliders; it ends the substep (the cloth's clock advances).
-    Constrain,
 }
 
 /// Adds cloth simulation to an app.
@@ -145,6 +121,8 @@ impl Plugin for ClothPlugin {
         }
         app.insert_resource(ClothSchedule(self.schedule));
         register_types(app);
+        // Every cloth can sleep (a game turns it off per cloth with `ClothSleep::never()`).
+        app.register_required_components::<Cloth, ClothSleep>();
         app.init_resource::<ClothEnvironment>()
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()

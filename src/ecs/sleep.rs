@@ -11,8 +11,8 @@ use crate::params::Environment;
 /// within one step on anything that can move it: an edit of its parameters, a change of
 /// gravity or wind (`ClothEnvironment`), its transform moving (the pins), a collider
 /// changing within reach of it, a grab, drag, release, cut or reset (anything that calls
-/// the solver's mutating tools), or a [`ClothWake`] message from the game. Required by
-/// [`Cloth`]; `enabled: false` keeps a cloth always awake.
+/// the solver's mutating tools), or a [`ClothWake`] message from the game. Added to every
+/// [`Cloth`](crate::Cloth) by the plugin; `enabled: false` keeps a cloth always awake.
 #[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
 #[reflect(Component, Default)]
 pub struct ClothSleep {

@@ -32,7 +32,7 @@ pub struct ClothStats {
     pub substeps: u32,
     /// True when automatic substeps hit their cap: the step may be unstable.
     pub under_resolved: bool,
-    /// True when the cloth fell asleep at its last step (see [`ClothSleep`], which says
+    /// True when the cloth fell asleep at its last step (see [`ClothSleep`](crate::ClothSleep), which says
     /// whether it sleeps now): the other values are those of that step.
     pub asleep: bool,
     /// Median step time over the last second of wall-clock steps, ms.

@@ -12,13 +12,36 @@ use crate::ecs::cloth::{
     ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
 };
 use crate::ecs::events::{ClothFellAsleep, ClothTorn};
-use crate::ecs::plugin::ClothSubstepSystems;
 use crate::ecs::sleep::ClothSleep;
 use crate::ecs::stats::ClothStats;
 use crate::error::ClothError;
 use crate::solver;
 
-/// The schedule run once per substep inside [`ClothSystems::Substeps`].
+/// The ordered system sets of one substep, in the [`ClothSubstep`] schedule only (a
+/// system put in them in another schedule would never run with the cloth's substeps,
+/// so they are a type of their own).
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ClothSubstepSystems {
+    /// [`ClothSolver::accumulate_forces`](crate::solver::ClothSolver::accumulate_forces):
+    /// every force from the old state (gravity, wind, drag; springs for mass-spring;
+    /// the goal pull for shape matching; for the patch model, the part lattice's forces
+    /// and the particles' pull toward their targets). Add forces after this set.
+    AccumulateForces,
+    /// [`ClothSolver::integrate`](crate::solver::ClothSolver::integrate): the prediction
+    /// (Verlet or semi-implicit Euler; XPBD always the latter; the patch model's part
+    /// lattice takes its whole substep here first).
+    Integrate,
+    /// [`ClothSolver::fit_targets`](crate::solver::ClothSolver::fit_targets): shape
+    /// matching's velocity update, the patch model's targets (nothing for mass-spring
+    /// and XPBD).
+    FitTargets,
+    /// [`ClothSolver::constrain`](crate::solver::ClothSolver::constrain): pins and grab
+    /// driven, the model's constraints (Provot's limit; XPBD's projection and tethers),
+    /// contact with the colliders; it ends the substep (the cloth's clock advances).
+    Constrain,
+}
+
+/// The schedule run once per substep inside [`ClothSystems::Substeps`](crate::ClothSystems::Substeps).
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ClothSubstep;
 

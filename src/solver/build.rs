@@ -26,7 +26,7 @@ impl ClothSolver {
         }
         params.validate()?;
         check_model_fits(params, layout.grid)?;
-        crate::limits::check_work(count, params)?;
+        crate::params::check_work(count, params)?;
         let mut cloth = ClothSolver {
             particles: Particles::with_len(count),
             structure: Structure::new(layout),

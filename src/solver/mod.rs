@@ -129,7 +129,7 @@ impl ClothSolver {
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
         check_model_fits(params, self.structure.grid)?;
-        crate::limits::check_work(self.particles.len(), params)?;
+        crate::params::check_work(self.particles.len(), params)?;
         self.apply_params(params);
         Ok(())
     }
