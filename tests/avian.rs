@@ -32,6 +32,21 @@ fn rest_on(collider: bevy_cloth::solver::Collider, start: Vec3) -> Vec3 {
     cloth.positions()[0]
 }
 
+/// The headless app with transforms, avian's physics and `plugin`, set up as `App::run`
+/// sets it up (avian makes some of its resources there).
+fn avian_app(plugin: ClothAvianPlugin) -> bevy::app::App {
+    use bevy::prelude::*;
+    let mut app = bevy_cloth::headless::headless_app();
+    app.add_plugins((
+        TransformPlugin,
+        avian3d::prelude::PhysicsPlugins::default(),
+        plugin,
+    ));
+    app.finish();
+    app.cleanup();
+    app
+}
+
 #[test]
 fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
     let at = |x: f32, y: f32, z: f32| GlobalTransform::from(Transform::from_xyz(x, y, z));
@@ -151,15 +166,7 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
     // (the cape swings forward into its back), then turns to face +x over 0.2 s and runs
     // that way for 0.8 s (the cape swings round its side). Every step every cape particle
     // stays outside the body, and while running the cape trails behind it.
-    let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((
-        TransformPlugin,
-        PhysicsPlugins::default(),
-        ClothAvianPlugin::default(),
-    ));
-    // As `App::run` does (avian sets up some of its resources there).
-    app.finish();
-    app.cleanup();
+    let mut app = avian_app(ClothAvianPlugin::default());
     app.world_mut().spawn((
         RigidBody::Static,
         Collider::half_space(Vec3::Y),
@@ -264,14 +271,7 @@ fn hammock_holds_a_ball(child_collider: bool) {
     // the reaction it would push the particles aside and fall through.) The hammock has
     // air drag (0.02 N·s/m a particle): with the default 0.0005 the ball keeps bouncing
     // (y 0.82–1.0 for the 19 s measured), the reaction reaching it a step late.
-    let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((
-        TransformPlugin,
-        PhysicsPlugins::default(),
-        ClothAvianPlugin::default(),
-    ));
-    app.finish();
-    app.cleanup();
+    let mut app = avian_app(ClothAvianPlugin::default());
     let n = 16;
     let cloth = app
         .world_mut()
@@ -343,14 +343,7 @@ fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
     // A kinematic avian box (2 × 0.2 × 2 m, μ = 0.8) moving at 0.5 m/s along x with a
     // cloth lying on it: the plugin gives the avian body its motion from its transforms,
     // and friction carries the cloth (less the ~1.6 cm it slips getting up to speed).
-    let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((
-        TransformPlugin,
-        PhysicsPlugins::default(),
-        ClothAvianPlugin::default(),
-    ));
-    app.finish();
-    app.cleanup();
+    let mut app = avian_app(ClothAvianPlugin::default());
     let platform = app
         .world_mut()
         .spawn((
@@ -392,14 +385,7 @@ fn sensors_disabled_colliders_and_other_layers_do_not_touch_the_cloth() {
     // Five small cloths dropped from 0.3 m, each over its own static box (top at y = 0):
     // an ordinary box holds its cloth, a sensor, a disabled collider and a box on another
     // layer let theirs fall through; a cloth with its own layers is held by a box on them.
-    let mut app = bevy_cloth::headless::headless_app();
-    app.add_plugins((
-        TransformPlugin,
-        PhysicsPlugins::default(),
-        ClothAvianPlugin::default(),
-    ));
-    app.finish();
-    app.cleanup();
+    let mut app = avian_app(ClothAvianPlugin::default());
     let other = CollisionLayers::from_bits(0b10, 0b10);
     let cases: [(&str, bool); 5] = [
         ("ordinary", true),
@@ -458,16 +444,9 @@ fn the_cloth_falls_under_avians_gravity_unless_told_not_to() {
     use avian3d::prelude::{Gravity, PhysicsPlugins};
     use bevy::prelude::*;
     for follow in [true, false] {
-        let mut app = bevy_cloth::headless::headless_app();
-        app.add_plugins((
-            TransformPlugin,
-            PhysicsPlugins::default(),
-            ClothAvianPlugin {
-                follow_gravity: follow,
-            },
-        ));
-        app.finish();
-        app.cleanup();
+        let mut app = avian_app(ClothAvianPlugin {
+            follow_gravity: follow,
+        });
         app.insert_resource(Gravity(Vec3::new(0.0, -1.62, 0.0)));
         // (The first update's clock has not advanced: no fixed step runs in it.)
         app.update();

@@ -200,23 +200,26 @@ fn pinned_cloth_follows_its_transform() {
     );
 }
 
-#[test]
-fn torn_springs_send_messages() {
-    let mut app = app();
+/// A small cloth hung by its top row that tears under [`TEARING_GRAVITY`].
+fn tearing_cloth() -> Cloth {
     let params = ClothParams {
         tear_ratio: Some(1.3),
         strain_limit: None,
         ..ClothParams::default()
     };
-    let e = app
-        .world_mut()
-        .spawn(
-            Cloth::grid(5, 5, 0.1)
-                .with_pins(ClothPins::TopRow)
-                .with_params(params),
-        )
-        .id();
-    app.world_mut().resource_mut::<ClothEnvironment>().gravity = Vec3::new(0.0, -30_000.0, 0.0);
+    Cloth::grid(5, 5, 0.1)
+        .with_pins(ClothPins::TopRow)
+        .with_params(params)
+}
+
+/// Gravity far past what [`tearing_cloth`]'s springs hold.
+const TEARING_GRAVITY: Vec3 = Vec3::new(0.0, -30_000.0, 0.0);
+
+#[test]
+fn torn_springs_send_messages() {
+    let mut app = app();
+    let e = app.world_mut().spawn(tearing_cloth()).id();
+    app.world_mut().resource_mut::<ClothEnvironment>().gravity = TEARING_GRAVITY;
     let mut cursor = app.world().resource::<Messages<ClothTorn>>().get_cursor();
     let mut seen = Vec::new();
     for _ in 0..30 {
@@ -1173,18 +1176,9 @@ struct Seen {
 fn observers_on_a_cloth_see_it_built_torn_asleep_woken_and_invalid() {
     let mut app = app();
     app.init_resource::<Seen>();
-    let params = ClothParams {
-        tear_ratio: Some(1.3),
-        strain_limit: None,
-        ..ClothParams::default()
-    };
     let e = app
         .world_mut()
-        .spawn(
-            Cloth::grid(5, 5, 0.1)
-                .with_pins(ClothPins::TopRow)
-                .with_params(params),
-        )
+        .spawn(tearing_cloth())
         .observe(|_: On<ClothBuilt>, mut seen: ResMut<Seen>| seen.built += 1)
         .observe(|torn: On<ClothTorn>, mut seen: ResMut<Seen>| seen.torn.push(torn.spring))
         .observe(|_: On<ClothFellAsleep>, mut seen: ResMut<Seen>| seen.asleep += 1)
@@ -1193,8 +1187,7 @@ fn observers_on_a_cloth_see_it_built_torn_asleep_woken_and_invalid() {
             seen.invalid.push(bad.error.clone())
         })
         .id();
-    // Torn: gravity far past what the springs hold.
-    app.world_mut().resource_mut::<ClothEnvironment>().gravity = Vec3::new(0.0, -30_000.0, 0.0);
+    app.world_mut().resource_mut::<ClothEnvironment>().gravity = TEARING_GRAVITY;
     for _ in 0..30 {
         app.update();
     }

@@ -148,14 +148,17 @@ impl GarmentLayout {
 /// The `assets` folder: where Bevy's asset server looks (`BEVY_ASSET_ROOT`, the crate
 /// under cargo, else beside the executable), or else `assets` in the working directory (a
 /// binary run by hand from the project).
+/// On the web there is no file system: it is `assets`, as Bevy's web reader has it.
 pub fn asset_root() -> PathBuf {
-    let bevy_root = bevy::asset::io::file::FileAssetReader::get_base_path().join("assets");
     let local = PathBuf::from("assets");
-    if bevy_root.exists() || !local.exists() {
-        bevy_root
-    } else {
-        local
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let bevy_root = bevy::asset::io::file::FileAssetReader::get_base_path().join("assets");
+        if bevy_root.exists() || !local.exists() {
+            return bevy_root;
+        }
     }
+    local
 }
 
 /// The path of an asset file under [`asset_root`]; absolute paths stay as they are.
