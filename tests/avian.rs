@@ -158,7 +158,7 @@ fn from_segment(x: Vec3, a: Vec3, b: Vec3) -> f32 {
 
 #[test]
 fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
-    use avian3d::prelude::{LinearVelocity, LockedAxes, PhysicsPlugins, RigidBody, Rotation};
+    use avian3d::prelude::{LinearVelocity, LockedAxes, RigidBody, Rotation};
     use bevy::prelude::*;
     // avian's physics running beside the cloth: a capsule body (radius 0.3, 1.6 m tall)
     // on a half-space ground, driven by setting its velocity; a cape attached by its top
@@ -262,7 +262,7 @@ fn a_child_colliders_push_reaches_its_body() {
 }
 
 fn hammock_holds_a_ball(child_collider: bool) {
-    use avian3d::prelude::{Mass, PhysicsPlugins, RigidBody};
+    use avian3d::prelude::{Mass, RigidBody};
     use bevy::prelude::*;
     // A 60 g avian ball (radius 0.1) dropped from 0.3 m onto a 0.75 m square cloth
     // pinned by its four corners at y = 1. The cloth gives the ball the reaction to its
@@ -338,7 +338,7 @@ fn hammock_holds_a_ball(child_collider: bool) {
 
 #[test]
 fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
-    use avian3d::prelude::{LinearVelocity, PhysicsPlugins, RigidBody};
+    use avian3d::prelude::{LinearVelocity, RigidBody};
     use bevy::prelude::*;
     // A kinematic avian box (2 × 0.2 × 2 m, μ = 0.8) moving at 0.5 m/s along x with a
     // cloth lying on it: the plugin gives the avian body its motion from its transforms,
@@ -380,7 +380,7 @@ fn a_cloth_on_a_moving_avian_platform_is_carried_by_friction() {
 
 #[test]
 fn sensors_disabled_colliders_and_other_layers_do_not_touch_the_cloth() {
-    use avian3d::prelude::{ColliderDisabled, CollisionLayers, PhysicsPlugins, RigidBody, Sensor};
+    use avian3d::prelude::{ColliderDisabled, CollisionLayers, RigidBody, Sensor};
     use bevy::prelude::*;
     // Five small cloths dropped from 0.3 m, each over its own static box (top at y = 0):
     // an ordinary box holds its cloth, a sensor, a disabled collider and a box on another
@@ -441,7 +441,7 @@ fn sensors_disabled_colliders_and_other_layers_do_not_touch_the_cloth() {
 
 #[test]
 fn the_cloth_falls_under_avians_gravity_unless_told_not_to() {
-    use avian3d::prelude::{Gravity, PhysicsPlugins};
+    use avian3d::prelude::Gravity;
     use bevy::prelude::*;
     for follow in [true, false] {
         let mut app = avian_app(ClothAvianPlugin {
