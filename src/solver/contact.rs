@@ -26,6 +26,8 @@ pub(super) struct Contact {
     pub turns_now: Vec<Quat>,
     /// What the cloth gave each collider over the step.
     pub collider_impulses: Vec<ColliderImpulse>,
+    /// One particle's pushes by collider (scratch, kept for its storage).
+    pub pushes: Vec<(usize, Vec3)>,
 }
 
 impl Contact {
@@ -88,10 +90,18 @@ impl Contact {
         );
     }
 
-    /// Pushes every free particle out of every collider to `thickness` outside its
-    /// surface, then removes tangential motion of this substep up to `friction × push`
-    /// (Coulomb). Velocities follow the corrected positions: `v = (x − x_prev)/h`. `tau`
-    /// is the time left in the step after this substep.
+    /// Keeps every free particle `thickness` outside every collider, order-independently,
+    /// with Coulomb friction once per particle; velocities follow the corrected positions,
+    /// `v = (x − x_prev)/h`. `tau` is the time left in the step after this substep.
+    ///
+    /// Per particle (`resolve_particle`): its path over the substep is swept against each
+    /// collider it starts outside of, so a fast particle stops at the near face of a thin
+    /// plate rather than crossing it; then, at most [`CONTACT_PASSES`] times, it is pushed
+    /// out of the collider it is deepest in (the deepest, not the first listed: the same
+    /// answer in any order). The part of a push deeper than the particle's own motion
+    /// undoes an overlap it started in (spawned inside, a collider that jumped): its
+    /// `previous` moves out with it (pre-stabilisation, Macklin et al. 2014 §5.2), so that
+    /// part adds no velocity.
     pub fn resolve(&mut self, p: &mut Particles, tau: f32, h: f32) {
         if self.colliders.is_empty() {
             return;
@@ -104,61 +114,220 @@ impl Contact {
         } else {
             (&self.colliders, &self.collider_bounds)
         };
+        let world = World {
+            colliders,
+            bounds,
+            turns: &self.turns_now,
+            h,
+        };
+        let pushes = &mut self.pushes;
         for i in 0..p.position.len() {
-            if p.inv_mass[i] == 0.0 {
+            let w = p.inv_mass[i];
+            if w == 0.0 {
                 continue;
             }
-            let mut x = p.position[i];
-            let mut touched = false;
-            for (k, (c, bounds)) in colliders.iter().zip(bounds).enumerate() {
-                if !bounds.contains(x) {
-                    continue; // farther than the thickness: the distance would say so
-                }
-                let Some((depth, n)) = c.penetration(x) else {
-                    continue;
-                };
-                let before = x;
-                let turn = self.turns_now.get(k).copied().unwrap_or_default();
-                x = push_out(c, x, depth, n, p.previous[i], turn, h);
-                touched = true;
-                // The reaction: the particle's momentum change, the other way.
-                let push = (x - before) / (p.inv_mass[i] * h);
-                self.collider_impulses[k].linear -= push;
-                self.collider_impulses[k].angular -= x.cross(push);
+            let (x, previous) = (p.position[i], p.previous[i]);
+            pushes.clear();
+            let Some((x, previous)) = world.resolve_particle(x, previous, pushes) else {
+                continue;
+            };
+            // The reaction: each collider takes the particle's momentum change it caused,
+            // the other way (`m Δv`, `Δv = (push − previous's shift)/h`).
+            for &(k, push) in pushes.iter() {
+                let impulse = push / (w * h);
+                self.collider_impulses[k].linear -= impulse;
+                self.collider_impulses[k].angular -= x.cross(impulse);
             }
-            if touched {
-                p.position[i] = x;
-                p.velocity[i] = (x - p.previous[i]) / h;
-            }
+            p.position[i] = x;
+            p.previous[i] = previous;
+            p.velocity[i] = (x - previous) / h;
         }
     }
 }
 
-/// `x` pushed out of `c` by `depth` along `n`, then its tangential motion since
-/// `previous` removed up to `friction × depth`. Friction acts on the motion relative to
-/// the surface under the particle: a particle that sticks moves with the body's point
-/// where it was (`turn`: the body's turn over the substep).
-fn push_out(
-    c: &Collider,
-    x: Vec3,
-    depth: f32,
-    n: Vec3,
-    previous: Vec3,
-    turn: Quat,
+/// How many times a particle is pushed out of the collider it is deepest in (a crease of
+/// two overlapping colliders takes a few; one collider takes one).
+pub const CONTACT_PASSES: usize = 4;
+
+/// The colliders of one substep, placed, with their boxes and turns.
+struct World<'a> {
+    colliders: &'a [Collider],
+    bounds: &'a [Bounds],
+    turns: &'a [Quat],
     h: f32,
-) -> Vec3 {
-    let x = x + n * depth;
-    let mut moved = x - previous;
-    if !c.motion.is_still() {
-        moved -= c.motion.carry(turn, h, previous);
+}
+
+impl World<'_> {
+    /// Where a particle's point `x` was at the start of the substep, seen from collider
+    /// `k` placed at its end: `previous` carried by the body's motion.
+    fn start(&self, k: usize, previous: Vec3) -> Vec3 {
+        let c = &self.colliders[k];
+        if c.motion.is_still() {
+            previous
+        } else {
+            let turn = self.turns.get(k).copied().unwrap_or_default();
+            previous + c.motion.carry(turn, self.h, previous)
+        }
     }
-    let tangential = moved - n * moved.dot(n);
-    let slide = tangential.length();
-    let grip = c.friction * depth;
-    x - if slide <= grip {
-        tangential
-    } else {
-        tangential * (grip / slide)
+
+    /// A particle that moved from `previous` to `x` in the substep, kept outside every
+    /// collider: its new position and `previous`, and each collider's share of the
+    /// correction (less the shift of `previous`) in `pushes`; `None` when no collider
+    /// touched it.
+    fn resolve_particle(
+        &self,
+        x: Vec3,
+        previous: Vec3,
+        pushes: &mut Vec<(usize, Vec3)>,
+    ) -> Option<(Vec3, Vec3)> {
+        let start = x;
+        let mut x = x;
+        let mut shift = Vec3::ZERO; // of `previous`
+        // The collider whose surface takes the friction: the one that pushed most.
+        let mut most: Option<(usize, f32, Vec3)> = None;
+        // Colliders the particle met in the first pass: with one, its push is final (a
+        // particle pushed out of one collider into another it was not in needs a push
+        // larger than the gap between them: a crease, where both meet it).
+        let mut met = 0;
+        for pass in 0..CONTACT_PASSES {
+            if pass == 1 && met < 2 {
+                break;
+            }
+            let mut deepest: Option<(usize, f32, Vec3, bool)> = None;
+            let path = Bounds::segment(previous, x);
+            for (k, c) in self.colliders.iter().enumerate() {
+                let hit = if pass == 0 {
+                    // The first pass sweeps the path (only a path that crossed the band
+                    // can differ from where it ends).
+                    if !self.bounds[k].overlaps(&path) {
+                        continue;
+                    }
+                    match self.crossing(k, previous, x) {
+                        Some((depth, n)) => Some((depth, n, true)),
+                        None => self.bounds[k]
+                            .contains(x)
+                            .then(|| c.penetration(x))
+                            .flatten()
+                            .map(|(depth, n)| (depth, n, false)),
+                    }
+                } else if self.bounds[k].contains(x) {
+                    c.penetration(x).map(|(depth, n)| (depth, n, false))
+                } else {
+                    None
+                };
+                let Some((depth, n, swept)) = hit else {
+                    continue;
+                };
+                if pass == 0 {
+                    met += 1;
+                }
+                // Equal depths (a symmetric crease) are told apart by their normals, not
+                // by the colliders' order.
+                let deeper = |&(_, d, m, _): &(usize, f32, Vec3, bool)| {
+                    depth > d || (depth == d && n.to_array() > m.to_array())
+                };
+                if deepest.is_none_or(|d| deeper(&d)) {
+                    deepest = Some((k, depth, n, swept));
+                }
+            }
+            let Some((k, depth, n, swept)) = deepest else {
+                break;
+            };
+            let push = n * depth;
+            x += push;
+            // Pre-stabilisation: a push deeper than the particle's own motion over the
+            // substep (relative to the body) undoes an overlap it started in; that part
+            // moves `previous` too, so it adds no velocity. A push never sends a particle
+            // off faster than it came in.
+            let own = (x - push - self.start(k, previous + shift)).length();
+            let before = (depth - own).max(0.0);
+            shift += n * before;
+            add_push(pushes, k, push - n * before);
+            // Stopped where its path met the surface, its motion into the surface ends
+            // there (Müller 2007 §3.5: the collision's velocity update, no restitution).
+            if swept {
+                let into = (x - previous - shift).dot(n);
+                if into < 0.0 {
+                    shift += n * into;
+                    add_push(pushes, k, -n * into);
+                }
+            }
+            let share = pushes
+                .iter()
+                .find(|(j, _)| *j == k)
+                .map_or(Vec3::ZERO, |p| p.1);
+            let total = share.length();
+            // (Ties, as above, by the push's direction rather than the order.)
+            let more = |&(_, m, p): &(usize, f32, Vec3)| {
+                total > m || (total == m && share.to_array() > p.to_array())
+            };
+            if most.is_none_or(|m| more(&m)) {
+                most = Some((k, total, share));
+            }
+        }
+        let (k, _, _) = most?;
+        let previous = previous + shift;
+        // Coulomb friction once, from the whole normal correction, against the motion of
+        // the surface that pushed most.
+        let correction = x - start;
+        let depth = correction.length();
+        let n = correction / depth.max(f32::MIN_POSITIVE);
+        let c = &self.colliders[k];
+        let mut moved = x - previous;
+        if !c.motion.is_still() {
+            let turn = self.turns.get(k).copied().unwrap_or_default();
+            moved -= c.motion.carry(turn, self.h, previous);
+        }
+        let tangential = moved - n * moved.dot(n);
+        let slide = tangential.length();
+        let grip = c.friction * depth;
+        let friction = -if slide <= grip {
+            tangential
+        } else {
+            tangential * (grip / slide)
+        };
+        x += friction;
+        add_push(pushes, k, friction);
+        Some((x, previous))
+    }
+
+    /// A path over the substep that the discrete test at its end gets wrong: it crossed
+    /// collider `k` (a plate thinner than the step) or ends pushed out of the far side.
+    /// Returns `(depth, normal)` of the correction that stops it where it met the band
+    /// (swept from outside the band), or on the plane it started on (from inside the band,
+    /// as a particle resting on the surface does), or `None` when the discrete test is
+    /// right.
+    fn crossing(&self, k: usize, previous: Vec3, x: Vec3) -> Option<(f32, Vec3)> {
+        let c = &self.colliders[k];
+        let start = self.start(k, previous);
+        let path = x - start;
+        // A path shorter than the band cannot cross the solid from outside it.
+        if path.length_squared() <= c.thickness * c.thickness {
+            return None;
+        }
+        if c.penetration(x).is_some_and(|(_, n)| n.dot(path) < 0.0) {
+            return None; // ends in the band on the side it came from: the discrete push
+        }
+        let (d0, n0) = c.distance(start);
+        let (t, n) = if d0 < 0.0 {
+            return None; // started inside the solid: pushed out where it ends
+        } else if d0 <= c.thickness {
+            (0.0, n0)
+        } else if path.length() < d0 - c.thickness {
+            return None; // cannot reach the band
+        } else {
+            c.sweep(start, x)?
+        };
+        let past = (x - (start + path * t)).dot(n);
+        (past < 0.0).then_some((-past, n))
+    }
+}
+
+/// Adds `push` to collider `k`'s share.
+fn add_push(pushes: &mut Vec<(usize, Vec3)>, k: usize, push: Vec3) {
+    match pushes.iter_mut().find(|(j, _)| *j == k) {
+        Some((_, p)) => *p += push,
+        None => pushes.push((k, push)),
     }
 }
 
