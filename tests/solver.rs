@@ -1211,3 +1211,64 @@ fn the_step_report_counts_substeps_times_stages_and_measures_xpbd_strain() {
     let none = cloth.step(0.0, &env);
     assert_eq!((none.substeps, none.taken, none.finite), (0, 0, true));
 }
+
+#[test]
+fn the_lightest_seed_material_with_drag_is_stable_at_one_substep() {
+    // Seed 002's lightest node, 0.001 g, with 0.005 N·s/m of drag: h c/m = 80 at one
+    // 16 ms substep, where explicit drag (`v += h (a − c v/m)`) multiplies the velocity
+    // by −79 a step. Implicit drag is stable at any h c/m and only takes energy away.
+    // Mass-spring without springs (its springs at this mass need thousands of substeps
+    // on their own: the drag is what is tested), and XPBD with its springs as constraints,
+    // released swinging from tilted, in gusty wind.
+    let models = [
+        ("mass-spring", Model::MassSpring, no_springs()),
+        (
+            "xpbd",
+            Model::Xpbd(XpbdParams::default()),
+            SpringParams::from_structural(100.0),
+        ),
+    ];
+    for (name, model, springs) in models {
+        let params = ClothParams {
+            model,
+            node_mass: 1e-6,
+            springs,
+            drag: 0.005,
+            substeps: Substeps::Fixed(1),
+            ..conservative(Integrator::Verlet)
+        };
+        let mut cloth = ClothShape::Grid {
+            width: 8,
+            height: 8,
+            spacing: 0.05,
+        }
+        .build_solver(
+            &ClothPins::TopCorners,
+            &params,
+            Affine3A::from_rotation_x(-1.2),
+        )
+        .unwrap();
+        let env = Environment {
+            wind: Wind {
+                direction: Vec3::Z,
+                strength: 1e-5,
+                field: WindField::Trigonometric,
+            },
+            ..no_wind()
+        };
+        let mut most = 0.0f32;
+        for step in 0..500 {
+            cloth.step(DT, &env);
+            assert!(cloth.is_stable(), "{name}: unstable at step {step}");
+            // Drag bounds the speed: the kinetic energy never exceeds what terminal
+            // velocity under gravity and wind allows (`m (g m/c)²/2` a particle, times 4).
+            let kinetic = cloth.energy(&env).kinetic;
+            most = most.max(kinetic);
+        }
+        let n = 64.0;
+        let terminal = 9.81 * 1e-6 / 0.005;
+        let bound = 4.0 * n * 0.5 * 1e-6 * terminal * terminal;
+        eprintln!("{name}: most kinetic energy {most} J (bound {bound} J)");
+        assert!(most <= bound, "{name}: kinetic energy {most} J over {bound} J");
+    }
+}

@@ -9,8 +9,9 @@ use super::{ClothSolver, Particles, SpringKind, Springs};
 use crate::params::Environment;
 
 impl ClothSolver {
-    /// Sets every particle's force to gravity (seed 002 eq. 1.6), wind and linear drag
-    /// `−c v` (seed 000 eq. 31). While its seams are being sewn, a garment is held as a
+    /// Sets every particle's force to gravity (seed 002 eq. 1.6) and wind. The linear drag
+    /// `−c v` (seed 000 eq. 31) is not a force here: the integrators take it implicitly
+    /// (`integrate.rs`), stable at any drag, mass and step. While its seams are being sewn, a garment is held as a
     /// tailor holds it: gravity and wind act once the seams are closed (otherwise the
     /// pieces would fall past the body in the time it takes to sew them).
     pub(super) fn external_forces(&mut self, env: &Environment) {
@@ -20,7 +21,6 @@ impl ClothSolver {
         } else {
             env.effective_gravity()
         };
-        let drag = self.params.drag;
         let has_wind = !held && env.wind.strength > 0.0 && env.wind.direction != Vec3::ZERO;
         let wind = env.wind.at_time(self.clock.time);
         let n = self.particles.len();
@@ -29,14 +29,13 @@ impl ClothSolver {
                           mass,
                           lump,
                           position,
-                          velocity,
                           ..
                       }| {
             let n = force.len();
             let (f, mass, lump) = (&mut force[..n], &mass[..n], &lump[..n]);
-            let (x, v) = (&position[..n], &velocity[..n]);
+            let x = &position[..n];
             for i in 0..n {
-                f[i] = mass[i] * g - drag * lump[i] * v[i];
+                f[i] = mass[i] * g;
                 if has_wind {
                     f[i] += wind.force_at(x[i]) * lump[i];
                 }

@@ -306,18 +306,16 @@ impl ClothSolver {
             false,
             POWER_ITERATIONS,
         );
-        let p = &self.particles;
-        let drag = (0..p.len())
-            .map(|i| self.params.drag * p.lump[i] * p.inv_mass[i])
-            .fold(0.0, f32::max);
+        // (Drag is implicit, `integrate.rs`: it bounds no step.)
         (
             (omega2 * POWER_MARGIN).min(omega2_bound),
-            (spring_gamma * POWER_MARGIN + drag).min(gamma_bound),
+            (spring_gamma * POWER_MARGIN).min(gamma_bound),
         )
     }
 
     /// Gershgorin bounds `(ω_max², γ_max)` of the spring lattice:
-    /// `ω_max² ≤ max_i 2·Σ_j k_ij / m_i`, `γ ≤ max_i (2·Σ_j c_ij + c_drag) / m_i`.
+    /// `ω_max² ≤ max_i 2·Σ_j k_ij / m_i`, `γ ≤ max_i 2·Σ_j c_ij / m_i` (the drag is
+    /// implicit).
     fn spring_gershgorin(&self) -> (f32, f32) {
         let n = self.particles.len();
         let mut k_sum = vec![0.0f32; n];
@@ -342,7 +340,7 @@ impl ClothSolver {
         for i in 0..n {
             let w = self.particles.inv_mass[i];
             omega2 = omega2.max(2.0 * k_sum[i] * w);
-            gamma = gamma.max((2.0 * c_sum[i] + self.params.drag * self.particles.lump[i]) * w);
+            gamma = gamma.max(2.0 * c_sum[i] * w);
         }
         (omega2, gamma)
     }
@@ -432,17 +430,14 @@ impl ClothSolver {
     }
 
     /// `(ω_max², γ_max)` of shape matching's goal force at the current deformation (see
-    /// `pull_omega2`). Müller's velocity update cannot overshoot: only drag and damping
-    /// bound its step.
+    /// `pull_omega2`). Müller's velocity update cannot overshoot: only the goal damping
+    /// bounds its step (the drag is implicit).
     fn goal_frequency(&self, sm: &ShapeMatchingParams, state: &ShapeMatching) -> (f32, f32) {
         let omega2 = match sm.update {
             GoalUpdate::Force => self.pull_omega2(&state.goals, sm.stiffness, sm.exponent),
             GoalUpdate::Velocity => 0.0,
         };
-        (
-            omega2,
-            (sm.damping + self.params.drag) * self.max_free_inv_mass(),
-        )
+        (omega2, sm.damping * self.max_free_inv_mass())
     }
 }
 

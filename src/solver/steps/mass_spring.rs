@@ -20,7 +20,7 @@ impl ModelSteps for MassSpring {
     }
 
     fn integrate(&self, cloth: &mut ClothSolver) {
-        cloth.integrate_particles();
+        cloth.integrate_particles(cloth.params.drag);
     }
 
     /// Strain limiting corrects springs (after the pins are driven).

@@ -100,7 +100,9 @@ impl ModelSteps for PatchParams {
                 return;
             }
         }
-        cloth.integrate_particles();
+        // No drag on the particles: the lattice feels it (a drag here the lattice would
+        // never feel, as the pull's damping is relative).
+        cloth.integrate_particles(0.0);
     }
 
     /// Tiles (Slika 12): every free particle on its target. Otherwise the targets move

@@ -44,7 +44,7 @@ impl ModelSteps for ShapeMatchingParams {
     }
 
     fn integrate(&self, cloth: &mut ClothSolver) {
-        cloth.integrate_particles();
+        cloth.integrate_particles(cloth.params.drag);
     }
 
     /// The velocity update: after integration, every free particle moves the fraction α

@@ -39,7 +39,7 @@ impl ModelSteps for XpbdParams {
 
     /// The prediction `v += h f/m`, `x += h v`, whatever the integrator setting.
     fn integrate(&self, cloth: &mut ClothSolver) {
-        symplectic_euler(&mut cloth.particles, cloth.clock.h);
+        symplectic_euler(&mut cloth.particles, cloth.clock.h, cloth.params.drag);
     }
 
     /// Every spring's constraint projected once, the strain limit with the structural and
