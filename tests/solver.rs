@@ -1269,6 +1269,9 @@ fn the_lightest_seed_material_with_drag_is_stable_at_one_substep() {
         let terminal = 9.81 * 1e-6 / 0.005;
         let bound = 4.0 * n * 0.5 * 1e-6 * terminal * terminal;
         eprintln!("{name}: most kinetic energy {most} J (bound {bound} J)");
-        assert!(most <= bound, "{name}: kinetic energy {most} J over {bound} J");
+        assert!(
+            most <= bound,
+            "{name}: kinetic energy {most} J over {bound} J"
+        );
     }
 }
