@@ -227,3 +227,58 @@ fn a_ball_fired_through_a_curtain_at_20_m_s_leaves_no_particle_inside_it() {
     );
     assert!(cloth.is_stable());
 }
+
+#[test]
+fn a_cloth_dropped_across_a_rope_hangs_over_it() {
+    // A 2 mm rope (a capsule along z) under the middle of a 16 × 16 cloth (5 cm
+    // spacing), between two columns of particles: only the cloth's edges can meet it.
+    let (radius, thickness) = (0.002, 0.005);
+    let rope = Collider {
+        thickness,
+        ..collider(ColliderShape::Capsule {
+            a: Vec3::new(0.0, 0.0, -1.0),
+            b: Vec3::new(0.0, 0.0, 1.0),
+            radius,
+        })
+    };
+    for (name, model) in [
+        ("mass-spring", Model::MassSpring),
+        ("xpbd", Model::Xpbd(XpbdParams::default())),
+    ] {
+        let params = ClothParams {
+            model,
+            ..ClothParams::default()
+        };
+        let frame = Affine3A::from_rotation_translation(
+            Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+            Vec3::new(0.0, 0.3, 0.0),
+        );
+        let mut cloth = Cloth::grid(16, 16, 0.05)
+            .shape
+            .build_solver(&ClothPins::None, &params, frame)
+            .unwrap();
+        let columns: Vec<f32> = cloth.positions().iter().map(|x| x.x.abs()).collect();
+        let nearest = columns.iter().fold(f32::INFINITY, |m, &x| m.min(x));
+        assert!(
+            nearest > 0.02,
+            "a particle column is over the rope: {nearest}"
+        );
+        cloth.set_colliders([rope.clone()]);
+        for _ in 0..125 {
+            cloth.step(DT, &Environment::default());
+        }
+        let x = cloth.positions();
+        let top = x.iter().map(|x| x.y).fold(f32::NEG_INFINITY, f32::max);
+        let centroid = x.iter().sum::<Vec3>() / x.len() as f32;
+        eprintln!("{name}: after 2 s the top at y = {top}, the centroid at {centroid}");
+        assert!(
+            top > 0.0 && top < 0.02,
+            "{name}: the cloth fell off the rope (top at y = {top})"
+        );
+        assert!(
+            centroid.x.abs() < 0.05,
+            "{name}: slid off sideways: {centroid}"
+        );
+        assert!(cloth.is_stable(), "{name}");
+    }
+}

@@ -195,6 +195,14 @@ impl Bounds {
         }
     }
 
+    /// The box grown by `margin` on every side.
+    pub(super) fn grown(&self, margin: f32) -> Self {
+        Self {
+            min: self.min - Vec3::splat(margin),
+            max: self.max + Vec3::splat(margin),
+        }
+    }
+
     /// The centre of the box and its half diagonal: a sphere around it.
     pub(super) fn sphere(&self) -> (Vec3, f32) {
         (

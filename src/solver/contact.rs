@@ -4,8 +4,8 @@
 
 use bevy::math::{Quat, Vec3};
 
-use super::collide::{Bounds, Collider, ColliderImpulse};
-use super::{ClothSolver, Particles};
+use super::collide::{Bounds, Collider, ColliderImpulse, ColliderShape};
+use super::{ClothSolver, Particles, SpringKind, Springs};
 
 /// The colliders a cloth meets and the scratch of its contact stage.
 #[derive(Clone, Debug, Default)]
@@ -143,6 +143,126 @@ impl Contact {
             p.velocity[i] = (x - previous) / h;
         }
     }
+}
+
+impl Contact {
+    /// Keeps the cloth's edges (its structural and shear springs) out of the capsules and
+    /// cylinders thinner than them, which slip between particles: each edge that comes
+    /// within `radius + thickness` of such a collider's axis is pushed out along the
+    /// closest points' line, the correction shared by its two particles by their
+    /// barycentric weight and inverse mass (the position-based edge constraint). A rope or
+    /// a pole across the cloth holds it. Runs after [`Contact::resolve`].
+    pub fn resolve_edges(&mut self, p: &mut Particles, springs: &Springs, h: f32) {
+        if self.colliders.is_empty() {
+            return;
+        }
+        let colliders = if self.colliders_move {
+            &self.colliders_now
+        } else {
+            &self.colliders
+        };
+        let edges = [SpringKind::Structural, SpringKind::Shear]
+            .map(|kind| springs.ranges[kind as usize].clone());
+        let longest = edges
+            .iter()
+            .flat_map(|r| springs.rest_length[r.clone()].iter())
+            .fold(0.0f32, |m, &l| m.max(l));
+        for (k, c) in colliders.iter().enumerate() {
+            let (a, b, radius) = match c.shape {
+                ColliderShape::Capsule { a, b, radius } => (a, b, radius),
+                ColliderShape::Cylinder {
+                    center,
+                    axis,
+                    half_height,
+                    radius,
+                } => (
+                    center - axis * half_height,
+                    center + axis * half_height,
+                    radius,
+                ),
+                _ => continue,
+            };
+            let reach = radius + c.thickness;
+            // Thicker than the cloth's longest edge: the particles catch it themselves.
+            if 2.0 * reach >= longest {
+                continue;
+            }
+            let bounds = Bounds::segment(a, b).grown(reach);
+            for range in edges.iter() {
+                for s in range.clone() {
+                    if !springs.alive[s] {
+                        continue;
+                    }
+                    let (i, j) = (springs.a[s] as usize, springs.b[s] as usize);
+                    let (wi, wj) = (p.inv_mass[i], p.inv_mass[j]);
+                    let (xi, xj) = (p.position[i], p.position[j]);
+                    if wi + wj == 0.0 || !Bounds::segment(xi, xj).overlaps(&bounds) {
+                        continue;
+                    }
+                    let (t, on_axis) = closest_points(xi, xj, a, b);
+                    let on_edge = xi.lerp(xj, t);
+                    let offset = on_edge - on_axis;
+                    let d = offset.length();
+                    if d >= reach {
+                        continue;
+                    }
+                    let n = offset
+                        .try_normalize()
+                        .unwrap_or_else(|| (b - a).normalize_or(Vec3::X).any_orthonormal_vector());
+                    // The point at `t` moves out by the depth: each end by its weight.
+                    let (bi, bj) = (1.0 - t, t);
+                    let w = bi * bi * wi + bj * bj * wj;
+                    if w <= 0.0 {
+                        continue;
+                    }
+                    let lambda = (reach - d) / w;
+                    for (x, weight, inv) in [(i, bi, wi), (j, bj, wj)] {
+                        let push = n * (lambda * weight * inv);
+                        p.position[x] += push;
+                        p.velocity[x] = (p.position[x] - p.previous[x]) / h;
+                    }
+                    // The reaction: `m Δx / h` of both ends, the other way.
+                    let impulse = n * (lambda * (bi + bj) / h);
+                    self.collider_impulses[k].linear -= impulse;
+                    self.collider_impulses[k].angular -= on_edge.cross(impulse);
+                }
+            }
+        }
+    }
+}
+
+/// The closest points of the segments `p–q` and `a–b`: the fraction along `p–q` and the
+/// point of `a–b` (Ericson, *Real-Time Collision Detection*, §5.1.9).
+fn closest_points(p: Vec3, q: Vec3, a: Vec3, b: Vec3) -> (f32, Vec3) {
+    let (d1, d2, r) = (q - p, b - a, p - a);
+    let (l1, l2, f) = (d1.length_squared(), d2.length_squared(), d2.dot(r));
+    let tiny = f32::MIN_POSITIVE;
+    if l1 <= tiny {
+        let u = (f / l2.max(tiny)).clamp(0.0, 1.0);
+        return (0.0, a + d2 * u);
+    }
+    let c = d1.dot(r);
+    let (s, u) = if l2 <= tiny {
+        ((-c / l1).clamp(0.0, 1.0), 0.0)
+    } else {
+        let e = d1.dot(d2);
+        let denom = l1 * l2 - e * e;
+        let mut s = if denom > tiny {
+            ((e * f - c * l2) / denom).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let mut u = (e * s + f) / l2;
+        if u < 0.0 {
+            u = 0.0;
+            s = (-c / l1).clamp(0.0, 1.0);
+        } else if u > 1.0 {
+            u = 1.0;
+            s = ((e - c) / l1).clamp(0.0, 1.0);
+        }
+        (s, u)
+    };
+    (s, a + d2 * u)
 }
 
 /// How many times a particle is pushed out of the collider it is deepest in (a crease of

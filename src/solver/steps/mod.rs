@@ -297,6 +297,8 @@ impl ClothSolver {
         let constrained = Instant::now();
         let tau = self.clock.left_after_substep();
         self.contact.resolve(&mut self.particles, tau, h);
+        self.contact
+            .resolve_edges(&mut self.particles, &self.structure.springs, h);
         self.clock.advance();
         self.report.taken += 1;
         self.report.time.constraints += constrained - start;
