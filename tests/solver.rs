@@ -359,21 +359,27 @@ fn seed_002_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
         substeps,
         ..conservative(Integrator::Verlet)
     };
+    tilted_in_gusts(4, &params, 1e-6)
+}
+
+/// A `size × size` grid (5 cm spacing) pinned by its top corners, tilted 1.2 rad from
+/// hanging so it swings, in seed 002's gusty wind of `wind` N a particle.
+fn tilted_in_gusts(size: u32, params: &ClothParams, wind: f32) -> (ClothSolver, Environment) {
     let cloth = ClothShape::Grid {
-        width: 4,
-        height: 4,
+        width: size,
+        height: size,
         spacing: 0.05,
     }
     .build_solver(
         &ClothPins::TopCorners,
-        &params,
+        params,
         Affine3A::from_rotation_x(-1.2),
     )
     .unwrap();
     let env = Environment {
         wind: Wind {
             direction: Vec3::Z,
-            strength: 1e-6,
+            strength: wind,
             field: WindField::Trigonometric,
         },
         ..no_wind()
@@ -1237,25 +1243,7 @@ fn the_lightest_seed_material_with_drag_is_stable_at_one_substep() {
             substeps: Substeps::Fixed(1),
             ..conservative(Integrator::Verlet)
         };
-        let mut cloth = ClothShape::Grid {
-            width: 8,
-            height: 8,
-            spacing: 0.05,
-        }
-        .build_solver(
-            &ClothPins::TopCorners,
-            &params,
-            Affine3A::from_rotation_x(-1.2),
-        )
-        .unwrap();
-        let env = Environment {
-            wind: Wind {
-                direction: Vec3::Z,
-                strength: 1e-5,
-                field: WindField::Trigonometric,
-            },
-            ..no_wind()
-        };
+        let (mut cloth, env) = tilted_in_gusts(8, &params, 1e-5);
         let mut most = 0.0f32;
         for step in 0..500 {
             cloth.step(DT, &env);
