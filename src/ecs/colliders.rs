@@ -81,6 +81,88 @@ pub enum ColliderKind {
     },
 }
 
+impl ColliderKind {
+    /// Checks the sizes: radii and half-extents > 0, half-lengths ≥ 0, a half-space's
+    /// normal non-zero, each within [`crate::limits::MAX_POSITION`].
+    pub fn validate(&self) -> Result<(), ClothError> {
+        let radius = |r: f32| check_size("radius", r, true, "a radius from 0 (excluded) to 1e5 m");
+        match *self {
+            ColliderKind::Sphere { radius: r } => radius(r)?,
+            ColliderKind::Capsule {
+                radius: r,
+                half_length,
+            } => {
+                radius(r)?;
+                check_size(
+                    "half_length",
+                    half_length,
+                    false,
+                    "a half-length from 0 to 1e5 m",
+                )?;
+            }
+            ColliderKind::Cuboid { half_extents: h } => {
+                for (field, value) in [
+                    ("half_extents.x", h.x),
+                    ("half_extents.y", h.y),
+                    ("half_extents.z", h.z),
+                ] {
+                    check_size(
+                        field,
+                        value,
+                        true,
+                        "a half-extent from 0 (excluded) to 1e5 m",
+                    )?;
+                }
+            }
+            ColliderKind::Cylinder {
+                radius: r,
+                half_height,
+            } => {
+                radius(r)?;
+                check_size(
+                    "half_height",
+                    half_height,
+                    true,
+                    "a half-height from 0 (excluded) to 1e5 m",
+                )?;
+            }
+            ColliderKind::Plane => {}
+            ColliderKind::HalfSpace { normal, distance } => {
+                let length = normal.length();
+                crate::params::check(
+                    "normal",
+                    length,
+                    length.is_finite() && length > 1e-6,
+                    "a finite, non-zero normal",
+                )?;
+                crate::params::check(
+                    "distance",
+                    distance,
+                    distance.abs() <= crate::limits::MAX_POSITION,
+                    "a distance within ±1e5 m",
+                )?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A size from 0 (excluded, with `least_excluded`) to [`crate::limits::MAX_POSITION`].
+fn check_size(
+    field: &'static str,
+    value: f32,
+    least_excluded: bool,
+    expected: &'static str,
+) -> Result<(), ClothError> {
+    let low = if least_excluded {
+        value > 0.0
+    } else {
+        value >= 0.0
+    };
+    let ok = low && value <= crate::limits::MAX_POSITION;
+    crate::params::check(field, value, ok, expected)
+}
+
 impl From<InfinitePlane3d> for ClothCollider {
     /// The solid behind the plane (its `normal` points out of it), like avian's
     /// `Collider::half_space`.
@@ -205,81 +287,14 @@ impl ClothCollider {
     /// Checks sizes: radius > 0, half-length, thickness and friction ≥ 0, each within
     /// [`crate::limits::MAX_POSITION`].
     pub fn validate(&self) -> Result<(), ClothError> {
-        use crate::params::check;
-        const MAX: f32 = crate::limits::MAX_POSITION;
-        let size = |field, value: f32, least_excluded: bool, expected| {
-            let low = if least_excluded {
-                value > 0.0
-            } else {
-                value >= 0.0
-            };
-            check(field, value, low && value <= MAX, expected)
-        };
-        let radius = |r: f32| size("radius", r, true, "a radius from 0 (excluded) to 1e5 m");
-        match self.shape {
-            ColliderKind::Sphere { radius: r } => radius(r)?,
-            ColliderKind::Capsule {
-                radius: r,
-                half_length,
-            } => {
-                radius(r)?;
-                size(
-                    "half_length",
-                    half_length,
-                    false,
-                    "a half-length from 0 to 1e5 m",
-                )?;
-            }
-            ColliderKind::Cuboid { half_extents: h } => {
-                for (field, value) in [
-                    ("half_extents.x", h.x),
-                    ("half_extents.y", h.y),
-                    ("half_extents.z", h.z),
-                ] {
-                    size(
-                        field,
-                        value,
-                        true,
-                        "a half-extent from 0 (excluded) to 1e5 m",
-                    )?;
-                }
-            }
-            ColliderKind::Cylinder {
-                radius: r,
-                half_height,
-            } => {
-                radius(r)?;
-                size(
-                    "half_height",
-                    half_height,
-                    true,
-                    "a half-height from 0 (excluded) to 1e5 m",
-                )?;
-            }
-            ColliderKind::Plane => {}
-            ColliderKind::HalfSpace { normal, distance } => {
-                let length = normal.length();
-                check(
-                    "normal",
-                    length,
-                    length.is_finite() && length > 1e-6,
-                    "a finite, non-zero normal",
-                )?;
-                check(
-                    "distance",
-                    distance,
-                    distance.abs() <= MAX,
-                    "a distance within ±1e5 m",
-                )?;
-            }
-        }
-        size(
+        self.shape.validate()?;
+        check_size(
             "thickness",
             self.thickness,
             false,
             "a thickness from 0 to 1e5 m",
         )?;
-        size(
+        check_size(
             "friction",
             self.friction,
             false,

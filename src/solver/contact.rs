@@ -269,6 +269,15 @@ fn closest_points(p: Vec3, q: Vec3, a: Vec3, b: Vec3) -> (f32, Vec3) {
 /// two overlapping colliders takes a few; one collider takes one).
 pub const CONTACT_PASSES: usize = 4;
 
+/// A collider a particle is in: which, how deep, the outward normal, and whether its
+/// path was swept into it.
+struct Hit {
+    k: usize,
+    depth: f32,
+    n: Vec3,
+    swept: bool,
+}
+
 /// The colliders of one substep, placed, with their boxes and turns.
 struct World<'a> {
     colliders: &'a [Collider],
@@ -303,7 +312,8 @@ impl World<'_> {
         let start = x;
         let mut x = x;
         let mut shift = Vec3::ZERO; // of `previous`
-        // The collider whose surface takes the friction: the one that pushed most.
+        // The collider whose surface takes the friction (`friction`): the one that pushed
+        // most.
         let mut most: Option<(usize, f32, Vec3)> = None;
         // Colliders the particle met in the first pass: with one, its push is final (a
         // particle pushed out of one collider into another it was not in needs a push
@@ -313,44 +323,7 @@ impl World<'_> {
             if pass == 1 && met < 2 {
                 break;
             }
-            let mut deepest: Option<(usize, f32, Vec3, bool)> = None;
-            let path = Bounds::segment(previous, x);
-            for (k, c) in self.colliders.iter().enumerate() {
-                let hit = if pass == 0 {
-                    // The first pass sweeps the path (only a path that crossed the band
-                    // can differ from where it ends).
-                    if !self.bounds[k].overlaps(&path) {
-                        continue;
-                    }
-                    match self.crossing(k, previous, x) {
-                        Some((depth, n)) => Some((depth, n, true)),
-                        None => self.bounds[k]
-                            .contains(x)
-                            .then(|| c.penetration(x))
-                            .flatten()
-                            .map(|(depth, n)| (depth, n, false)),
-                    }
-                } else if self.bounds[k].contains(x) {
-                    c.penetration(x).map(|(depth, n)| (depth, n, false))
-                } else {
-                    None
-                };
-                let Some((depth, n, swept)) = hit else {
-                    continue;
-                };
-                if pass == 0 {
-                    met += 1;
-                }
-                // Equal depths (a symmetric crease) are told apart by their normals, not
-                // by the colliders' order.
-                let deeper = |&(_, d, m, _): &(usize, f32, Vec3, bool)| {
-                    depth > d || (depth == d && n.to_array() > m.to_array())
-                };
-                if deepest.is_none_or(|d| deeper(&d)) {
-                    deepest = Some((k, depth, n, swept));
-                }
-            }
-            let Some((k, depth, n, swept)) = deepest else {
+            let Some(Hit { k, depth, n, swept }) = self.deepest(pass, previous, x, &mut met) else {
                 break;
             };
             let push = n * depth;
@@ -387,9 +360,58 @@ impl World<'_> {
         }
         let (k, _, _) = most?;
         let previous = previous + shift;
-        // Coulomb friction once, from the whole normal correction, against the motion of
-        // the surface that pushed most.
-        let correction = x - start;
+        let friction = self.friction(k, x - start, x, previous);
+        x += friction;
+        add_push(pushes, k, friction);
+        Some((x, previous))
+    }
+
+    /// The collider the particle at `x` (from `previous`) is deepest in, in pass `pass`;
+    /// the first pass also sweeps its path, and counts in `met` the colliders it meets.
+    fn deepest(&self, pass: usize, previous: Vec3, x: Vec3, met: &mut usize) -> Option<Hit> {
+        let mut deepest: Option<Hit> = None;
+        let path = Bounds::segment(previous, x);
+        for (k, c) in self.colliders.iter().enumerate() {
+            let hit = if pass == 0 {
+                // The first pass sweeps the path (only a path that crossed the band can
+                // differ from where it ends).
+                if !self.bounds[k].overlaps(&path) {
+                    continue;
+                }
+                match self.crossing(k, previous, x) {
+                    Some((depth, n)) => Some((depth, n, true)),
+                    None => self.bounds[k]
+                        .contains(x)
+                        .then(|| c.penetration(x))
+                        .flatten()
+                        .map(|(depth, n)| (depth, n, false)),
+                }
+            } else if self.bounds[k].contains(x) {
+                c.penetration(x).map(|(depth, n)| (depth, n, false))
+            } else {
+                None
+            };
+            let Some((depth, n, swept)) = hit else {
+                continue;
+            };
+            if pass == 0 {
+                *met += 1;
+            }
+            // Equal depths (a symmetric crease) are told apart by their normals, not by
+            // the colliders' order.
+            let deeper =
+                |d: &Hit| depth > d.depth || (depth == d.depth && n.to_array() > d.n.to_array());
+            if deepest.as_ref().is_none_or(deeper) {
+                deepest = Some(Hit { k, depth, n, swept });
+            }
+        }
+        deepest
+    }
+
+    /// Coulomb friction once, from the whole normal `correction` of a particle now at `x`
+    /// (from `previous`), against the motion of collider `k`'s surface: the tangential
+    /// motion removed, up to `friction × |correction|`.
+    fn friction(&self, k: usize, correction: Vec3, x: Vec3, previous: Vec3) -> Vec3 {
         let depth = correction.length();
         let n = correction / depth.max(f32::MIN_POSITIVE);
         let c = &self.colliders[k];
@@ -401,14 +423,11 @@ impl World<'_> {
         let tangential = moved - n * moved.dot(n);
         let slide = tangential.length();
         let grip = c.friction * depth;
-        let friction = -if slide <= grip {
+        -if slide <= grip {
             tangential
         } else {
             tangential * (grip / slide)
-        };
-        x += friction;
-        add_push(pushes, k, friction);
-        Some((x, previous))
+        }
     }
 
     /// A path over the substep that the discrete test at its end gets wrong: it crossed
