@@ -97,7 +97,7 @@ pub(super) fn for_each_from<T: Send>(
     });
 }
 
-/// Sets every element of `out` by `f(index, element)`, in pieces as [`for_each`] does:
+/// Sets every element of `out` by `f(index, element)`, in pieces as `for_each` does:
 /// the per-particle kernels that read other arrays by index (normals, the patch pull)
 /// and the plugin's mesh write-back.
 pub fn for_each_indexed<T: Send>(out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {

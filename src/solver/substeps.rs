@@ -123,7 +123,7 @@ impl ClothSolver {
     /// springs.
     ///
     /// XPBD is stable at any substep count; its automatic substeps follow its accuracy
-    /// target instead ([`Self::xpbd_substeps`]).
+    /// target instead (`xpbd_substeps`).
     pub fn stable_substeps(&self, dt: f32) -> u32 {
         let (omega2, gamma) = match (&self.params.model, &self.model) {
             (Model::Xpbd(xpbd), _) => return self.xpbd_substeps(dt, xpbd.max_stretch_error),
