@@ -28,6 +28,9 @@ pub(super) struct Contact {
     pub collider_impulses: Vec<ColliderImpulse>,
     /// One particle's pushes by collider (scratch, kept for its storage).
     pub pushes: Vec<(usize, Vec3)>,
+    /// The capsules and cylinders thinner than the cloth's longest edge, which the edge
+    /// pass tests (set with the colliders: neither changes between steps).
+    pub thin: Vec<usize>,
 }
 
 impl Contact {
@@ -153,7 +156,7 @@ impl Contact {
     /// barycentric weight and inverse mass (the position-based edge constraint). A rope or
     /// a pole across the cloth holds it. Runs after [`Contact::resolve`].
     pub fn resolve_edges(&mut self, p: &mut Particles, springs: &Springs, h: f32) {
-        if self.colliders.is_empty() {
+        if self.thin.is_empty() {
             return;
         }
         let colliders = if self.colliders_move {
@@ -161,32 +164,12 @@ impl Contact {
         } else {
             &self.colliders
         };
-        let edges = [SpringKind::Structural, SpringKind::Shear]
-            .map(|kind| springs.ranges[kind as usize].clone());
-        let longest = edges
-            .iter()
-            .flat_map(|r| springs.rest_length[r.clone()].iter())
-            .fold(0.0f32, |m, &l| m.max(l));
-        for (k, c) in colliders.iter().enumerate() {
-            let (a, b, radius) = match c.shape {
-                ColliderShape::Capsule { a, b, radius } => (a, b, radius),
-                ColliderShape::Cylinder {
-                    center,
-                    axis,
-                    half_height,
-                    radius,
-                } => (
-                    center - axis * half_height,
-                    center + axis * half_height,
-                    radius,
-                ),
-                _ => continue,
-            };
-            let reach = radius + c.thickness;
-            // Thicker than the cloth's longest edge: the particles catch it themselves.
-            if 2.0 * reach >= longest {
+        let edges = EDGES.map(|kind| springs.ranges[kind as usize].clone());
+        for &k in &self.thin {
+            let c = &colliders[k];
+            let Some((a, b, reach)) = axis(c) else {
                 continue;
-            }
+            };
             let bounds = Bounds::segment(a, b).grown(reach);
             for range in edges.iter() {
                 for s in range.clone() {
@@ -229,6 +212,29 @@ impl Contact {
             }
         }
     }
+}
+
+/// The springs the edge pass keeps out of thin colliders.
+const EDGES: [SpringKind; 2] = [SpringKind::Structural, SpringKind::Shear];
+
+/// A capsule's or cylinder's axis and its reach (radius plus thickness), or `None` for
+/// another shape.
+fn axis(c: &Collider) -> Option<(Vec3, Vec3, f32)> {
+    let (a, b, radius) = match c.shape {
+        ColliderShape::Capsule { a, b, radius } => (a, b, radius),
+        ColliderShape::Cylinder {
+            center,
+            axis,
+            half_height,
+            radius,
+        } => (
+            center - axis * half_height,
+            center + axis * half_height,
+            radius,
+        ),
+        _ => return None,
+    };
+    Some((a, b, radius + c.thickness))
 }
 
 /// The closest points of the segments `p–q` and `a–b`: the fraction along `p–q` and the
@@ -486,6 +492,19 @@ impl ClothSolver {
         }
         let cloth = Bounds::around(&self.particles.position);
         self.disturbed |= self.contact.change_reaches(&cloth);
+        // The thin colliders, for the edge pass: thicker than the cloth's longest edge,
+        // the particles catch a collider themselves.
+        let springs = &self.structure.springs;
+        let longest = EDGES
+            .iter()
+            .flat_map(|&kind| springs.rest_length[springs.ranges[kind as usize].clone()].iter())
+            .fold(0.0f32, |m, &l| m.max(l));
+        let contact = &mut self.contact;
+        contact.thin.clear();
+        let thin = |c: &Collider| axis(c).is_some_and(|(_, _, reach)| 2.0 * reach < longest);
+        contact
+            .thin
+            .extend((0..contact.colliders.len()).filter(|&k| thin(&contact.colliders[k])));
         // The part centres meet the colliders too: otherwise the targets sink into a
         // collider and pull the particles in after it.
         if let Some(patches) = self.model.patches_mut() {
