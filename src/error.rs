@@ -79,6 +79,14 @@ pub enum ClothError {
         /// The model.
         model: &'static str,
     },
+    /// A feature the model does not have was switched on.
+    #[error("the {model} model has no {feature}: use xpbd or mass-spring")]
+    ModelLacks {
+        /// The model.
+        model: &'static str,
+        /// The feature.
+        feature: &'static str,
+    },
     /// A shape that is laid out from data it does not hold itself (a mesh from the
     /// entity's `Mesh3d`, a garment from its file) was asked for its layout directly.
     #[error("a {shape} cloth is laid out from its {source_of}")]

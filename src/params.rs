@@ -559,6 +559,45 @@ pub struct ClothParams {
     pub strain_limit_tolerance: Option<f32>,
     /// A spring longer than `tear_ratio · rest_length` breaks (seed 000 §3.2). `None`: never.
     pub tear_ratio: Option<f32>,
+    /// Particles of the cloth kept apart from one another, so folds do not pass through
+    /// themselves (XPBD and mass-spring). Off by default.
+    pub self_collision: SelfCollision,
+}
+
+/// Self-collision: every two particles of a cloth that are not joined by a spring keep
+/// a distance `d` apart, with friction (Müller's "Ten Minute Physics" #15, the method of
+/// NvCloth's self-collision). `d` is `distance`, at most the cloth's rest spacing (the
+/// median structural rest length): a particle cannot slip through a triangle whose
+/// corners it must stay `d` from.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SelfCollision {
+    /// On or off.
+    pub enabled: bool,
+    /// The distance kept, m; `None`: the rest spacing.
+    pub distance: Option<f32>,
+    /// Coulomb friction between touching particles (0: they slide freely).
+    pub friction: f32,
+}
+
+impl Default for SelfCollision {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            distance: None,
+            friction: 0.3,
+        }
+    }
+}
+
+impl SelfCollision {
+    /// On, at the rest spacing, with the default friction.
+    pub fn on() -> Self {
+        Self {
+            enabled: true,
+            ..Self::default()
+        }
+    }
 }
 
 impl Default for ClothParams {
@@ -574,6 +613,7 @@ impl Default for ClothParams {
             strain_limit_iterations: 4,
             strain_limit_tolerance: None,
             tear_ratio: None,
+            self_collision: SelfCollision::default(),
         }
     }
 }
@@ -702,11 +742,41 @@ impl ClothParams {
         if let Some(ratio) = self.tear_ratio {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
         }
+        self.validate_self_collision()?;
         match &self.model {
             Model::ShapeMatching(sm) => sm.validate()?,
             Model::Patches(patches) => patches.validate()?,
             Model::Xpbd(xpbd) => xpbd.validate()?,
             Model::MassSpring => {}
+        }
+        Ok(())
+    }
+
+    /// Self-collision's distance and friction, and a model that has it: the patch model
+    /// moves its particles with their parts, and shape matching toward goals that would
+    /// pull folds back through each other.
+    fn validate_self_collision(&self) -> Result<(), ClothError> {
+        let sc = &self.self_collision;
+        if let Some(d) = sc.distance {
+            check(
+                "self_collision.distance",
+                d,
+                d > 0.0 && d <= crate::limits::MAX_SPACING,
+                "a distance > 0 and at most 10 m (limits::MAX_SPACING)",
+            )?;
+        }
+        check(
+            "self_collision.friction",
+            sc.friction,
+            (0.0..=10.0).contains(&sc.friction),
+            "a friction coefficient from 0 to 10",
+        )?;
+        let model = self.model.kind();
+        if sc.enabled && matches!(model, ModelKind::Patches | ModelKind::ShapeMatching) {
+            return Err(ClothError::ModelLacks {
+                model: model.name(),
+                feature: "self-collision",
+            });
         }
         Ok(())
     }

@@ -90,6 +90,10 @@ pub struct SceneCloth {
     /// Rotation of the frame about the vertical axis, in degrees.
     #[serde(default)]
     pub yaw_degrees: f32,
+    /// Tilt of the frame about its x axis before the yaw, in degrees: 90 lays a grid
+    /// level (its rows running away along −z).
+    #[serde(default)]
+    pub pitch_degrees: f32,
     /// Shape, pins and model parameters.
     pub cloth: Cloth,
     /// Base colour as linear RGB in 0–1.
@@ -106,11 +110,14 @@ pub struct SceneCloth {
 }
 
 impl SceneCloth {
-    /// The cloth's frame: its translation, turned by `yaw_degrees` about +y.
+    /// The cloth's frame: its translation, tilted by `pitch_degrees` about +x, then
+    /// turned by `yaw_degrees` about +y.
     pub fn transform(&self) -> bevy::transform::components::Transform {
-        bevy::transform::components::Transform::from_translation(self.translation).with_rotation(
-            bevy::math::Quat::from_rotation_y(self.yaw_degrees.to_radians()),
-        )
+        use bevy::math::Quat;
+        let yaw = Quat::from_rotation_y(self.yaw_degrees.to_radians());
+        let pitch = Quat::from_rotation_x(self.pitch_degrees.to_radians());
+        bevy::transform::components::Transform::from_translation(self.translation)
+            .with_rotation(yaw * pitch)
     }
 }
 
@@ -333,6 +340,7 @@ impl ClothScene {
             let checks = [
                 ("translation", placed(entry.translation)),
                 ("yaw_degrees", angle(entry.yaw_degrees)),
+                ("pitch_degrees", angle(entry.pitch_degrees)),
             ];
             if let Some((key, _)) = checks.iter().find(|(_, ok)| !ok) {
                 return Err(invalid(
@@ -506,6 +514,7 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         | Pattern(_)
         | Garment { .. } => "shape",
         UnknownModel { .. } => "model",
+        ModelLacks { .. } => "self_collision",
         NotMeasurable { .. } | NonFinite { .. } => "cloths",
     }
 }

@@ -1,4 +1,4 @@
-//! The render test: each example (curtain, card, T-shirt, flag; the cape with `--features
+//! The render test: each example (curtain, card, T-shirt, fold, flag; the cape with `--features
 //! avian`) under Xvfb with Mesa's software Vulkan, two screenshots, and checks from the
 //! pixels that the cloth is drawn where the camera looks and that it moved between them.
 //! Catches a black window, a mesh that is not updated and a frozen simulation.
@@ -199,6 +199,12 @@ fn tshirt_renders_and_moves() {
         (40, 120),
         0.02..0.5,
     );
+}
+
+#[test]
+fn fold_renders_and_moves() {
+    // The cloth falls onto the ball (frame 20) and folds round it (frame 90).
+    renders_and_moves("fold", &[], (20, 90), 0.02..0.6);
 }
 
 #[test]

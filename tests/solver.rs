@@ -35,6 +35,7 @@ fn conservative(integrator: Integrator) -> ClothParams {
         strain_limit_iterations: 0,
         strain_limit_tolerance: None,
         tear_ratio: None,
+        self_collision: Default::default(),
     }
 }
 

@@ -496,6 +496,19 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
         );
     }
     optional(ui, "tear ratio", &mut p.tear_ratio, 2.0, 1.05..=10.0);
+    // XPBD and mass-spring only: the other models say so above ("not simulated: …").
+    let sc = &mut p.self_collision;
+    ui.checkbox(&mut sc.enabled, "self-collision");
+    if sc.enabled {
+        optional(
+            ui,
+            "distance, m (else the spacing)",
+            &mut sc.distance,
+            0.01,
+            0.001..=0.1,
+        );
+        ui.add(slider(&mut sc.friction, 0.0..=1.0).text("cloth-on-cloth friction"));
+    }
 }
 
 fn shape_matching_controls(ui: &mut egui::Ui, sm: &mut ShapeMatchingParams) {

@@ -148,6 +148,7 @@ pub fn params(
         strain_limit_iterations: 0,
         strain_limit_tolerance: None,
         tear_ratio: None,
+        self_collision: Default::default(),
     })
 }
 

@@ -45,8 +45,8 @@ use crate::layout::garment::{Garment, GarmentLoader};
 use crate::layout::shape::{ClothPins, ClothShape};
 use crate::params::{
     ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
-    RotationMethod, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind, WindField,
-    XpbdParams,
+    RotationMethod, SelfCollision, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind,
+    WindField, XpbdParams,
 };
 
 /// The ordered system sets of the cloth simulation in the plugin's schedule (and, for
@@ -194,6 +194,7 @@ fn register_types(app: &mut App) {
         .register_type::<ShapeMatchingParams>()
         .register_type::<PatchParams>()
         .register_type::<XpbdParams>()
+        .register_type::<SelfCollision>()
         .register_type::<PatchTargets>()
         .register_type::<RotationMethod>()
         .register_type::<GoalUpdate>()

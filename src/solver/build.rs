@@ -32,6 +32,7 @@ impl ClothSolver {
             structure: Structure::new(layout),
             drivers: Drivers::new(pins, frame),
             contact: Contact::default(),
+            self_contact: Default::default(),
             clock: Clock::default(),
             params: *params,
             model: ModelState::None,

@@ -4,7 +4,7 @@
 //! A step is a pipeline of stages (`steps/mod.rs` describes it; one file per model under
 //! `steps/`). A cloth's state is kept by concern: its particles ([`Particles`]), what it
 //! is made of (`structure.rs`), what holds it from outside (`drivers.rs`), what it touches
-//! (`contact.rs`), its clock (`clock.rs`) and the active model's own state.
+//! (`contact.rs`), how it keeps out of itself (`self_contact.rs`), its clock (`clock.rs`) and the active model's own state.
 
 mod build;
 mod clock;
@@ -20,6 +20,7 @@ mod layout;
 mod parallel;
 pub mod patches;
 mod queries;
+mod self_contact;
 pub mod shape_matching;
 mod state;
 mod steps;
@@ -58,6 +59,8 @@ pub struct ClothSolver {
     drivers: drivers::Drivers,
     /// Colliders and the contact stage's scratch.
     contact: contact::Contact,
+    /// Self-collision's pairs and scratch.
+    self_contact: self_contact::SelfContact,
     /// Time and substeps.
     clock: clock::Clock,
     params: ClothParams,

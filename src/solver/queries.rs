@@ -106,6 +106,23 @@ impl ClothSolver {
         self.structure.grid
     }
 
+    /// The distance self-collision keeps particles apart in the last step, m (0 when
+    /// off, or for a model without it).
+    pub fn self_collision_distance(&self) -> f32 {
+        self.self_contact.distance()
+    }
+
+    /// The pairs self-collision listed for the last step (0 when off).
+    pub fn self_collision_pairs(&self) -> usize {
+        self.self_contact.pair_count()
+    }
+
+    /// The pairs self-collision pushed apart in the last step (a pair counts once per
+    /// substep it was pushed in).
+    pub fn self_collision_pushes(&self) -> usize {
+        self.self_contact.pushed()
+    }
+
     /// Number of particles.
     pub fn particle_count(&self) -> usize {
         self.particles.len()

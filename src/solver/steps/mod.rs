@@ -11,14 +11,14 @@
 //! 3. [`ClothSolver::fit_targets`]: the model's move toward its goals or targets (shape
 //!    matching's velocity update, the patch model's single-particle parts);
 //! 4. [`ClothSolver::constrain`]: the pins and grab driven to their place, the model's
-//!    constraints (Provot's limit, XPBD's projection and tethers), then contact (the
-//!    last: no later correction pushes a particle back into a collider); it ends the
-//!    substep and advances the clock.
+//!    constraints (Provot's limit, XPBD's projection and tethers), self-collision
+//!    (`self_contact.rs`), then contact (the last: no later correction pushes a particle
+//!    back into a collider); it ends the substep and advances the clock.
 //!
 //! What differs between models lives in one file per model (`steps/*.rs`), each an
 //! implementation of [`ModelSteps`]; the model is chosen once, when the step begins.
-//! A new stage common to every model (self-collision) goes into `constrain` after
-//! contact; a model's own stage into its file.
+//! A new stage common to every model goes into `constrain` before contact; a model's
+//! own stage into its file.
 
 mod mass_spring;
 mod patches;
@@ -120,6 +120,8 @@ pub struct StageTimes {
     pub fit_targets: Duration,
     /// Stage 4 but contact: the drivers and the model's constraints.
     pub constraints: Duration,
+    /// Self-collision (its pairs are listed in `begin`).
+    pub self_contact: Duration,
     /// Contact with the colliders.
     pub contact: Duration,
     /// `end_step`: the finite check, tearing, the strain measure.
@@ -134,6 +136,7 @@ impl StageTimes {
             + self.integrate
             + self.fit_targets
             + self.constraints
+            + self.self_contact
             + self.contact
             + self.end
     }
@@ -217,6 +220,14 @@ impl ClothSolver {
         steps.build(self, auto && self.state_dependent_stiffness());
         steps.prepare(self, dt);
         let n = self.choose_substeps(dt);
+        let on = matches!(model, Model::Xpbd(_) | Model::MassSpring);
+        self.self_contact.prepare(
+            &self.particles,
+            &self.structure.springs,
+            &self.params.self_collision,
+            on,
+            (dt, n),
+        );
         let ratio = self.clock.begin(dt, n);
         steps.begin(self, dt, ratio);
         let p = &self.particles.position;
@@ -295,6 +306,8 @@ impl ClothSolver {
         let model = self.stepping;
         model_steps(&model).constrain(self);
         let constrained = Instant::now();
+        self.self_contact.resolve(&mut self.particles, h);
+        let separated = Instant::now();
         let tau = self.clock.left_after_substep();
         self.contact.resolve(&mut self.particles, tau, h);
         self.contact
@@ -302,7 +315,8 @@ impl ClothSolver {
         self.clock.advance();
         self.report.taken += 1;
         self.report.time.constraints += constrained - start;
-        self.report.time.contact += constrained.elapsed();
+        self.report.time.self_contact += separated - constrained;
+        self.report.time.contact += separated.elapsed();
     }
 
     /// Finishes a step. A step that left a position or velocity non-finite is undone (the

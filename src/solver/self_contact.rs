@@ -1,0 +1,319 @@
+//! Self-collision: the particles of one cloth kept a distance `d` apart, so that folds do
+//! not pass through themselves (Müller, "Ten Minute Physics" #15, "Self-collision"; the
+//! method of NvCloth's self-collision).
+//!
+//! Once a step, a spatial hash over the particles (cells the size of the query radius, a
+//! dense table of twice the particle count filled by counting sort: no allocation once
+//! grown) lists every pair that can come within `d` during the step: those closer than
+//! `R = d + 2L`, where `L` bounds how far a particle moves relative to the cloth's mean
+//! motion over the step. Pairs joined by a spring of any family (seams included) are
+//! never listed: they are the cloth's own structure, and a seam's two ends are meant to
+//! meet. Each substep, after the model's constraints and before contact:
+//! 1. every free particle's motion relative to the mean is clamped to `min(L/n, d/2)`
+//!    (the velocity clamp): two particles then close in by at most `d` in a substep, so
+//!    one cannot pass another unseen, and no pair outside the list comes within `d`;
+//! 2. every listed pair closer than `d` is pushed apart to `d` along their line, shared
+//!    by inverse mass, with Coulomb friction on their relative tangential motion
+//!    (position-based friction, Macklin et al. 2014 §6.1), in the list's order
+//!    (Gauss–Seidel on one thread: the same bits whatever the pool).
+//!
+//! The clamp is relative to the mean motion, so a cloth falling or carried as a whole is
+//! not slowed; only its parts' motion relative to one another is bounded, to `d/2` per
+//! substep (at 13 substeps of 16 ms and `d` = 3 cm, 12 m/s).
+
+use bevy::math::Vec3;
+
+use super::{Particles, SpringKind, Springs};
+use crate::params::SelfCollision;
+
+/// The self-collision stage's state (see the module doc).
+#[derive(Clone, Debug, Default)]
+pub(super) struct SelfContact {
+    /// The distance kept this step (0: off).
+    d: f32,
+    /// The most a free particle moves relative to the mean in one substep.
+    reach: f32,
+    /// Coulomb's coefficient between two particles.
+    friction: f32,
+    /// Each particle's partners by spring, sorted:
+    /// `excluded[excluded_start[i]..excluded_start[i + 1]]`.
+    excluded_start: Vec<u32>,
+    excluded: Vec<u32>,
+    /// The spring count and particle count the exclusions were built for.
+    built_for: Option<(usize, usize)>,
+    /// The cloth's rest spacing: the median structural rest length.
+    spacing: f32,
+    /// This step's pairs, `i < j`, in increasing order.
+    pairs: Vec<[u32; 2]>,
+    /// The hash: each slot's first entry in `entries` (particle indices by slot).
+    slot_start: Vec<u32>,
+    entries: Vec<u32>,
+    /// One particle's candidates (scratch).
+    near: Vec<u32>,
+    /// Pairs pushed apart since the step began.
+    pushed: usize,
+}
+
+impl SelfContact {
+    /// The distance kept this step (0 when self-collision is off).
+    pub fn distance(&self) -> f32 {
+        self.d
+    }
+
+    /// The pairs listed this step.
+    pub fn pair_count(&self) -> usize {
+        self.pairs.len()
+    }
+
+    /// Pairs pushed apart since the step began (a pair counts once per substep).
+    pub fn pushed(&self) -> usize {
+        self.pushed
+    }
+
+    /// Lists this step's pairs (switched off when `params` is off or the model has no
+    /// self-collision: `on` false). `dt` is the step, `n` its substeps.
+    pub fn prepare(
+        &mut self,
+        p: &Particles,
+        springs: &Springs,
+        params: &SelfCollision,
+        on: bool,
+        (dt, n): (f32, u32),
+    ) {
+        self.pairs.clear();
+        self.pushed = 0;
+        self.d = 0.0;
+        if !(on && params.enabled) || p.is_empty() {
+            return;
+        }
+        if self.built_for != Some((springs.len(), p.len())) {
+            self.exclude_springs(springs, p.len());
+        }
+        let d = params
+            .distance
+            .map_or(self.spacing, |d| d.min(self.spacing));
+        if !(d > 0.0) {
+            return;
+        }
+        // How far a particle moves relative to the mean over the step: 1.5× what its
+        // velocity now takes it, at least `d/2`, at most two spacings (the list's cost),
+        // and at most `d/2` a substep (the clamp that keeps pairs from passing).
+        let (mean, free) = mean_of_free(p, |i| p.velocity[i]);
+        if free == 0 {
+            return;
+        }
+        let fastest = (0..p.len())
+            .filter(|&i| p.inv_mass[i] != 0.0)
+            .map(|i| (p.velocity[i] - mean).length_squared())
+            .fold(0.0f32, f32::max)
+            .sqrt();
+        let per_step = (1.5 * fastest * dt).clamp(0.5 * d, 2.0 * self.spacing.max(d));
+        self.reach = (per_step / n.max(1) as f32).min(0.5 * d);
+        self.d = d;
+        self.friction = params.friction;
+        let radius = d + 2.0 * self.reach * n.max(1) as f32;
+        self.fill_hash(&p.position, radius);
+        self.find_pairs(p, radius);
+    }
+
+    /// Every particle's partners by spring (torn ones too: a tear's two sides start
+    /// where they were), and the rest spacing.
+    fn exclude_springs(&mut self, springs: &Springs, n: usize) {
+        let mut count = vec![0u32; n + 1];
+        for s in 0..springs.len() {
+            count[springs.a[s] as usize] += 1;
+            count[springs.b[s] as usize] += 1;
+        }
+        self.excluded_start.clear();
+        self.excluded_start.push(0);
+        let mut total = 0;
+        for c in &count[..n] {
+            total += c;
+            self.excluded_start.push(total);
+        }
+        self.excluded.clear();
+        self.excluded.resize(total as usize, 0);
+        let mut fill: Vec<u32> = self.excluded_start[..n].to_vec();
+        for s in 0..springs.len() {
+            let (a, b) = (springs.a[s], springs.b[s]);
+            self.excluded[fill[a as usize] as usize] = b;
+            fill[a as usize] += 1;
+            self.excluded[fill[b as usize] as usize] = a;
+            fill[b as usize] += 1;
+        }
+        for i in 0..n {
+            let (start, end) = (self.excluded_start[i], self.excluded_start[i + 1]);
+            self.excluded[start as usize..end as usize].sort_unstable();
+        }
+        let structural = springs.ranges[SpringKind::Structural as usize].clone();
+        let mut lengths = springs.rest_length[structural].to_vec();
+        if lengths.is_empty() {
+            lengths = springs.rest_length.clone();
+        }
+        lengths.sort_unstable_by(f32::total_cmp);
+        self.spacing = lengths.get(lengths.len() / 2).copied().unwrap_or(0.0);
+        self.built_for = Some((springs.len(), n));
+    }
+
+    /// Whether `i` and `j` are joined by a spring.
+    fn excluded(&self, i: u32, j: u32) -> bool {
+        let (start, end) = (
+            self.excluded_start[i as usize],
+            self.excluded_start[i as usize + 1],
+        );
+        self.excluded[start as usize..end as usize]
+            .binary_search(&j)
+            .is_ok()
+    }
+
+    /// Sorts the particles into the hash's slots by their cell of size `cell`.
+    fn fill_hash(&mut self, x: &[Vec3], cell: f32) {
+        let slots = 2 * x.len();
+        self.slot_start.clear();
+        self.slot_start.resize(slots + 1, 0);
+        for &xi in x {
+            self.slot_start[slot(cell_of(xi, cell), slots)] += 1;
+        }
+        let mut total = 0;
+        for start in self.slot_start.iter_mut() {
+            total += *start;
+            *start = total;
+        }
+        // Filled from the back, so each slot's entries end up in increasing order and
+        // `slot_start[k]` at the slot's first.
+        self.entries.clear();
+        self.entries.resize(x.len(), 0);
+        for (i, &xi) in x.iter().enumerate().rev() {
+            let k = slot(cell_of(xi, cell), slots);
+            self.slot_start[k] -= 1;
+            self.entries[self.slot_start[k] as usize] = i as u32;
+        }
+    }
+
+    /// The pairs closer than `radius`, not joined by a spring and not both pinned.
+    fn find_pairs(&mut self, p: &Particles, radius: f32) {
+        let (x, slots) = (&p.position, 2 * p.len());
+        let r2 = radius * radius;
+        let mut near = std::mem::take(&mut self.near);
+        for i in 0..x.len() {
+            let c = cell_of(x[i], radius);
+            near.clear();
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let k = slot([c[0] + dx, c[1] + dy, c[2] + dz], slots);
+                        let (start, end) = (self.slot_start[k], self.slot_start[k + 1]);
+                        for &j in &self.entries[start as usize..end as usize] {
+                            if j as usize > i && x[j as usize].distance_squared(x[i]) < r2 {
+                                near.push(j);
+                            }
+                        }
+                    }
+                }
+            }
+            // Two cells may share a slot: each pair once, in increasing order.
+            near.sort_unstable();
+            near.dedup();
+            let i = i as u32;
+            for &j in near.iter() {
+                let pinned = p.inv_mass[i as usize] == 0.0 && p.inv_mass[j as usize] == 0.0;
+                if !pinned && !self.excluded(i, j) {
+                    self.pairs.push([i, j]);
+                }
+            }
+        }
+        self.near = near;
+    }
+
+    /// One substep's self-collision (see the module doc): the clamp on each particle's
+    /// motion relative to the mean, then every listed pair kept `d` apart with friction.
+    /// Velocities follow the corrected positions, `v = (x − x_prev)/h`.
+    pub fn resolve(&mut self, p: &mut Particles, h: f32) {
+        if self.d == 0.0 {
+            return;
+        }
+        self.clamp(p, h);
+        let (d, mu) = (self.d, self.friction);
+        for &[i, j] in &self.pairs {
+            let (i, j) = (i as usize, j as usize);
+            let r = p.position[j] - p.position[i];
+            let l2 = r.length_squared();
+            if l2 >= d * d {
+                continue;
+            }
+            let (wi, wj) = (p.inv_mass[i], p.inv_mass[j]);
+            let w = wi + wj;
+            // Two particles at one point part the way they came from.
+            let l = l2.sqrt();
+            let n = if l > 1e-6 * d {
+                r / l
+            } else {
+                (p.previous[j] - p.previous[i]).normalize_or(Vec3::Y)
+            };
+            let c = d - r.dot(n);
+            let push = n * (c / w);
+            p.position[i] -= push * wi;
+            p.position[j] += push * wj;
+            // Coulomb: their relative tangential motion over the substep, cut by at most
+            // μ times the normal correction.
+            let moved = (p.position[j] - p.previous[j]) - (p.position[i] - p.previous[i]);
+            let slide = moved - n * moved.dot(n);
+            let length = slide.length();
+            if length > 0.0 {
+                let cut = slide * ((mu * c).min(length) / (length * w));
+                p.position[i] += cut * wi;
+                p.position[j] -= cut * wj;
+            }
+            p.velocity[i] = (p.position[i] - p.previous[i]) / h;
+            p.velocity[j] = (p.position[j] - p.previous[j]) / h;
+            self.pushed += 1;
+        }
+    }
+
+    /// Clamps each free particle's motion over the substep, relative to the free
+    /// particles' mean, to `reach`.
+    fn clamp(&self, p: &mut Particles, h: f32) {
+        let (mean, _) = mean_of_free(p, |i| p.position[i] - p.previous[i]);
+        let reach = self.reach;
+        for i in 0..p.len() {
+            if p.inv_mass[i] == 0.0 {
+                continue;
+            }
+            let relative = p.position[i] - p.previous[i] - mean;
+            let l2 = relative.length_squared();
+            if l2 > reach * reach {
+                let relative = relative * (reach / l2.sqrt());
+                p.position[i] = p.previous[i] + mean + relative;
+                p.velocity[i] = (mean + relative) / h;
+            }
+        }
+    }
+}
+
+/// The mean of `v(i)` over the free particles, and their count.
+fn mean_of_free(p: &Particles, v: impl Fn(usize) -> Vec3) -> (Vec3, usize) {
+    let mut sum = Vec3::ZERO;
+    let mut free = 0;
+    for i in 0..p.len() {
+        if p.inv_mass[i] != 0.0 {
+            sum += v(i);
+            free += 1;
+        }
+    }
+    (sum / free.max(1) as f32, free)
+}
+
+/// The cell of size `cell` that `x` is in (float-to-int casts saturate: a far point
+/// lands in an edge cell, which only costs a candidate).
+fn cell_of(x: Vec3, cell: f32) -> [i32; 3] {
+    let c = (x / cell).floor();
+    [c.x as i32, c.y as i32, c.z as i32]
+}
+
+/// The hash slot of cell `c` among `slots` (Teschner et al. 2003's primes).
+fn slot(c: [i32; 3], slots: usize) -> usize {
+    let h = (c[0].wrapping_mul(92_837_111))
+        ^ (c[1].wrapping_mul(689_287_499))
+        ^ (c[2].wrapping_mul(283_923_481));
+    (h.unsigned_abs() as usize) % slots
+}

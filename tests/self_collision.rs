@@ -1,0 +1,247 @@
+//! Self-collision: a cloth dropped onto a ball folds onto itself on the ground without
+//! passing through itself (no two particles that are not rest neighbours closer than
+//! half the distance kept, no edge through a triangle, checked exactly here, not by the
+//! solver), and the same scene without it does cross; one thread and two give the same
+//! bits. `cargo test --test self_collision`.
+
+use bevy::math::{Vec3, Vec3A};
+use bevy_cloth::headless::SceneRun;
+use bevy_cloth::params::{Model, Substeps};
+use bevy_cloth::scene::ClothScene;
+use bevy_cloth::solver::{ClothSolver, SpringKind};
+
+/// Seconds each scene runs: it has settled by then.
+const SECONDS: f32 = 5.0;
+/// Frames checked: every this many steps.
+const EVERY: usize = 8;
+
+fn fold_scene(self_collision: bool, model: &str) -> ClothScene {
+    let mut scene = ClothScene::load("assets/scenes/fold.ron").expect("fold.ron loads");
+    let params = &mut scene.cloths[0].cloth.params;
+    params.self_collision.enabled = self_collision;
+    if model == "mass-spring" {
+        params.model = Model::MassSpring;
+        params.springs.structural.stiffness = 400.0;
+        params.strain_limit = Some(0.1);
+        params.substeps = Substeps::Auto { max: 512 };
+    }
+    scene
+}
+
+/// What a run did, over the frames checked.
+#[derive(Debug, Default)]
+struct Crossings {
+    /// The closest two particles that are not rest neighbours came, m.
+    closest: f32,
+    /// Frames with an edge through a triangle, and the most such edges in one.
+    frames: usize,
+    most: usize,
+    /// The distance the solver kept.
+    d: f32,
+    checked: usize,
+}
+
+fn run(scene: &ClothScene) -> Crossings {
+    let mut run = SceneRun::new(scene).expect("the scene builds");
+    let steps = (SECONDS / run.timestep).round() as usize;
+    let mut seen = Crossings {
+        closest: f32::INFINITY,
+        ..Default::default()
+    };
+    run.run(steps, |step, cloths| {
+        if step % EVERY != 0 {
+            return;
+        }
+        let cloth = &cloths[0].1;
+        assert!(cloth.is_stable(), "the cloth stays finite");
+        seen.d = seen.d.max(cloth.self_collision_distance());
+        seen.closest = seen.closest.min(closest_non_neighbours(cloth));
+        let crossing = edges_through_triangles(cloth);
+        if crossing > 0 {
+            seen.frames += 1;
+            seen.most = seen.most.max(crossing);
+        }
+        seen.checked += 1;
+    });
+    seen
+}
+
+/// The closest two particles of a grid cloth come that are more than two rows or
+/// columns apart (rest neighbours: within two along the grid, the springs' reach).
+fn closest_non_neighbours(cloth: &ClothSolver) -> f32 {
+    let (w, _) = cloth.grid_size().expect("a grid");
+    let x = cloth.positions();
+    let mut closest = f32::INFINITY;
+    for i in 0..x.len() {
+        let (ci, ri) = (i as i64 % w as i64, i as i64 / w as i64);
+        for (j, xj) in x.iter().enumerate().skip(i + 1) {
+            let (cj, rj) = (j as i64 % w as i64, j as i64 / w as i64);
+            if (ci - cj).abs() <= 2 && (ri - rj).abs() <= 2 {
+                continue;
+            }
+            closest = closest.min(x[i].distance(*xj));
+        }
+    }
+    closest
+}
+
+/// How many of the cloth's edges (its structural and shear springs) pass through one
+/// of its triangles that does not share a particle with them: an exact segment–triangle
+/// test over every pair, with a box test first.
+fn edges_through_triangles(cloth: &ClothSolver) -> usize {
+    let x: Vec<Vec3A> = cloth.positions().iter().map(|&p| p.into()).collect();
+    let springs = cloth.springs();
+    let edges: Vec<[u32; 2]> = [SpringKind::Structural, SpringKind::Shear]
+        .into_iter()
+        .flat_map(|kind| springs.ranges[kind as usize].clone())
+        .filter(|&s| springs.alive[s])
+        .map(|s| [springs.a[s], springs.b[s]])
+        .collect();
+    let boxes = |ids: &[u32]| {
+        let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        for &i in ids {
+            lo = lo.min(x[i as usize]);
+            hi = hi.max(x[i as usize]);
+        }
+        (lo, hi)
+    };
+    let edge_boxes: Vec<_> = edges.iter().map(|e| boxes(e)).collect();
+    let mut crossing = 0;
+    for t in cloth.triangles() {
+        let (lo, hi) = boxes(t);
+        for (e, (elo, ehi)) in edges.iter().zip(&edge_boxes) {
+            if elo.cmpgt(hi).any() || ehi.cmplt(lo).any() || t.contains(&e[0]) || t.contains(&e[1])
+            {
+                continue;
+            }
+            let [a, b, c] = t.map(|i| x[i as usize]);
+            if segment_hits_triangle(x[e[0] as usize], x[e[1] as usize], a, b, c) {
+                crossing += 1;
+            }
+        }
+    }
+    crossing
+}
+
+/// Whether the segment `p–q` meets the triangle `abc` (Möller–Trumbore with the
+/// segment's parameter in [0, 1]).
+fn segment_hits_triangle(p: Vec3A, q: Vec3A, a: Vec3A, b: Vec3A, c: Vec3A) -> bool {
+    let (dir, e1, e2) = (q - p, b - a, c - a);
+    let h = dir.cross(e2);
+    let det = e1.dot(h);
+    if det.abs() < 1e-12 {
+        return false;
+    }
+    let s = p - a;
+    let u = s.dot(h) / det;
+    if !(0.0..=1.0).contains(&u) {
+        return false;
+    }
+    let qv = s.cross(e1);
+    let v = dir.dot(qv) / det;
+    if v < 0.0 || u + v > 1.0 {
+        return false;
+    }
+    let t = e2.dot(qv) / det;
+    (0.0..=1.0).contains(&t)
+}
+
+#[test]
+fn the_exact_crossing_test_finds_an_edge_through_a_triangle_and_no_other() {
+    let (a, b, c) = (Vec3A::ZERO, Vec3A::X, Vec3A::Y);
+    let through = |p: Vec3, q: Vec3| segment_hits_triangle(p.into(), q.into(), a, b, c);
+    assert!(through(Vec3::new(0.2, 0.2, -1.0), Vec3::new(0.2, 0.2, 1.0)));
+    assert!(!through(Vec3::new(0.2, 0.2, 0.1), Vec3::new(0.2, 0.2, 1.0)));
+    assert!(!through(
+        Vec3::new(0.8, 0.8, -1.0),
+        Vec3::new(0.8, 0.8, 1.0)
+    ));
+    assert!(!through(
+        Vec3::new(0.2, 0.2, -1.0),
+        Vec3::new(0.2, 0.2, -0.5)
+    ));
+}
+
+#[test]
+fn a_cloth_folding_onto_itself_does_not_pass_through_itself() {
+    for model in ["xpbd", "mass-spring"] {
+        let with = run(&fold_scene(true, model));
+        eprintln!("{model}, self-collision on: {with:?}");
+        assert!(with.d > 0.0, "{model}: self-collision acts");
+        assert_eq!(
+            with.frames, 0,
+            "{model}: no edge through a triangle: {with:?}"
+        );
+        assert!(
+            with.closest >= 0.5 * with.d,
+            "{model}: no two particles closer than d/2 = {}: {with:?}",
+            0.5 * with.d
+        );
+        // The same scene without it: the detector above sees the crossings.
+        let without = run(&fold_scene(false, model));
+        eprintln!("{model}, self-collision off: {without:?}");
+        assert!(
+            without.frames > 0 && without.closest < 0.5 * with.d,
+            "{model}: without self-collision the cloth passes through itself: {without:?}"
+        );
+    }
+}
+
+#[test]
+fn self_collision_is_refused_for_the_models_without_it() {
+    let mut scene = fold_scene(true, "xpbd");
+    let params = &mut scene.cloths[0].cloth.params;
+    params.model = Model::ShapeMatching(Default::default());
+    params.springs.structural.stiffness = 400.0;
+    let err = SceneRun::new(&scene).err().expect("refused");
+    assert!(err.to_string().contains("self-collision"), "{err}");
+}
+
+/// A 256 × 256 cloth folded over onto itself (the upper half laid 0.9 of the distance
+/// kept above the lower, so every pair of layers is in contact from the first substep):
+/// the same bits on one thread and on the pool.
+#[test]
+fn the_same_bits_on_one_thread_and_on_both_cores() {
+    let folded = || {
+        let mut scene = fold_scene(true, "xpbd");
+        let cloth = &mut scene.cloths[0].cloth;
+        cloth.shape = bevy_cloth::ClothShape::Grid {
+            width: 256,
+            height: 256,
+            spacing: 0.004,
+        };
+        let mut run = SceneRun::new(&scene).expect("builds");
+        let solver = &mut run.cloths[0].1;
+        solver.step(run.timestep, &run.environment);
+        let d = solver.self_collision_distance();
+        assert!(d > 0.0);
+        let p = solver.particles_mut();
+        let half = 128 * 256;
+        for i in half..2 * half {
+            let mirror = (2 * half - 1 - i) / 256 * 256 + i % 256;
+            p.position[i] = p.position[mirror] + Vec3::Y * (0.9 * d);
+            p.previous[i] = p.position[i];
+            p.velocity[i] = Vec3::ZERO;
+        }
+        run
+    };
+    let mut positions = Vec::new();
+    for parallel in [false, true] {
+        bevy_cloth::solver::set_parallel(parallel);
+        let mut run = folded();
+        let mut pushes = 0;
+        run.run(10, |step, cloths| {
+            if step == 1 {
+                pushes = cloths[0].1.self_collision_pushes();
+            }
+        });
+        assert!(pushes > 10_000, "the layers touch: {pushes} pushes");
+        let solver = &run.cloths[0].1;
+        positions.push(solver.positions().to_vec());
+    }
+    bevy_cloth::solver::set_parallel(true);
+    assert!(
+        positions[0] == positions[1],
+        "one thread and the pool differ"
+    );
+}
