@@ -111,6 +111,10 @@ impl SceneRun {
         let mut times = crate::stats::StepTimes::default();
         for step in 1..=steps {
             let start = Instant::now();
+            if self.cloths.len() > 1 {
+                let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
+                solver::collide_cloths(&mut all);
+            }
             for (_, cloth) in &mut self.cloths {
                 cloth.step(self.timestep, &env);
             }

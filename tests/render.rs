@@ -208,6 +208,17 @@ fn fold_renders_and_moves() {
 }
 
 #[test]
+fn stack_renders_and_moves() {
+    // Three cloths dropped on each other (the fold example's window, another scene).
+    renders_and_moves(
+        "fold",
+        &["--scene", "assets/scenes/stack.ron"],
+        (20, 90),
+        0.02..0.6,
+    );
+}
+
+#[test]
 fn flag_renders_and_moves() {
     // The textured flag on its pole, carried round a circle: its coloured bands are the
     // cloth's pixels, and it moves with the pole (issue 18's attachment and texture).

@@ -1,5 +1,5 @@
 //! Self-collision: a cloth dropped onto a ball folds onto itself on the ground without
-//! passing through itself (no two particles that are not rest neighbours closer than
+//! passing through itself, and three cloths dropped on each other stay in layers (no two particles that are not rest neighbours closer than
 //! half the distance kept, no edge through a triangle, checked exactly here, not by the
 //! solver), and the same scene without it does cross; one thread and two give the same
 //! bits. `cargo test --test self_collision`.
@@ -16,14 +16,23 @@ const SECONDS: f32 = 5.0;
 const EVERY: usize = 8;
 
 fn fold_scene(self_collision: bool, model: &str) -> ClothScene {
-    let mut scene = ClothScene::load("assets/scenes/fold.ron").expect("fold.ron loads");
-    let params = &mut scene.cloths[0].cloth.params;
-    params.self_collision.enabled = self_collision;
-    if model == "mass-spring" {
-        params.model = Model::MassSpring;
-        params.springs.structural.stiffness = 400.0;
-        params.strain_limit = Some(0.1);
-        params.substeps = Substeps::Auto { max: 512 };
+    scene("fold", self_collision, model)
+}
+
+/// A scene of `assets/scenes/` with self-collision on or off, as XPBD (the file's) or
+/// mass-spring.
+fn scene(name: &str, self_collision: bool, model: &str) -> ClothScene {
+    let path = format!("assets/scenes/{name}.ron");
+    let mut scene = ClothScene::load(&path).expect("the scene loads");
+    for entry in &mut scene.cloths {
+        let params = &mut entry.cloth.params;
+        params.self_collision.enabled = self_collision;
+        if model == "mass-spring" {
+            params.model = Model::MassSpring;
+            params.springs.structural.stiffness = 400.0;
+            params.strain_limit = Some(0.1);
+            params.substeps = Substeps::Auto { max: 512 };
+        }
     }
     scene
 }
@@ -52,11 +61,13 @@ fn run(scene: &ClothScene) -> Crossings {
         if step % EVERY != 0 {
             return;
         }
-        let cloth = &cloths[0].1;
-        assert!(cloth.is_stable(), "the cloth stays finite");
-        seen.d = seen.d.max(cloth.self_collision_distance());
-        seen.closest = seen.closest.min(closest_non_neighbours(cloth));
-        let crossing = edges_through_triangles(cloth);
+        let cloths: Vec<&ClothSolver> = cloths.iter().map(|(_, c)| c).collect();
+        for cloth in &cloths {
+            assert!(cloth.is_stable(), "the cloth stays finite");
+            seen.d = seen.d.max(cloth.self_collision_distance());
+        }
+        seen.closest = seen.closest.min(closest_non_neighbours(&cloths));
+        let crossing = edges_through_triangles(&cloths);
         if crossing > 0 {
             seen.frames += 1;
             seen.most = seen.most.max(crossing);
@@ -66,37 +77,53 @@ fn run(scene: &ClothScene) -> Crossings {
     seen
 }
 
-/// The closest two particles of a grid cloth come that are more than two rows or
-/// columns apart (rest neighbours: within two along the grid, the springs' reach).
-fn closest_non_neighbours(cloth: &ClothSolver) -> f32 {
-    let (w, _) = cloth.grid_size().expect("a grid");
-    let x = cloth.positions();
+/// The closest two particles come that are not rest neighbours: of different cloths,
+/// or of one grid cloth more than two rows or columns apart (within two along the grid
+/// is the springs' reach).
+fn closest_non_neighbours(cloths: &[&ClothSolver]) -> f32 {
     let mut closest = f32::INFINITY;
-    for i in 0..x.len() {
-        let (ci, ri) = (i as i64 % w as i64, i as i64 / w as i64);
-        for (j, xj) in x.iter().enumerate().skip(i + 1) {
-            let (cj, rj) = (j as i64 % w as i64, j as i64 / w as i64);
-            if (ci - cj).abs() <= 2 && (ri - rj).abs() <= 2 {
-                continue;
+    for (a, ca) in cloths.iter().enumerate() {
+        let (w, _) = ca.grid_size().expect("a grid");
+        let x = ca.positions();
+        for i in 0..x.len() {
+            let (ci, ri) = (i as i64 % w as i64, i as i64 / w as i64);
+            for (j, xj) in x.iter().enumerate().skip(i + 1) {
+                let (cj, rj) = (j as i64 % w as i64, j as i64 / w as i64);
+                if (ci - cj).abs() <= 2 && (ri - rj).abs() <= 2 {
+                    continue;
+                }
+                closest = closest.min(x[i].distance(*xj));
             }
-            closest = closest.min(x[i].distance(*xj));
+            for cb in &cloths[a + 1..] {
+                for xj in cb.positions() {
+                    closest = closest.min(x[i].distance(*xj));
+                }
+            }
         }
     }
     closest
 }
 
-/// How many of the cloth's edges (its structural and shear springs) pass through one
-/// of its triangles that does not share a particle with them: an exact segment–triangle
-/// test over every pair, with a box test first.
-fn edges_through_triangles(cloth: &ClothSolver) -> usize {
-    let x: Vec<Vec3A> = cloth.positions().iter().map(|&p| p.into()).collect();
-    let springs = cloth.springs();
-    let edges: Vec<[u32; 2]> = [SpringKind::Structural, SpringKind::Shear]
-        .into_iter()
-        .flat_map(|kind| springs.ranges[kind as usize].clone())
-        .filter(|&s| springs.alive[s])
-        .map(|s| [springs.a[s], springs.b[s]])
-        .collect();
+/// How many of the cloths' edges (their structural and shear springs) pass through a
+/// triangle (of any of them) that does not share a particle with them: an exact
+/// segment–triangle test over every pair, with a box test first.
+fn edges_through_triangles(cloths: &[&ClothSolver]) -> usize {
+    let mut x: Vec<Vec3A> = Vec::new();
+    let mut edges: Vec<[u32; 2]> = Vec::new();
+    let mut triangles: Vec<[u32; 3]> = Vec::new();
+    for cloth in cloths {
+        let offset = x.len() as u32;
+        x.extend(cloth.positions().iter().map(|&p| Vec3A::from(p)));
+        let springs = cloth.springs();
+        edges.extend(
+            [SpringKind::Structural, SpringKind::Shear]
+                .into_iter()
+                .flat_map(|kind| springs.ranges[kind as usize].clone())
+                .filter(|&s| springs.alive[s])
+                .map(|s| [springs.a[s] + offset, springs.b[s] + offset]),
+        );
+        triangles.extend(cloth.triangles().iter().map(|t| t.map(|i| i + offset)));
+    }
     let boxes = |ids: &[u32]| {
         let (mut lo, mut hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for &i in ids {
@@ -107,7 +134,7 @@ fn edges_through_triangles(cloth: &ClothSolver) -> usize {
     };
     let edge_boxes: Vec<_> = edges.iter().map(|e| boxes(e)).collect();
     let mut crossing = 0;
-    for t in cloth.triangles() {
+    for t in &triangles {
         let (lo, hi) = boxes(t);
         for (e, (elo, ehi)) in edges.iter().zip(&edge_boxes) {
             if elo.cmpgt(hi).any() || ehi.cmplt(lo).any() || t.contains(&e[0]) || t.contains(&e[1])
@@ -183,6 +210,29 @@ fn a_cloth_folding_onto_itself_does_not_pass_through_itself() {
         assert!(
             without.frames > 0 && without.closest < 0.5 * with.d,
             "{model}: without self-collision the cloth passes through itself: {without:?}"
+        );
+    }
+}
+
+#[test]
+fn three_cloths_dropped_on_each_other_stay_in_layers() {
+    for model in ["xpbd", "mass-spring"] {
+        let with = run(&scene("stack", true, model));
+        eprintln!("{model}, cloth-cloth on: {with:?}");
+        assert_eq!(
+            with.frames, 0,
+            "{model}: no edge through a triangle: {with:?}"
+        );
+        assert!(
+            with.closest >= 0.5 * with.d,
+            "{model}: no two particles closer than d/2 = {}: {with:?}",
+            0.5 * with.d
+        );
+        let without = run(&scene("stack", false, model));
+        eprintln!("{model}, cloth-cloth off: {without:?}");
+        assert!(
+            without.frames > 0 && without.closest < 0.5 * with.d,
+            "{model}: without it the cloths pass through each other: {without:?}"
         );
     }
 }

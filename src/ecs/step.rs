@@ -123,6 +123,23 @@ pub(crate) fn begin_steps(
     }
     plan.count = 0;
     plan.index = 0;
+    // Cloth–cloth contact: the cloths with self-collision on take each other's
+    // particles near them (a sleeping cloth's stay where they are).
+    let colliding = cloths
+        .iter()
+        .filter(|(_, sim, ..)| sim.solver.params().self_collision.enabled)
+        .count();
+    if colliding > 1 {
+        let mut all: Vec<_> = cloths
+            .iter_mut()
+            .map(|(_, sim, _, sleep)| (sim, run && sleep.is_none_or(|s| !s.asleep)))
+            .collect();
+        let mut solvers: Vec<_> = all
+            .iter_mut()
+            .map(|(sim, moving)| (&mut sim.solver, *moving))
+            .collect();
+        solver::collide_cloths(&mut solvers);
+    }
     for (entity, mut sim, progress, sleep) in &mut cloths {
         let start = Instant::now();
         let awake = sleep.is_none_or(|s| !s.asleep);

@@ -6,9 +6,9 @@
 //! dense table of twice the particle count filled by counting sort: no allocation once
 //! grown) lists every pair that can come within `d` during the step: those closer than
 //! `R = d + 2L`, where `L` bounds how far a particle moves relative to the cloth's mean
-//! motion over the step. Pairs joined by a spring of any family (seams included) are
-//! never listed: they are the cloth's own structure, and a seam's two ends are meant to
-//! meet. Each substep, after the model's constraints and before contact:
+//! motion over the step. Pairs joined by a structural, shear or seam spring are never
+//! listed: they are the cloth's own structure (closer than `d` at rest), and a seam's
+//! two ends are meant to meet. Each substep, after the model's constraints and before contact:
 //! 1. every free particle's motion relative to the mean is clamped to `min(L/n, d/2)`
 //!    (the velocity clamp): two particles then close in by at most `d` in a substep, so
 //!    one cannot pass another unseen, and no pair outside the list comes within `d`;
@@ -16,6 +16,20 @@
 //!    by inverse mass, with Coulomb friction on their relative tangential motion
 //!    (position-based friction, Macklin et al. 2014 §6.1), in the list's order
 //!    (Gauss–Seidel on one thread: the same bits whatever the pool).
+//!
+//! Cloth–cloth contact is the same test between a cloth's particles and those of the
+//! other cloths near it ([`collide_cloths`]): once a step each cloth takes a copy of their
+//! particles (position, velocity, inverse mass) and keeps its own `d` from where they
+//! were when the step began. Each cloth moves only its own particle, by its share of the
+//! correction (`w_i/(w_i + w_k)`), so the two cloths' steps together make the whole
+//! correction and neither waits for the other (they step in parallel, each with its own
+//! substeps). The push adds no velocity (the other has moved since: a push against a
+//! stale position must not launch), only the approach is stopped. Tried and dropped:
+//! predicting the others along their velocity (a cloth stopped by a collider is then
+//! predicted through it, and the noisy last-substep velocities of a settling cloth made
+//! the stack of `assets/scenes/stack.ron` go non-finite); the cost of the stale positions
+//! is that two cloths falling together closer than `d` plus a step's fall hold each
+//! other back a little.
 //!
 //! The clamp is relative to the mean motion, so a cloth falling or carried as a whole is
 //! not slowed; only its parts' motion relative to one another is bounded, to `d/2` per
@@ -35,7 +49,7 @@ pub(super) struct SelfContact {
     reach: f32,
     /// Coulomb's coefficient between two particles.
     friction: f32,
-    /// Each particle's partners by spring, sorted:
+    /// Each particle's partners by a structural, shear or seam spring, sorted:
     /// `excluded[excluded_start[i]..excluded_start[i + 1]]`.
     excluded_start: Vec<u32>,
     excluded: Vec<u32>,
@@ -52,6 +66,18 @@ pub(super) struct SelfContact {
     near: Vec<u32>,
     /// Pairs pushed apart since the step began.
     pushed: usize,
+    /// The other cloths' particles near this one, for the step about to begin ([`collide_cloths`]).
+    others: Vec<Other>,
+    /// This step's pairs of a particle and another cloth's, `[i, k]` (`k` in `others`).
+    cross: Vec<[u32; 2]>,
+}
+
+/// A particle of another cloth, as it was when the step began.
+#[derive(Clone, Copy, Debug, Default)]
+struct Other {
+    x: Vec3,
+    v: Vec3,
+    w: f32,
 }
 
 impl SelfContact {
@@ -81,9 +107,11 @@ impl SelfContact {
         (dt, n): (f32, u32),
     ) {
         self.pairs.clear();
+        self.cross.clear();
         self.pushed = 0;
         self.d = 0.0;
         if !(on && params.enabled) || p.is_empty() {
+            self.others.clear();
             return;
         }
         if self.built_for != Some((springs.len(), p.len())) {
@@ -114,13 +142,21 @@ impl SelfContact {
         let radius = d + 2.0 * self.reach * n.max(1) as f32;
         self.fill_hash(&p.position, radius);
         self.find_pairs(p, radius);
+        self.find_cross_pairs(&p.position, radius, mean, dt);
     }
 
-    /// Every particle's partners by spring (torn ones too: a tear's two sides start
-    /// where they were), and the rest spacing.
+    /// Every particle's partners by a structural, shear or seam spring (torn ones too: a
+    /// tear's two sides start where they were), and the rest spacing. Bend springs join
+    /// particles two spacings apart, farther than `d`: those pairs are kept apart like
+    /// any other, so a crease cannot fold flat within two rows (where an edge would pass
+    /// through the next cell's triangles without any pair coming closer than `d`).
     fn exclude_springs(&mut self, springs: &Springs, n: usize) {
+        let joined: Vec<usize> = [SpringKind::Structural, SpringKind::Shear, SpringKind::Seam]
+            .into_iter()
+            .flat_map(|kind| springs.ranges[kind as usize].clone())
+            .collect();
         let mut count = vec![0u32; n + 1];
-        for s in 0..springs.len() {
+        for &s in &joined {
             count[springs.a[s] as usize] += 1;
             count[springs.b[s] as usize] += 1;
         }
@@ -134,7 +170,7 @@ impl SelfContact {
         self.excluded.clear();
         self.excluded.resize(total as usize, 0);
         let mut fill: Vec<u32> = self.excluded_start[..n].to_vec();
-        for s in 0..springs.len() {
+        for &s in &joined {
             let (a, b) = (springs.a[s], springs.b[s]);
             self.excluded[fill[a as usize] as usize] = b;
             fill[a as usize] += 1;
@@ -225,6 +261,34 @@ impl SelfContact {
         self.near = near;
     }
 
+    /// The pairs of a particle of this cloth and one of `others` that can meet in the
+    /// step: closer than `radius` plus 1.5× the other's travel relative to this cloth's
+    /// mean velocity `mean` (at most three cells away).
+    fn find_cross_pairs(&mut self, x: &[Vec3], radius: f32, mean: Vec3, dt: f32) {
+        let slots = 2 * x.len();
+        for (k, o) in self.others.iter().enumerate() {
+            let reach = (radius + 1.5 * (o.v - mean).length() * dt).min(3.0 * radius);
+            let c = cell_of(o.x, radius);
+            let m = (reach / radius).ceil() as i32;
+            for dz in -m..=m {
+                for dy in -m..=m {
+                    for dx in -m..=m {
+                        let k2 = slot([c[0] + dx, c[1] + dy, c[2] + dz], slots);
+                        let (start, end) = (self.slot_start[k2], self.slot_start[k2 + 1]);
+                        for &i in &self.entries[start as usize..end as usize] {
+                            if x[i as usize].distance_squared(o.x) < reach * reach {
+                                self.cross.push([i, k as u32]);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // Two cells may share a slot: each pair once.
+        self.cross.sort_unstable();
+        self.cross.dedup();
+    }
+
     /// One substep's self-collision (see the module doc): the clamp on each particle's
     /// motion relative to the mean, then every listed pair kept `d` apart with friction.
     /// Velocities follow the corrected positions, `v = (x − x_prev)/h`.
@@ -266,6 +330,55 @@ impl SelfContact {
             }
             p.velocity[i] = (p.position[i] - p.previous[i]) / h;
             p.velocity[j] = (p.position[j] - p.previous[j]) / h;
+            self.pushed += 1;
+        }
+        self.resolve_cross(p, h);
+    }
+
+    /// The pairs with the other cloths' particles, kept `d` from where those were when
+    /// the step began; this cloth's particle takes its share of the correction, as a
+    /// position change that adds no velocity, and its share of stopping its approach,
+    /// with friction.
+    fn resolve_cross(&mut self, p: &mut Particles, h: f32) {
+        let (d, mu) = (self.d, self.friction);
+        for &[i, k] in &self.cross {
+            let (i, o) = (i as usize, self.others[k as usize]);
+            let wi = p.inv_mass[i];
+            if wi == 0.0 {
+                continue;
+            }
+            let xo = o.x;
+            let r = p.position[i] - xo;
+            let l2 = r.length_squared();
+            if l2 >= d * d {
+                continue;
+            }
+            let share = wi / (wi + o.w);
+            let l = l2.sqrt();
+            let n = if l > 1e-6 * d {
+                r / l
+            } else {
+                (p.previous[i] - xo).normalize_or(Vec3::Y)
+            };
+            // The overlap is undone without adding velocity (`previous` moves with the
+            // particle: the other particle has moved since, and a push against where it
+            // was must not launch this one); the approach along `n` is stopped, by this
+            // cloth's share, and Coulomb friction takes at most μ times that from the
+            // sliding.
+            let push = n * ((d - r.dot(n)) * share);
+            let v = (p.position[i] - p.previous[i]) / h;
+            let approach = v.dot(n).min(0.0) * share;
+            let slide = v - n * v.dot(n);
+            let length = slide.length();
+            let friction = if length > 0.0 {
+                slide * ((mu * -approach).min(length) / length)
+            } else {
+                Vec3::ZERO
+            };
+            let dv = -n * approach - friction;
+            p.position[i] += push;
+            p.velocity[i] = (p.position[i] - p.previous[i]) / h + dv - push / h;
+            p.previous[i] = p.position[i] - p.velocity[i] * h;
             self.pushed += 1;
         }
     }
@@ -316,4 +429,53 @@ fn slot(c: [i32; 3], slots: usize) -> usize {
         ^ (c[1].wrapping_mul(689_287_499))
         ^ (c[2].wrapping_mul(283_923_481));
     (h.unsigned_abs() as usize) % slots
+}
+
+/// Cloth–cloth contact for the step about to begin (see the module doc): each cloth of
+/// `cloths` with self-collision on takes the particles of the others with it on that
+/// lie within its box grown by a margin (their positions and velocities now, and their
+/// inverse masses: 0 for a cloth that will not step, `moving` false, such as a sleeping
+/// one, so the cloth that steps takes the whole correction). Call it before the cloths'
+/// `begin_step`; a cloth keeps its copy until the next call.
+pub fn collide_cloths(cloths: &mut [(&mut super::ClothSolver, bool)]) {
+    let on: Vec<bool> = cloths
+        .iter()
+        .map(|(c, _)| c.params.self_collision.enabled)
+        .collect();
+    let boxes: Vec<(Vec3, Vec3)> = cloths
+        .iter()
+        .map(|(c, _)| {
+            let x = &c.particles.position;
+            x.iter()
+                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+                    (lo.min(p), hi.max(p))
+                })
+        })
+        .collect();
+    for a in 0..cloths.len() {
+        let mut others = std::mem::take(&mut cloths[a].0.self_contact.others);
+        others.clear();
+        if on[a] {
+            // What can come within reach of the cloth in a step: four spacings, and where
+            // a particle's speed takes it in 50 ms (three 16 ms steps).
+            let (lo, hi) = boxes[a];
+            let margin = 4.0 * cloths[a].0.self_contact.spacing.max(0.01);
+            for b in (0..cloths.len()).filter(|&b| b != a && on[b]) {
+                let (other, moving) = (&*cloths[b].0, cloths[b].1);
+                let p = &other.particles;
+                for i in 0..p.len() {
+                    let reach = margin + p.velocity[i].length() * 0.05;
+                    let x = p.position[i];
+                    if x.cmpge(lo - reach).all() && x.cmple(hi + reach).all() {
+                        others.push(Other {
+                            x,
+                            v: p.velocity[i],
+                            w: if moving { p.inv_mass[i] } else { 0.0 },
+                        });
+                    }
+                }
+            }
+        }
+        cloths[a].0.self_contact.others = others;
+    }
 }
