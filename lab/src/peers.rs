@@ -73,12 +73,15 @@ impl Hang {
 /// One configuration of one solver.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub enum Peer {
-    /// Our XPBD at `substeps` fixed substeps, with or without tethers to the pins.
+    /// Our XPBD at `substeps` fixed substeps, with or without tethers to the pins, with
+    /// or without self-collision (what it costs, beside the same run without).
     Ours {
         /// Substeps per frame.
         substeps: u32,
         /// Long-range attachments on.
         tethers: bool,
+        /// Self-collision on (at the rest spacing).
+        self_collision: bool,
     },
     /// rapier-cloth-core: `steps` steps a frame of `iterations` iterations each.
     Rapier {
@@ -95,12 +98,16 @@ pub enum Peer {
 }
 
 /// The solvers by the names `cloth peers --solvers` takes.
-pub const PEER_SOLVERS: [&str; 4] = ["ours", "tethers", "rapier", "sticks"];
+pub const PEER_SOLVERS: [&str; 5] = ["ours", "tethers", "self", "rapier", "sticks"];
 
 impl Peer {
     /// The solver's name in [`PEER_SOLVERS`].
     pub fn key(&self) -> &'static str {
         match self {
+            Peer::Ours {
+                self_collision: true,
+                ..
+            } => "self",
             Peer::Ours { tethers: false, .. } => "ours",
             Peer::Ours { tethers: true, .. } => "tethers",
             Peer::Rapier { .. } => "rapier",
@@ -111,6 +118,10 @@ impl Peer {
     /// The solver's name in the table.
     pub fn solver(&self) -> &'static str {
         match self {
+            Peer::Ours {
+                self_collision: true,
+                ..
+            } => "bevy_cloth XPBD + tethers + self-collision",
             Peer::Ours { tethers: false, .. } => "bevy_cloth XPBD",
             Peer::Ours { tethers: true, .. } => "bevy_cloth XPBD + tethers",
             Peer::Rapier { .. } => "rapier-cloth-core 0.3",
@@ -137,12 +148,23 @@ pub fn default_peers() -> Vec<Peer> {
         peers.push(Peer::Ours {
             substeps,
             tethers: false,
+            self_collision: false,
         });
     }
     for substeps in [1, 2, 5, 10, 20, 40, 80] {
         peers.push(Peer::Ours {
             substeps,
             tethers: true,
+            self_collision: false,
+        });
+    }
+    // What self-collision costs: the tethered configurations a game would pick, again
+    // with it on.
+    for substeps in [5, 10, 20] {
+        peers.push(Peer::Ours {
+            substeps,
+            tethers: true,
+            self_collision: true,
         });
     }
     for (steps, iterations) in [(1, 2), (1, 4), (1, 8), (1, 16), (2, 8), (4, 8)] {
@@ -263,7 +285,15 @@ trait Frames {
 /// Measures `peer` on the `side × side` cloth hung by `hang` over `frames` frames.
 pub fn measure(side: usize, hang: Hang, peer: Peer, frames: usize) -> Result<PeerRow, String> {
     let mut solver: Box<dyn Frames> = match peer {
-        Peer::Ours { substeps, tethers } => Box::new(Ours::new(side, hang, substeps, tethers)?),
+        Peer::Ours {
+            substeps,
+            tethers,
+            self_collision,
+        } => {
+            let mut params = ours_params(substeps, tethers);
+            params.self_collision.enabled = self_collision;
+            Box::new(Ours::new(side, hang, &params)?)
+        }
         Peer::Rapier { steps, iterations } => Box::new(Rapier::new(side, hang, steps, iterations)?),
         Peer::Sticks { sweeps } => Box::new(Sticks::new(side, hang, sweeps)),
     };
@@ -382,7 +412,7 @@ struct Ours {
 }
 
 impl Ours {
-    fn new(side: usize, hang: Hang, substeps: u32, tethers: bool) -> Result<Self, String> {
+    fn new(side: usize, hang: Hang, params: &ClothParams) -> Result<Self, String> {
         let shape = ClothShape::Grid {
             width: side as u32,
             height: side as u32,
@@ -398,7 +428,7 @@ impl Ours {
         let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
         let pins = ClothPins::Indices(hang.pins(side));
         let cloth = shape
-            .build_solver(&pins, &ours_params(substeps, tethers), frame)
+            .build_solver(&pins, params, frame)
             .map_err(|e: ClothError| e.to_string())?;
         let mut env = Environment::default();
         env.wind.strength = 0.0;

@@ -242,6 +242,12 @@ fn the_peer_bench_times_every_solver_and_never_a_failed_run() {
         Peer::Ours {
             substeps: 5,
             tethers: true,
+            self_collision: false,
+        },
+        Peer::Ours {
+            substeps: 5,
+            tethers: true,
+            self_collision: true,
         },
         Peer::Rapier {
             steps: 1,

@@ -226,7 +226,7 @@ impl ClothSolver {
             &self.structure.springs,
             &self.params.self_collision,
             on,
-            (dt, n),
+            dt,
         );
         let ratio = self.clock.begin(dt, n);
         steps.begin(self, dt, ratio);
