@@ -28,6 +28,24 @@ pub const MAX_LIMITER_SWEEPS: u32 = 1 << 10;
 /// per particle-substep, about 3 s of one core per step.
 pub const MAX_WORK_PER_STEP: u64 = 1 << 26;
 
+/// Sweeps until within (`strain_limit_tolerance`) of one step of `substeps`: on average
+/// [`LIMITER_SWEEPS_PER_SUBSTEP`] a substep, and at least [`MAX_LIMITER_SWEEPS`] (any one
+/// substep may take its most). A limiter that cannot converge, fighting a collider or a
+/// seam, took its 500 sweeps every substep: the T-shirt inside a capsule of radius 100 km
+/// cost 503 ms a step at 36 substeps, 91 ms with this budget (`cloth run`, the median of
+/// 50 steps, which now warn). Steps that converge are not cut: the T-shirt scene's own
+/// (3.1 ms) and seed 002's corners on it (`tests/garment.rs`; 0.001 g at 100 and 25,000
+/// N/m: 39 and 369 ms at 454 and 4,040 substeps, the same strain as without the budget).
+/// At 32 sweeps a substep the 1 g, 100 N/m corner (12 substeps) ran out of it.
+pub fn limiter_budget(substeps: u32) -> u32 {
+    substeps
+        .saturating_mul(LIMITER_SWEEPS_PER_SUBSTEP)
+        .max(MAX_LIMITER_SWEEPS)
+}
+
+/// See [`limiter_budget`].
+pub const LIMITER_SWEEPS_PER_SUBSTEP: u32 = 128;
+
 /// Work of one step's fixed limiter sweeps, particles × substeps × sweeps (with a
 /// tolerance the sweeps stop early and only [`MAX_LIMITER_SWEEPS`] applies).
 pub const MAX_SWEEP_WORK_PER_STEP: u64 = 1 << 28;

@@ -17,8 +17,12 @@ pub(super) struct Clock {
     pub substeps: u32,
     /// Substeps of the current step already taken.
     pub substep_index: u32,
-    /// The automatic substeps hit their cap in the current step.
+    /// The automatic substeps hit their cap in the current step, or the strain limiter's
+    /// sweeps ran out of its budget.
     pub under_resolved: bool,
+    /// The strain limiter's sweeps until within that the current step has left
+    /// (`limits::limiter_budget`).
+    pub limiter_sweeps_left: u32,
     /// Automatic substeps remembered for (parameters, dt) (see [`SubstepCache`]).
     pub substep_cache: SubstepCache,
     /// XPBD's measured substeps of the last step, for (parameters, dt); empty after a
@@ -39,6 +43,7 @@ impl Clock {
     /// changed since the last step (Verlet rescales its implicit velocity by it).
     pub fn begin(&mut self, dt: f32, n: u32) -> Option<f32> {
         self.substeps = n;
+        self.limiter_sweeps_left = crate::limits::limiter_budget(n);
         self.substep_index = 0;
         self.h = dt / n as f32;
         let ratio = (self.last_h > 0.0 && self.last_h != self.h).then(|| self.h / self.last_h);

@@ -355,7 +355,9 @@ impl Stencil {
     /// Provot's strain limit (the general path's law, `integrate.rs`) over the enabled
     /// structural and shear springs: `sweeps` coloured sweeps (see the module doc), or
     /// fewer once one finds every spring within `past·l0` (with `past` given). Works on
-    /// lanes; each particle's velocity takes its whole correction over `h`.
+    /// lanes; each particle's velocity takes its whole correction over `h`. Returns the
+    /// sweeps run, and whether the last found every spring within `past·l0` (true
+    /// without `past`).
     #[allow(clippy::too_many_arguments)]
     pub fn limit_strain(
         &mut self,
@@ -365,14 +367,17 @@ impl Stencil {
         sweeps: u32,
         past: Option<f32>,
         h: f32,
-    ) {
+    ) -> (u32, bool) {
         self.x.load(&p.position);
-        for _ in 0..sweeps {
+        let (mut run, mut within) = (0, past.is_none());
+        while run < sweeps {
+            run += 1;
             let unconverged = match past {
                 None => self.sweep::<false>(&p.inv_mass, &enabled, limit, f32::INFINITY),
                 Some(past) => self.sweep::<true>(&p.inv_mass, &enabled, limit, past),
             };
             if past.is_some() && !unconverged {
+                within = true;
                 break;
             }
         }
@@ -410,6 +415,7 @@ impl Stencil {
                 }
             },
         );
+        (run, within)
     }
 
     /// One coloured sweep; with `TRACK`, whether a spring was longer than `past·l0`.

@@ -41,35 +41,49 @@ impl ClothSolver {
     /// over the structural and shear springs. Velocities take the same correction over `h`.
     /// With `strain_limit_tolerance`, sweeping stops once a sweep finds every spring
     /// within `(1 + limit + tolerance)·l0`.
+    ///
+    /// The sweeps until within draw on the step's budget (`limits::limiter_budget`): a
+    /// limiter that cannot converge (fighting a collider or a seam) would otherwise take
+    /// its most sweeps every substep. Once the budget is spent each substep sweeps once,
+    /// and the step reports itself under-resolved.
     fn limit_strain(&mut self, limit: f32, h: f32) {
-        let sweeps = self.params.strain_limit_iterations;
-        if let Some(stencil) = &mut self.structure.stencil {
+        let most = self.params.strain_limit_iterations;
+        let past = self
+            .params
+            .strain_limit_tolerance
+            .map(|tolerance| 1.0 + limit + tolerance);
+        let sweeps = match past {
+            Some(_) => most.min(self.clock.limiter_sweeps_left.max(1)),
+            None => most,
+        };
+        let (run, within) = if let Some(stencil) = &mut self.structure.stencil {
             let springs = self.params.springs;
             let enabled = |kind| match kind {
                 SpringKind::Structural => springs.structural.enabled,
                 SpringKind::Shear => springs.shear.enabled,
                 _ => false,
             };
-            let past = self
-                .params
-                .strain_limit_tolerance
-                .map(|tolerance| 1.0 + limit + tolerance);
-            stencil.limit_strain(&mut self.particles, enabled, limit, sweeps, past, h);
-            return;
-        }
-        match self.params.strain_limit_tolerance {
-            None => {
-                for _ in 0..sweeps {
-                    self.limit_strain_sweep::<false>(limit, f32::INFINITY, h);
+            stencil.limit_strain(&mut self.particles, enabled, limit, sweeps, past, h)
+        } else {
+            let (mut run, mut within) = (0, past.is_none());
+            while run < sweeps {
+                run += 1;
+                let unconverged = match past {
+                    None => self.limit_strain_sweep::<false>(limit, f32::INFINITY, h),
+                    Some(past) => self.limit_strain_sweep::<true>(limit, past, h),
+                };
+                if past.is_some() && !unconverged {
+                    within = true;
+                    break;
                 }
             }
-            Some(tolerance) => {
-                let past = 1.0 + limit + tolerance;
-                for _ in 0..sweeps {
-                    if !self.limit_strain_sweep::<true>(limit, past, h) {
-                        break;
-                    }
-                }
+            (run, within)
+        };
+        if past.is_some() {
+            let left = &mut self.clock.limiter_sweeps_left;
+            *left = left.saturating_sub(run);
+            if !within && sweeps < most {
+                self.clock.under_resolved = true;
             }
         }
     }

@@ -77,7 +77,9 @@ pub struct StepReport {
     /// The substeps taken: `substeps`, unless the stages were called by hand a different
     /// number of times.
     pub taken: u32,
-    /// The automatic substeps hit their cap: the step may be unstable or inaccurate.
+    /// The automatic substeps hit their cap, or the strain limiter's sweeps until within
+    /// ran out of the step's budget (`limits::limiter_budget`): the step may be unstable
+    /// or inaccurate.
     pub under_resolved: bool,
     /// The largest stretch `(l − l0)/l0` of a whole structural spring with a free end at
     /// the end of the step, when the step measured it (XPBD's automatic substeps do, each
@@ -326,6 +328,8 @@ impl ClothSolver {
         if self.report.substeps == 0 {
             return self.report;
         }
+        // The limiter may have spent its budget during the substeps.
+        self.report.under_resolved = self.clock.under_resolved;
         let (p, time) = (&self.particles, self.clock.time);
         self.report.finite = self.checkpoint.take(&p.position, &p.velocity, time);
         if self.report.finite {

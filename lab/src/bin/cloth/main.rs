@@ -463,7 +463,9 @@ fn run(args: RunArgs) -> Result<(), String> {
     for cloth in summary.cloths.iter().filter(|c| c.under_resolved) {
         eprintln!(
             "warning: `{}` needed more automatic substeps than its cap (substeps.max, or \
-             limits::MAX_WORK_PER_STEP for its {} particles): it ran at {} and may be unstable",
+             limits::MAX_WORK_PER_STEP for its {} particles), or more strain-limiter sweeps \
+             than a step's budget (limits::limiter_budget): it ran at {} substeps and may be \
+             unstable or inaccurate",
             cloth.name, cloth.particles, cloth.substeps
         );
     }
