@@ -1118,3 +1118,30 @@ fn a_convex_hull_is_exact_the_box_hull_matches_the_box_everywhere() {
     let e = bevy_cloth::solver::ConvexHull::new(corners, faces[..3].to_vec()).unwrap_err();
     assert!(e.contains("at least 4 faces"), "{e}");
 }
+
+/// The fuzzer's case: a capsule of radius 100 km round the T-shirt. The limiter fights
+/// the collider (it pulls the shirt back in, contact pushes it out) and never converges;
+/// its sweeps until within stop at the step's budget (`limits::limiter_budget`) and the
+/// step says it is under-resolved (before the budget it took its 500 sweeps every
+/// substep, half a second a step, and said nothing). The scene itself is not.
+#[test]
+fn a_limiter_that_cannot_converge_spends_its_budget_and_says_so() {
+    let mut scene = ClothScene::load("assets/scenes/tshirt.ron").expect("scene loads");
+    let mut run = SceneRun::new(&scene).expect("builds");
+    run.run(3, |_, cloths| assert!(!cloths[0].1.under_resolved()));
+    let shoulders = scene
+        .colliders
+        .iter_mut()
+        .find(|c| c.name == "shoulder line")
+        .expect("the shoulder line");
+    shoulders.collider.shape = bevy_cloth::ColliderKind::Capsule {
+        radius: 1e5,
+        half_length: 0.17,
+    };
+    let mut run = SceneRun::new(&scene).expect("builds");
+    let mut flagged = 0;
+    run.run(3, |_, cloths| {
+        flagged += cloths[0].1.under_resolved() as usize
+    });
+    assert_eq!(flagged, 3, "every step spent the budget");
+}
