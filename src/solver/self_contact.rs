@@ -4,8 +4,10 @@
 //!
 //! Once a step, a spatial hash over the particles (cells the size of the query radius, a
 //! dense table of at least twice the particle count filled by counting sort: no allocation once
-//! grown) lists the pairs closer than `2.5 d`, which can come within `d` during the step
-//! unless they close in faster than `1.5 d` a step. Pairs joined by a structural, shear or seam spring are never
+//! grown) lists the pairs closer than `2.5 d`; the list is kept while no particle has
+//! moved `d/4` relative to the cloth's mean since, so every pair off it is at least `2 d`
+//! apart and can come within `d` during a step only by closing in faster than `d` a
+//! step. Pairs joined by a structural, shear or seam spring are never
 //! listed: they are the cloth's own structure (closer than `d` at rest), and a seam's
 //! two ends are meant to meet. Each substep, after the model's constraints and before contact:
 //! 1. every free particle's motion relative to the mean is clamped to `d/2` a substep
@@ -65,6 +67,10 @@ pub(super) struct SelfContact {
     near: Vec<u32>,
     /// Pairs pushed apart since the step began.
     pushed: usize,
+    /// The positions when the pairs were listed, and the `d` and the free particles'
+    /// mean position then (`None`: no list).
+    listed_at: Vec<Vec3>,
+    listed: Option<(f32, Vec3)>,
     /// The other cloths' particles near this one, for the step about to begin ([`collide_cloths`]).
     others: Vec<Other>,
     /// This step's pairs of a particle and another cloth's, `[i, k]` (`k` in `others`).
@@ -105,12 +111,13 @@ impl SelfContact {
         on: bool,
         dt: f32,
     ) {
-        self.pairs.clear();
         self.cross.clear();
         self.pushed = 0;
         self.d = 0.0;
         if !(on && params.enabled) || p.is_empty() {
             self.others.clear();
+            self.pairs.clear();
+            self.listed = None;
             return;
         }
         if self.built_for != Some((springs.len(), p.len())) {
@@ -119,7 +126,7 @@ impl SelfContact {
         let d = params
             .distance
             .map_or(self.spacing, |d| d.min(self.spacing));
-        if !(d > 0.0) {
+        if d.is_nan() || d <= 0.0 {
             return;
         }
         let (mean, free) = mean_of_free(p, |i| p.velocity[i]);
@@ -132,9 +139,34 @@ impl SelfContact {
         self.d = d;
         self.friction = params.friction;
         let radius = LIST_RADIUS * d;
+        if self.list_holds(p, d) && self.others.is_empty() {
+            return;
+        }
+        self.pairs.clear();
         self.fill_hash(&p.position, radius);
         self.find_pairs(p, radius);
         self.find_cross_pairs(&p.position, radius, mean, dt);
+        self.listed_at.clone_from(&p.position);
+        self.listed = Some((d, mean_of_free(p, |i| p.position[i]).0));
+    }
+
+    /// Whether the last list still holds for `d`: no free particle has moved more than
+    /// `d/4` relative to the free particles' mean since it was made, so a pair not on it
+    /// is still at least `2 d` apart (a resting or slowly draping cloth keeps its list;
+    /// the check is one pass over the particles).
+    fn list_holds(&self, p: &Particles, d: f32) -> bool {
+        let Some((listed_d, listed_mean)) = self.listed else {
+            return false;
+        };
+        if listed_d != d || self.listed_at.len() != p.len() {
+            return false;
+        }
+        let shift = mean_of_free(p, |i| p.position[i]).0 - listed_mean;
+        let most = RELIST_AFTER * d;
+        (0..p.len()).all(|i| {
+            p.inv_mass[i] == 0.0
+                || (p.position[i] - self.listed_at[i] - shift).length_squared() <= most * most
+        })
     }
 
     /// Every particle's partners by a structural, shear or seam spring (torn ones too: a
@@ -299,6 +331,9 @@ impl SelfContact {
             }
             let (wi, wj) = (p.inv_mass[i], p.inv_mass[j]);
             let w = wi + wj;
+            if w == 0.0 {
+                continue; // both pinned since the list was made
+            }
             // Two particles at one point part the way they came from.
             let l = l2.sqrt();
             let n = if l > 1e-6 * d {
@@ -408,9 +443,10 @@ fn mean_of_free(p: &Particles, v: impl Fn(usize) -> Vec3) -> (Vec3, usize) {
     (sum / free.max(1) as f32, free)
 }
 
-/// The pairs listed at a step's start are those closer than this many times `d`: a
-/// pair closing in faster than `1.5 d` a step (3 m/s at `d` = 3 cm and 16 ms) is seen
-/// only once it is that close. A longer list (the relative speed's reach, up to two
+/// The pairs listed are those closer than this many times `d`; with the list kept until
+/// a particle has moved [`RELIST_AFTER`]` d`, a pair off it is at least `2 d` apart at a
+/// step's start, and one closing in faster than `d` a step (2 m/s at `d` = 3 cm and
+/// 16 ms) can pass within `d` unseen. A longer list (the relative speed's reach, up to two
 /// spacings) cost 6.5× the XPBD step of a swinging 64² cloth at 5 substeps (`cloth peers
 /// --sides 64 --hang swing --solvers tethers,self`), against ≤ 0.5× asked.
 const LIST_RADIUS: f32 = 2.5;
@@ -419,6 +455,11 @@ const LIST_RADIUS: f32 = 2.5;
 fn table_size(n: usize) -> usize {
     (2 * n).next_power_of_two()
 }
+
+/// The list is made again once a particle has moved this many times `d` relative to the
+/// cloth's mean since it was made: until then every pair off it is at least
+/// `(LIST_RADIUS − 2·RELIST_AFTER)·d = 2 d` apart.
+const RELIST_AFTER: f32 = 0.25;
 
 /// The cell of size `cell` that `x` is in (float-to-int casts saturate: a far point
 /// lands in an edge cell, which only costs a candidate).
