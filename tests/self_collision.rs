@@ -111,10 +111,20 @@ fn edges_through_triangles(cloths: &[&ClothSolver]) -> usize {
     let mut x: Vec<Vec3A> = Vec::new();
     let mut edges: Vec<[u32; 2]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
+    // A garment's seams join two particles (one per piece) that sewing brings to one
+    // point: they count as one vertex here (an edge at one end of a seam and a triangle
+    // at the other share a corner, not a crossing).
+    let mut same: Vec<u32> = Vec::new();
     for cloth in cloths {
         let offset = x.len() as u32;
         x.extend(cloth.positions().iter().map(|&p| Vec3A::from(p)));
         let springs = cloth.springs();
+        same.extend((0..cloth.particle_count() as u32).map(|i| i + offset));
+        for s in springs.ranges[SpringKind::Seam as usize].clone() {
+            let (a, b) = (springs.a[s] + offset, springs.b[s] + offset);
+            let (ra, rb) = (root(&same, a), root(&same, b));
+            same[ra.max(rb) as usize] = ra.min(rb);
+        }
         edges.extend(
             [SpringKind::Structural, SpringKind::Shear]
                 .into_iter()
@@ -137,8 +147,11 @@ fn edges_through_triangles(cloths: &[&ClothSolver]) -> usize {
     for t in &triangles {
         let (lo, hi) = boxes(t);
         for (e, (elo, ehi)) in edges.iter().zip(&edge_boxes) {
-            if elo.cmpgt(hi).any() || ehi.cmplt(lo).any() || t.contains(&e[0]) || t.contains(&e[1])
-            {
+            if elo.cmpgt(hi).any() || ehi.cmplt(lo).any() {
+                continue;
+            }
+            let corners = t.map(|i| root(&same, i));
+            if corners.contains(&root(&same, e[0])) || corners.contains(&root(&same, e[1])) {
                 continue;
             }
             let [a, b, c] = t.map(|i| x[i as usize]);
@@ -148,6 +161,14 @@ fn edges_through_triangles(cloths: &[&ClothSolver]) -> usize {
         }
     }
     crossing
+}
+
+/// The representative of `i` among the particles joined by seams (union–find).
+fn root(same: &[u32], mut i: u32) -> u32 {
+    while same[i as usize] != i {
+        i = same[i as usize];
+    }
+    i
 }
 
 /// Whether the segment `p–q` meets the triangle `abc` (Möller–Trumbore with the
@@ -293,5 +314,47 @@ fn the_same_bits_on_one_thread_and_on_both_cores() {
     assert!(
         positions[0] == positions[1],
         "one thread and the pool differ"
+    );
+}
+
+/// The T-shirt sewn on the mannequin (1.5 s), then the mannequin taken away: the shirt
+/// falls to the ground and its front and back fold onto each other. With self-collision
+/// no edge passes through a triangle; without, they do.
+#[test]
+fn a_sewn_t_shirt_dropped_off_its_mannequin_keeps_front_and_back_apart() {
+    let run_shirt = |on: bool| {
+        let mut scene = ClothScene::load("assets/scenes/tshirt.ron").expect("loads");
+        scene.environment.wind.strength = 0.0;
+        scene.cloths[0].cloth.params.self_collision.enabled = on;
+        let mut run = SceneRun::new(&scene).expect("builds");
+        run.run(94, |_, _| {});
+        let ground: Vec<_> = scene
+            .colliders
+            .iter()
+            .filter(|c| c.name == "ground")
+            .map(|c| {
+                let t = bevy::transform::components::GlobalTransform::from(c.transform());
+                c.collider.to_world(&t)
+            })
+            .collect();
+        run.cloths[0].1.set_colliders(ground);
+        let mut frames = 0;
+        let mut most = 0;
+        run.run(188, |step, cloths| {
+            if step % EVERY == 0 {
+                let crossing = edges_through_triangles(&[&cloths[0].1]);
+                frames += (crossing > 0) as usize;
+                most = most.max(crossing);
+            }
+        });
+        (frames, most)
+    };
+    let with = run_shirt(true);
+    let without = run_shirt(false);
+    eprintln!("T-shirt dropped: with self-collision {with:?}, without {without:?}");
+    assert_eq!(with.0, 0, "no edge through a triangle: {with:?}");
+    assert!(
+        without.0 > 0,
+        "without it the shirt passes through itself: {without:?}"
     );
 }
