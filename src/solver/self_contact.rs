@@ -16,7 +16,8 @@
 //! 2. every listed pair closer than `d` is pushed apart to `d` along their line, shared
 //!    by inverse mass, with Coulomb friction on their relative tangential motion
 //!    (position-based friction, Macklin et al. 2014 §6.1), in the list's order
-//!    (Gauss–Seidel on one thread: the same bits whatever the pool).
+//!    (Gauss–Seidel on one thread: the same bits whatever the pool; the list itself is
+//!    made on both cores in pieces joined in order).
 //!
 //! Cloth–cloth contact is the same test between a cloth's particles and those of the
 //! other cloths near it ([`collide_cloths`]): once a step each cloth takes a copy of their
@@ -38,6 +39,7 @@
 
 use bevy::math::Vec3;
 
+use super::parallel::{self, PIECE};
 use super::{Particles, SpringKind, Springs};
 use crate::params::SelfCollision;
 
@@ -63,8 +65,10 @@ pub(super) struct SelfContact {
     /// The hash: each slot's first entry in `entries` (particle indices by slot).
     slot_start: Vec<u32>,
     entries: Vec<u32>,
-    /// One particle's candidates (scratch).
-    near: Vec<u32>,
+    /// Each particle's cell when the list was made.
+    cells: Vec<[i32; 3]>,
+    /// Each piece's pairs while they are listed (kept for their storage).
+    found: Vec<Vec<[u32; 2]>>,
     /// Pairs pushed apart since the step began.
     pushed: usize,
     /// The positions when the pairs were listed, and the `d` and the free particles'
@@ -229,10 +233,12 @@ impl SelfContact {
     /// Sorts the particles into the hash's slots by their cell of size `cell`.
     fn fill_hash(&mut self, x: &[Vec3], cell: f32) {
         let slots = table_size(x.len());
+        self.cells.clear();
+        self.cells.extend(x.iter().map(|&xi| cell_of(xi, cell)));
         self.slot_start.clear();
         self.slot_start.resize(slots + 1, 0);
-        for &xi in x {
-            self.slot_start[slot(cell_of(xi, cell), slots)] += 1;
+        for &c in &self.cells {
+            self.slot_start[slot(c, slots)] += 1;
         }
         let mut total = 0;
         for start in self.slot_start.iter_mut() {
@@ -243,46 +249,64 @@ impl SelfContact {
         // `slot_start[k]` at the slot's first.
         self.entries.clear();
         self.entries.resize(x.len(), 0);
-        for (i, &xi) in x.iter().enumerate().rev() {
-            let k = slot(cell_of(xi, cell), slots);
+        for (i, &c) in self.cells.iter().enumerate().rev() {
+            let k = slot(c, slots);
             self.slot_start[k] -= 1;
             self.entries[self.slot_start[k] as usize] = i as u32;
         }
     }
 
-    /// The pairs closer than `radius`, not joined by a spring and not both pinned.
+    /// The pairs closer than `radius`, not joined by a spring and not both pinned, on
+    /// both cores from 16,384 particles (`parallel::PARALLEL_FROM`). Each particle looks in its own cell (at higher indices) and in the 13 cells after it
+    /// (all of theirs), so each pair is met once; an entry of a slot is taken only if
+    /// its cell is the one looked for (cells sharing a slot are told apart), so nothing
+    /// is met twice and no sort is needed. Deterministic: particle order, then cells.
     fn find_pairs(&mut self, p: &Particles, radius: f32) {
-        let (x, slots) = (&p.position, table_size(p.len()));
-        let r2 = radius * radius;
-        let mut near = std::mem::take(&mut self.near);
-        for i in 0..x.len() {
-            let c = cell_of(x[i], radius);
-            near.clear();
-            for dz in -1..=1 {
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let k = slot([c[0] + dx, c[1] + dy, c[2] + dz], slots);
-                        let (start, end) = (self.slot_start[k], self.slot_start[k + 1]);
-                        for &j in &self.entries[start as usize..end as usize] {
-                            if j as usize > i && x[j as usize].distance_squared(x[i]) < r2 {
-                                near.push(j);
-                            }
-                        }
-                    }
-                }
+        let n = p.len();
+        let pieces = n.div_ceil(PIECE);
+        let mut found = std::mem::take(&mut self.found);
+        found.resize_with(pieces, Vec::new);
+        let this = &*self;
+        // In pieces of particles over the pool (each piece's pairs in its own list, the
+        // lists joined in piece order: the same list on any number of threads).
+        parallel::for_each(n, found.iter_mut().enumerate(), |(piece, pairs)| {
+            pairs.clear();
+            let start = piece * PIECE;
+            for i in start..(start + PIECE).min(n) {
+                this.pairs_of(i, p, radius * radius, pairs);
             }
-            // Two cells may share a slot: each pair once, in increasing order.
-            near.sort_unstable();
-            near.dedup();
-            let i = i as u32;
-            for &j in near.iter() {
-                let pinned = p.inv_mass[i as usize] == 0.0 && p.inv_mass[j as usize] == 0.0;
-                if !pinned && !self.excluded(i, j) {
-                    self.pairs.push([i, j]);
+        });
+        self.pairs.clear();
+        for pairs in &found {
+            self.pairs.extend_from_slice(pairs);
+        }
+        self.found = found;
+    }
+
+    /// Particle `i`'s pairs closer than `√r2` (see [`Self::find_pairs`]) into `pairs`.
+    fn pairs_of(&self, i: usize, p: &Particles, r2: f32, pairs: &mut Vec<[u32; 2]>) {
+        let (x, slots) = (&p.position, table_size(p.len()));
+        let c = self.cells[i];
+        for (n, o) in FORWARD.iter().enumerate() {
+            let cell = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
+            let k = slot(cell, slots);
+            let (start, end) = (self.slot_start[k], self.slot_start[k + 1]);
+            for &j in &self.entries[start as usize..end as usize] {
+                let ju = j as usize;
+                // The own cell (the first offset): each pair from its lower index.
+                if (n == 0 && ju <= i) || self.cells[ju] != cell {
+                    continue;
+                }
+                if x[ju].distance_squared(x[i]) >= r2 {
+                    continue;
+                }
+                let (a, b) = (i.min(ju) as u32, i.max(ju) as u32);
+                let pinned = p.inv_mass[i] == 0.0 && p.inv_mass[ju] == 0.0;
+                if !pinned && !self.excluded(a, b) {
+                    pairs.push([a, b]);
                 }
             }
         }
-        self.near = near;
     }
 
     /// The pairs of a particle of this cloth and one of `others` that can meet in the
@@ -450,6 +474,25 @@ fn mean_of_free(p: &Particles, v: impl Fn(usize) -> Vec3) -> (Vec3, usize) {
 /// spacings) cost 6.5× the XPBD step of a swinging 64² cloth at 5 substeps (`cloth peers
 /// --sides 64 --hang swing --solvers tethers,self`), against ≤ 0.5× asked.
 const LIST_RADIUS: f32 = 2.5;
+
+/// A cell and the 13 after it (of the 26 around it, those with the first non-zero
+/// offset positive): every two neighbouring cells are met once, from the first.
+const FORWARD: [[i32; 3]; 14] = [
+    [0, 0, 0],
+    [1, 0, 0],
+    [-1, 1, 0],
+    [0, 1, 0],
+    [1, 1, 0],
+    [-1, -1, 1],
+    [0, -1, 1],
+    [1, -1, 1],
+    [-1, 0, 1],
+    [0, 0, 1],
+    [1, 0, 1],
+    [-1, 1, 1],
+    [0, 1, 1],
+    [1, 1, 1],
+];
 
 /// The hash table's slots for `n` particles: a power of two, at least `2n`.
 fn table_size(n: usize) -> usize {
