@@ -15,10 +15,6 @@ const SECONDS: f32 = 5.0;
 /// Frames checked: every this many steps.
 const EVERY: usize = 8;
 
-fn fold_scene(self_collision: bool, model: &str) -> ClothScene {
-    scene("fold", self_collision, model)
-}
-
 /// A scene of `assets/scenes/` with self-collision on or off, as XPBD (the file's) or
 /// mass-spring.
 fn scene(name: &str, self_collision: bool, model: &str) -> ClothScene {
@@ -212,55 +208,42 @@ fn the_exact_crossing_test_finds_an_edge_through_a_triangle_and_no_other() {
 
 #[test]
 fn a_cloth_folding_onto_itself_does_not_pass_through_itself() {
-    for model in ["xpbd", "mass-spring"] {
-        let with = run(&fold_scene(true, model));
-        eprintln!("{model}, self-collision on: {with:?}");
-        assert!(with.d > 0.0, "{model}: self-collision acts");
-        assert_eq!(
-            with.frames, 0,
-            "{model}: no edge through a triangle: {with:?}"
-        );
-        assert!(
-            with.closest >= 0.5 * with.d,
-            "{model}: no two particles closer than d/2 = {}: {with:?}",
-            0.5 * with.d
-        );
-        // The same scene without it: the detector above sees the crossings.
-        let without = run(&fold_scene(false, model));
-        eprintln!("{model}, self-collision off: {without:?}");
-        assert!(
-            without.frames > 0 && without.closest < 0.5 * with.d,
-            "{model}: without self-collision the cloth passes through itself: {without:?}"
-        );
-    }
+    stays_apart("fold");
 }
 
 #[test]
 fn three_cloths_dropped_on_each_other_stay_in_layers() {
+    stays_apart("stack");
+}
+
+/// Scene `name`, XPBD and mass-spring: with self-collision no edge through a triangle
+/// and no two particles closer than `d/2`; without it, both (the detector sees them).
+fn stays_apart(name: &str) {
     for model in ["xpbd", "mass-spring"] {
-        let with = run(&scene("stack", true, model));
-        eprintln!("{model}, cloth-cloth on: {with:?}");
+        let with = run(&scene(name, true, model));
+        eprintln!("{name}, {model}, self-collision on: {with:?}");
+        assert!(with.d > 0.0, "{name}, {model}: self-collision acts");
         assert_eq!(
             with.frames, 0,
-            "{model}: no edge through a triangle: {with:?}"
+            "{name}, {model}: an edge through a triangle: {with:?}"
         );
         assert!(
             with.closest >= 0.5 * with.d,
-            "{model}: no two particles closer than d/2 = {}: {with:?}",
+            "{name}, {model}: two particles closer than d/2 = {}: {with:?}",
             0.5 * with.d
         );
-        let without = run(&scene("stack", false, model));
-        eprintln!("{model}, cloth-cloth off: {without:?}");
+        let without = run(&scene(name, false, model));
+        eprintln!("{name}, {model}, self-collision off: {without:?}");
         assert!(
             without.frames > 0 && without.closest < 0.5 * with.d,
-            "{model}: without it the cloths pass through each other: {without:?}"
+            "{name}, {model}: without self-collision it should pass through: {without:?}"
         );
     }
 }
 
 #[test]
 fn self_collision_is_refused_for_the_models_without_it() {
-    let mut scene = fold_scene(true, "xpbd");
+    let mut scene = scene("fold", true, "xpbd");
     let params = &mut scene.cloths[0].cloth.params;
     params.model = Model::ShapeMatching(Default::default());
     params.springs.structural.stiffness = 400.0;
@@ -274,7 +257,7 @@ fn self_collision_is_refused_for_the_models_without_it() {
 #[test]
 fn the_same_bits_on_one_thread_and_on_both_cores() {
     let folded = || {
-        let mut scene = fold_scene(true, "xpbd");
+        let mut scene = scene("fold", true, "xpbd");
         let cloth = &mut scene.cloths[0].cloth;
         cloth.shape = bevy_cloth::ClothShape::Grid {
             width: 256,

@@ -1198,7 +1198,14 @@ fn the_step_report_counts_substeps_times_stages_and_measures_xpbd_strain() {
     assert!(t.forces > t.fit_targets && t.constraints > std::time::Duration::ZERO);
     assert_eq!(
         t.total(),
-        t.begin + t.forces + t.integrate + t.fit_targets + t.constraints + t.contact + t.end
+        t.begin
+            + t.forces
+            + t.integrate
+            + t.fit_targets
+            + t.constraints
+            + t.self_contact
+            + t.contact
+            + t.end
     );
     let strain = report
         .max_strain
