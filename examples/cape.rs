@@ -18,7 +18,7 @@ use avian3d::prelude::{
     Collider, Friction, LinearVelocity, LockedAxes, PhysicsPlugins, RigidBody, Rotation,
 };
 use bevy::prelude::*;
-use bevy_cloth::params::{Wind, WindField};
+use bevy_cloth::params::{SelfCollision, Wind, WindField};
 use bevy_cloth::prelude::*;
 use bevy_panorbit_camera::PanOrbitCamera;
 
@@ -209,9 +209,11 @@ fn setup(
             .with_pins(ClothPins::None)
             // Light, with air drag enough to fly behind a runner: at 3.5 m/s the drag
             // (0.0012 N·s/m per particle) is 0.86 times the weight of a 0.5 g particle.
+            // Self-collision keeps the cape out of itself when it wraps round the runner.
             .with_params(ClothParams {
                 node_mass: 0.5e-3,
                 drag: 1.2e-3,
+                self_collision: SelfCollision::on(),
                 ..default()
             }),
         place.with_translation(place.transform_point(shoulders)),
