@@ -690,6 +690,23 @@ impl ClothParams {
             (0.0..=MAX_DAMPING).contains(&self.drag),
             "a drag from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
         )?;
+        self.validate_stepping()?;
+        if let Some(ratio) = self.tear_ratio {
+            check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
+        }
+        self.validate_self_collision()?;
+        match &self.model {
+            Model::ShapeMatching(sm) => sm.validate()?,
+            Model::Patches(patches) => patches.validate()?,
+            Model::Xpbd(xpbd) => xpbd.validate()?,
+            Model::MassSpring => {}
+        }
+        Ok(())
+    }
+
+    /// The substeps and the strain limiter: counts within their limits, a limit and a
+    /// tolerance above zero.
+    fn validate_stepping(&self) -> Result<(), ClothError> {
         match self.substeps {
             Substeps::Fixed(0) => {
                 return Err(ClothError::InvalidParameter {
@@ -738,16 +755,6 @@ impl ClothParams {
                 tolerance > 0.0,
                 "a tolerance > 0",
             )?;
-        }
-        if let Some(ratio) = self.tear_ratio {
-            check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
-        }
-        self.validate_self_collision()?;
-        match &self.model {
-            Model::ShapeMatching(sm) => sm.validate()?,
-            Model::Patches(patches) => patches.validate()?,
-            Model::Xpbd(xpbd) => xpbd.validate()?,
-            Model::MassSpring => {}
         }
         Ok(())
     }

@@ -302,6 +302,33 @@ impl ClothScene {
             .map_err(|e| fail(e.to_string()))
     }
 
+    /// The first cloth or collider placed out of range (not finite, or farther than
+    /// `limits::MAX_POSITION`): its field, the key to point at, the message and the
+    /// section it is in.
+    fn misplaced(&self) -> Option<(String, &'static str, &'static str, &'static str)> {
+        let placed = |p: Vec3| p.is_finite() && p.length() <= crate::limits::MAX_POSITION;
+        let angle = |a: f32| a.is_finite() && a.abs() <= crate::limits::MAX_POSITION;
+        for (i, entry) in self.cloths.iter().enumerate() {
+            let checks = [
+                ("translation", placed(entry.translation)),
+                ("yaw_degrees", angle(entry.yaw_degrees)),
+                ("pitch_degrees", angle(entry.pitch_degrees)),
+            ];
+            if let Some((key, _)) = checks.iter().find(|(_, ok)| !ok) {
+                let message = "must be finite and within 1e5 (limits::MAX_POSITION)";
+                return Some((format!("cloths[{i}].{key}"), key, message, "cloths"));
+            }
+        }
+        for (i, entry) in self.colliders.iter().enumerate() {
+            if !placed(entry.translation) || !placed(entry.rotation_degrees) {
+                let message = "translation and rotation_degrees must be finite and within 1e5 (limits::MAX_POSITION)";
+                let field = format!("colliders[{i}].translation");
+                return Some((field, "translation", message, "colliders"));
+            }
+        }
+        None
+    }
+
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
         let invalid = |field: String, key: &str, message: String, after: usize| {
             // Point at the line of the offending key, searching from the cloth's entry.
@@ -334,33 +361,9 @@ impl ClothScene {
                 0,
             ));
         }
-        let placed = |p: Vec3| p.is_finite() && p.length() <= crate::limits::MAX_POSITION;
-        let angle = |a: f32| a.is_finite() && a.abs() <= crate::limits::MAX_POSITION;
-        for (i, entry) in self.cloths.iter().enumerate() {
-            let checks = [
-                ("translation", placed(entry.translation)),
-                ("yaw_degrees", angle(entry.yaw_degrees)),
-                ("pitch_degrees", angle(entry.pitch_degrees)),
-            ];
-            if let Some((key, _)) = checks.iter().find(|(_, ok)| !ok) {
-                return Err(invalid(
-                    format!("cloths[{i}].{key}"),
-                    key,
-                    "must be finite and within 1e5 (limits::MAX_POSITION)".into(),
-                    text.find("cloths").unwrap_or(0),
-                ));
-            }
-        }
-        for (i, entry) in self.colliders.iter().enumerate() {
-            let rotation = entry.rotation_degrees;
-            if !placed(entry.translation) || !placed(rotation) {
-                return Err(invalid(
-                    format!("colliders[{i}].translation"),
-                    "translation",
-                    "translation and rotation_degrees must be finite and within 1e5 (limits::MAX_POSITION)".into(),
-                    text.find("colliders").unwrap_or(0),
-                ));
-            }
+        if let Some((field, key, message, section)) = self.misplaced() {
+            let after = text.find(section).unwrap_or(0);
+            return Err(invalid(field, key, message.into(), after));
         }
         let mut search_from = text.find("cloths").unwrap_or(0);
         for (i, entry) in self.cloths.iter().enumerate() {
@@ -397,16 +400,12 @@ impl ClothScene {
             }
             search_from = entry_start + 1;
         }
-        for (i, entry) in self.colliders.iter().enumerate() {
-            if let Err(e) = entry.collider.validate() {
-                let field = error_field(&e);
-                return Err(invalid(
-                    format!("colliders[{i}].collider.{field}"),
-                    leaf(field),
-                    e.to_string(),
-                    text.find("colliders").unwrap_or(0),
-                ));
-            }
+        let mut bad = self.colliders.iter().enumerate();
+        if let Some((i, e)) = bad.find_map(|(i, c)| c.collider.validate().err().map(|e| (i, e))) {
+            let field = error_field(&e);
+            let after = text.find("colliders").unwrap_or(0);
+            let path = format!("colliders[{i}].collider.{field}");
+            return Err(invalid(path, leaf(field), e.to_string(), after));
         }
         Ok(())
     }
