@@ -133,7 +133,7 @@ impl SelfContact {
         if d.is_nan() || d <= 0.0 {
             return;
         }
-        let (mean, free) = mean_of_free(p, |i| p.velocity[i]);
+        let (centre, free) = mean_of_free(p, |i| p.position[i]);
         if free == 0 {
             return;
         }
@@ -143,29 +143,33 @@ impl SelfContact {
         self.d = d;
         self.friction = params.friction;
         let radius = LIST_RADIUS * d;
-        if self.list_holds(p, d) && self.others.is_empty() {
+        if self.list_holds(p, d, centre) && self.others.is_empty() {
             return;
         }
         self.pairs.clear();
         self.fill_hash(&p.position, radius);
         self.find_pairs(p, radius);
-        self.find_cross_pairs(&p.position, radius, mean, dt);
+        if !self.others.is_empty() {
+            let (mean, _) = mean_of_free(p, |i| p.velocity[i]);
+            self.find_cross_pairs(&p.position, radius, mean, dt);
+        }
         self.listed_at.clone_from(&p.position);
-        self.listed = Some((d, mean_of_free(p, |i| p.position[i]).0));
+        self.listed = Some((d, centre));
     }
 
     /// Whether the last list still holds for `d`: no free particle has moved more than
     /// `d/4` relative to the free particles' mean since it was made, so a pair not on it
     /// is still at least `2 d` apart (a resting or slowly draping cloth keeps its list;
     /// the check is one pass over the particles).
-    fn list_holds(&self, p: &Particles, d: f32) -> bool {
+    /// `centre` is the free particles' mean position now.
+    fn list_holds(&self, p: &Particles, d: f32, centre: Vec3) -> bool {
         let Some((listed_d, listed_mean)) = self.listed else {
             return false;
         };
         if listed_d != d || self.listed_at.len() != p.len() {
             return false;
         }
-        let shift = mean_of_free(p, |i| p.position[i]).0 - listed_mean;
+        let shift = centre - listed_mean;
         let most = RELIST_AFTER * d;
         (0..p.len()).all(|i| {
             p.inv_mass[i] == 0.0
