@@ -124,12 +124,12 @@ pub(crate) fn begin_steps(
     plan.count = 0;
     plan.index = 0;
     // Cloth–cloth contact: the cloths with self-collision on take each other's
-    // particles near them (a sleeping cloth's stay where they are).
+    // particles near them (a sleeping cloth's stay where they are). With one such cloth
+    // left it still runs, so a copy of a cloth since despawned or switched off is dropped.
     let colliding = cloths
         .iter()
-        .filter(|(_, sim, ..)| sim.solver.params().self_collision.enabled)
-        .count();
-    if colliding > 1 {
+        .any(|(_, sim, ..)| sim.solver.params().self_collision.enabled);
+    if colliding {
         let mut all: Vec<_> = cloths
             .iter_mut()
             .map(|(_, sim, _, sleep)| (sim, run && sleep.is_none_or(|s| !s.asleep)))
