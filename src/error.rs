@@ -107,6 +107,18 @@ pub enum ClothError {
         /// The names that exist.
         known: &'static str,
     },
+    /// A fabric preset name that does not exist.
+    #[error(
+        "unknown fabric {name:?}: the presets are denim, interlock, rib-knit, ponte, sweatshirt, swimsuit, polyester, tablecloth, jacket, twill"
+    )]
+    UnknownFabric {
+        /// The name given.
+        name: String,
+    },
+    /// A fabric was given to a cloth with no triangles (a rope or a lattice of springs):
+    /// its masses and bending come from the triangles' areas.
+    #[error("a fabric needs a cloth with triangles (its masses and bending come from their areas)")]
+    FabricNeedsSurface,
     /// A step would have left a position or velocity non-finite (an absurd parameter,
     /// force or edit): the cloth kept the state it had before that step, and is paused
     /// until it is reset or its parameters change.

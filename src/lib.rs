@@ -37,6 +37,7 @@
 
 mod ecs;
 pub mod error;
+pub mod fabric;
 pub mod headless;
 pub mod layout;
 pub mod limits;
@@ -66,6 +67,7 @@ pub mod prelude {
         ClothSubstep, ClothSubstepSystems, ClothSystems, ClothTorn, ClothWake,
     };
     pub use crate::error::ClothError;
+    pub use crate::fabric::Fabric;
     pub use crate::layout::shape::{ClothPins, ClothShape};
     pub use crate::params::ClothParams;
     pub use crate::scene::ClothScene;

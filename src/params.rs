@@ -11,6 +11,7 @@ use bevy::reflect::Reflect;
 use serde::{Deserialize, Serialize};
 
 use crate::error::ClothError;
+pub use crate::fabric::Fabric;
 
 /// Serde for `Vec3` as a `(x, y, z)` tuple, so scene files can hold vectors without
 /// turning on serde for the whole of Bevy.
@@ -562,6 +563,13 @@ pub struct ClothParams {
     /// Particles of the cloth kept apart from one another, so folds do not pass through
     /// themselves (XPBD and mass-spring). Off by default.
     pub self_collision: SelfCollision,
+    /// A fabric in physical units (XPBD and mass-spring, cloths with triangles): when set,
+    /// it replaces `node_mass` (each particle weighs the fabric's areal density times its
+    /// share of the triangles' area), the structural and shear stiffnesses (from its
+    /// tensile and shear stiffness, [`Fabric::grid_springs`]) and the bend springs (the
+    /// quadratic bending model takes its rigidity instead). `None`: the seeds' per-spring
+    /// parameters. In scene files a preset by name: `fabric: Some("denim")`.
+    pub fabric: Option<Fabric>,
 }
 
 /// Self-collision: every two particles of a cloth that are not joined by a spring keep
@@ -614,6 +622,7 @@ impl Default for ClothParams {
             strain_limit_tolerance: None,
             tear_ratio: None,
             self_collision: SelfCollision::default(),
+            fabric: None,
         }
     }
 }
@@ -637,6 +646,23 @@ pub(crate) fn check(
 }
 
 impl ClothParams {
+    /// The spring families that act: [`ClothParams::springs`], or with a fabric its
+    /// structural and shear stiffnesses and no bend springs (its bending is the quadratic
+    /// bending model's).
+    pub fn springs_in_use(&self) -> SpringParams {
+        let Some(fabric) = &self.fabric else {
+            return self.springs;
+        };
+        let (structural, shear) = fabric.grid_springs();
+        SpringParams {
+            structural: SpringFamily::new(structural),
+            shear: SpringFamily::new(shear),
+            bend: SpringFamily::off(self.springs.bend.stiffness),
+            bend_diagonal: SpringFamily::off(self.springs.bend_diagonal.stiffness),
+            ..self.springs
+        }
+    }
+
     /// Checks every value; the error names the field.
     pub fn validate(&self) -> Result<(), ClothError> {
         check(
@@ -695,6 +721,15 @@ impl ClothParams {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
         }
         self.validate_self_collision()?;
+        if let Some(fabric) = &self.fabric {
+            fabric.validate()?;
+            if !matches!(self.model, Model::MassSpring | Model::Xpbd(_)) {
+                return Err(ClothError::ModelLacks {
+                    model: self.model.kind().name(),
+                    feature: "fabric in physical units",
+                });
+            }
+        }
         match &self.model {
             Model::ShapeMatching(sm) => sm.validate()?,
             Model::Patches(patches) => patches.validate()?,

@@ -513,7 +513,9 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         | Pattern(_)
         | Garment { .. } => "shape",
         UnknownModel { .. } => "model",
+        ModelLacks { feature, .. } if feature.starts_with("fabric") => "fabric",
         ModelLacks { .. } => "self_collision",
+        UnknownFabric { .. } | FabricNeedsSurface => "fabric",
         NotMeasurable { .. } | NonFinite { .. } => "cloths",
     }
 }

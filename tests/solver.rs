@@ -36,6 +36,7 @@ fn conservative(integrator: Integrator) -> ClothParams {
         strain_limit_tolerance: None,
         tear_ratio: None,
         self_collision: Default::default(),
+        fabric: None,
     }
 }
 

@@ -6,6 +6,7 @@
 
 pub mod accuracy;
 pub mod baseline;
+pub mod cantilever;
 pub mod choose;
 pub mod fps;
 pub mod peers;

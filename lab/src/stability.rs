@@ -149,6 +149,7 @@ pub fn params(
         strain_limit_tolerance: None,
         tear_ratio: None,
         self_collision: Default::default(),
+        fabric: None,
     })
 }
 

@@ -25,7 +25,7 @@ impl ClothSolver {
             return Err(ClothError::PinOutOfRange { index, count });
         }
         params.validate()?;
-        check_model_fits(params, layout.grid)?;
+        check_model_fits(params, layout.grid, !layout.triangles.is_empty())?;
         crate::params::check_work(count, params)?;
         let mut cloth = ClothSolver {
             particles: Particles::with_len(count),
@@ -58,7 +58,9 @@ impl ClothSolver {
             ModelState::Patches(_) => self.model = ModelState::None,
             ModelState::None | ModelState::Xpbd(_) => {}
         }
-        let mass = self.params.node_mass;
+        let masses: Vec<f32> = (0..self.particles.len())
+            .map(|i| self.particle_mass(i))
+            .collect();
         let p = &mut self.particles;
         for (i, local) in self.structure.local_rest.iter().enumerate() {
             let x = self.drivers.frame.transform_point3(*local);
@@ -67,7 +69,7 @@ impl ClothSolver {
             p.velocity[i] = Vec3::ZERO;
             p.residue[i] = Vec3::ZERO;
             p.force[i] = Vec3::ZERO;
-            p.mass[i] = mass * p.lump[i];
+            p.mass[i] = masses[i];
             p.inv_mass[i] = 1.0 / p.mass[i];
         }
         // Attachments are dropped (their owner attaches again on its next step).
@@ -76,6 +78,16 @@ impl ClothSolver {
         self.clock.reset();
         self.report = Default::default();
         self.save_checkpoint();
+    }
+
+    /// Particle `i`'s mass under the current parameters: with a fabric its areal
+    /// density times the particle's share of the triangles' area, else `node_mass` (times
+    /// the particles a patch-model node stands for).
+    pub(super) fn particle_mass(&self, i: usize) -> f32 {
+        match &self.params.fabric {
+            Some(fabric) => fabric.areal_density * self.structure.area[i],
+            None => self.params.node_mass * self.particles.lump[i],
+        }
     }
 
     /// Tears spring `s` by hand (e.g. a cut with the mouse). Returns false if it was

@@ -14,7 +14,7 @@ pub struct Energy {
     pub kinetic: f32,
     /// `Σ −m g·x` over free particles (zero at the world origin).
     pub gravitational: f32,
-    /// `Σ ½ k (l − l0)²` over acting springs.
+    /// `Σ ½ k (l − l0)²` over acting springs, and a fabric's bending energy.
     pub spring: f32,
 }
 
@@ -47,7 +47,7 @@ impl ClothSolver {
             && self.particles.velocity.iter().all(|v| v.is_finite())
     }
 
-    /// Kinetic, gravitational and spring energy of the particles under `env`, the same
+    /// Kinetic, gravitational and spring energy (with a fabric's bending) of the particles under `env`, the same
     /// quantity for every model: the springs count at the cloth's spring parameters
     /// (`params.springs`) whichever model moves the particles, so a shape-matched or
     /// patch cloth is measured as the same cloth a mass-spring run would be (its goal
@@ -62,8 +62,17 @@ impl ClothSolver {
                 e.gravitational -= p.mass[i] * g.dot(p.position[i]);
             }
         }
-        e.spring = self.spring_energy(&self.params.springs);
+        e.spring = self.spring_energy(&self.params.springs_in_use()) + self.bending_energy();
         e
+    }
+
+    /// A fabric's bending energy (the quadratic bending model, `bending.rs`); 0 without.
+    fn bending_energy(&self) -> f32 {
+        self.params.fabric.map_or(0.0, |f| {
+            self.structure
+                .hinges
+                .energy(&self.particles.position, f.bending)
+        })
     }
 
     /// `Σ ½ k (l − l0)²` over the whole springs, with each family's stiffness from

@@ -6,6 +6,7 @@
 //! is made of (`structure.rs`), what holds it from outside (`drivers.rs`), what it touches
 //! (`contact.rs`), how it keeps out of itself (`self_contact.rs`), its clock (`clock.rs`) and the active model's own state.
 
+mod bending;
 mod build;
 mod clock;
 mod collide;
@@ -132,7 +133,11 @@ impl ClothSolver {
     /// refused with an error and the old parameters stay.
     pub fn set_params(&mut self, params: &ClothParams) -> Result<(), ClothError> {
         params.validate()?;
-        check_model_fits(params, self.structure.grid)?;
+        check_model_fits(
+            params,
+            self.structure.grid,
+            !self.structure.triangles.is_empty(),
+        )?;
         crate::params::check_work(self.particles.len(), params)?;
         self.apply_params(params);
         Ok(())
@@ -143,15 +148,17 @@ impl ClothSolver {
     pub(crate) fn apply_params(&mut self, params: &ClothParams) {
         self.disturbed |= *params != self.params;
         self.begin_switch(params);
-        if params.node_mass != self.params.node_mass {
+        let reweigh =
+            params.node_mass != self.params.node_mass || params.fabric != self.params.fabric;
+        self.params = *params;
+        if reweigh {
             for i in 0..self.particles.len() {
-                self.particles.mass[i] = params.node_mass * self.particles.lump[i];
+                self.particles.mass[i] = self.particle_mass(i);
                 if self.particles.inv_mass[i] != 0.0 {
                     self.particles.inv_mass[i] = 1.0 / self.particles.mass[i];
                 }
             }
         }
-        self.params = *params;
     }
 
     /// The frame (local → world) the pins follow.
@@ -187,10 +194,18 @@ fn family_stiffness(springs: &crate::params::SpringParams, kind: SpringKind) -> 
     }
 }
 
-/// The patch model needs a grid cloth (its parts are blocks of rows and columns).
-fn check_model_fits(params: &ClothParams, grid: Option<(u32, u32)>) -> Result<(), ClothError> {
+/// The patch model needs a grid cloth (its parts are blocks of rows and columns); a
+/// fabric needs triangles (its masses and hinges come from their areas).
+fn check_model_fits(
+    params: &ClothParams,
+    grid: Option<(u32, u32)>,
+    triangles: bool,
+) -> Result<(), ClothError> {
     if matches!(params.model, Model::Patches(_)) && grid.is_none() {
         return Err(ClothError::ModelNeedsGrid { model: "patch" });
+    }
+    if params.fabric.is_some() && !triangles {
+        return Err(ClothError::FabricNeedsSurface);
     }
     Ok(())
 }

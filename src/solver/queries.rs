@@ -37,7 +37,7 @@ impl ClothSolver {
         if !matches!(self.params.model, Model::MassSpring | Model::Xpbd(_)) {
             return 0.0;
         }
-        family_stiffness(&self.params.springs, kind)
+        family_stiffness(&self.params.springs_in_use(), kind)
     }
 
     /// Particle state (positions, velocities, masses, forces).

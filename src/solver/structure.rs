@@ -6,6 +6,7 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
+use super::bending::{Hinges, particle_areas};
 use super::lattice::Stencil;
 use super::layout::Layout;
 use super::topology::{self, SpringKind, Springs, VertexFaces};
@@ -38,6 +39,10 @@ pub(super) struct Structure {
     pub length_scale: f32,
     pub torn_this_step: Vec<u32>,
     pub torn_count: usize,
+    /// The quadratic bending model's hinges (`bending.rs`), for a fabric.
+    pub hinges: Hinges,
+    /// Each particle's share of the triangles' rest area, m² (a fabric's masses).
+    pub area: Vec<f32>,
 }
 
 impl Structure {
@@ -65,6 +70,8 @@ impl Structure {
             springs.rest_length[structural.clone()].iter().sum::<f32>() / structural.len() as f32
         };
         Structure {
+            hinges: Hinges::new(&triangles, &local),
+            area: particle_areas(&triangles, &local),
             torn_this_step: Vec::with_capacity(springs.len()),
             springs,
             local_rest: local,

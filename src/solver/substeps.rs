@@ -198,7 +198,7 @@ impl ClothSolver {
     /// The stretch a family's springs may take: 0 when inextensible, the strain limit when
     /// limited (structural and shear), `None` when neither (or switched off).
     pub(super) fn family_bound(&self, kind: SpringKind) -> Option<f32> {
-        let k = super::family_stiffness(&self.params.springs, kind);
+        let k = super::family_stiffness(&self.params.springs_in_use(), kind);
         let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
         match (k > 0.0, k == f32::INFINITY) {
             (false, _) => None,
@@ -288,10 +288,14 @@ impl ClothSolver {
     /// With the estimate the T-shirt failed `the_seed_material_range_stays_stable_on_the_mannequin`:
     /// the stiffest material gained energy, and with seams counted as springs of length 0
     /// (`c I`, see [`Self::lattice_eigenvalue`]) the lightest, softest one went unstable.
+    ///
+    /// A fabric's bending adds Gershgorin's bound of its hinges ([`Self::bending_gershgorin`]):
+    /// the largest eigenvalue of a sum is at most the sum of the largest.
     fn spring_frequency(&self) -> (f32, f32) {
         let (omega2_bound, gamma_bound) = self.spring_gershgorin();
+        let bending = self.bending_gershgorin();
         if self.structure.grid.is_none() {
-            return (omega2_bound, gamma_bound);
+            return (omega2_bound + bending, gamma_bound);
         }
         let damping = self.params.springs.damping;
         let omega2 = self.lattice_eigenvalue(|kind| self.stiffness(kind), true, POWER_ITERATIONS);
@@ -308,9 +312,24 @@ impl ClothSolver {
         );
         // (Drag is implicit, `integrate.rs`: it bounds no step.)
         (
-            (omega2 * POWER_MARGIN).min(omega2_bound),
+            (omega2 * POWER_MARGIN).min(omega2_bound) + bending,
             (spring_gamma * POWER_MARGIN).min(gamma_bound),
         )
+    }
+
+    /// Gershgorin's bound on `ω_max²` of a fabric's bending hinges, `max_i 2 B Σ_h |K_i| Σ|K| /
+    /// ((A0 + A1) m_i)` (0 without a fabric).
+    fn bending_gershgorin(&self) -> f32 {
+        let Some(fabric) = self.params.fabric else {
+            return 0.0;
+        };
+        let mut rows = vec![0.0f32; self.particles.len()];
+        self.structure.hinges.add_gershgorin_rows(&mut rows);
+        rows.iter()
+            .zip(&self.particles.inv_mass)
+            .fold(0.0f32, |most, (row, w)| {
+                most.max(2.0 * fabric.bending * row * w)
+            })
     }
 
     /// Gershgorin bounds `(ω_max², γ_max)` of the spring lattice:

@@ -17,6 +17,10 @@ impl ModelSteps for MassSpring {
     fn forces(&self, cloth: &mut ClothSolver, env: &Environment) {
         cloth.external_forces(env);
         cloth.spring_forces();
+        if let Some(fabric) = cloth.params.fabric {
+            let hinges = &cloth.structure.hinges;
+            hinges.add_forces(&mut cloth.particles, fabric.bending);
+        }
     }
 
     fn integrate(&self, cloth: &mut ClothSolver) {
@@ -57,7 +61,7 @@ impl ClothSolver {
             None => most,
         };
         let (run, within) = if let Some(stencil) = &mut self.structure.stencil {
-            let springs = self.params.springs;
+            let springs = self.params.springs_in_use();
             let enabled = |kind| match kind {
                 SpringKind::Structural => springs.structural.enabled,
                 SpringKind::Shear => springs.shear.enabled,
@@ -96,8 +100,8 @@ impl ClothSolver {
         let p = &mut self.particles;
         let mut unconverged = false;
         for kind in [SpringKind::Structural, SpringKind::Shear] {
-            if !self.params.springs.structural.enabled && kind == SpringKind::Structural
-                || !self.params.springs.shear.enabled && kind == SpringKind::Shear
+            if !self.params.springs_in_use().structural.enabled && kind == SpringKind::Structural
+                || !self.params.springs_in_use().shear.enabled && kind == SpringKind::Shear
             {
                 continue;
             }

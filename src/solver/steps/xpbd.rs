@@ -1,6 +1,7 @@
 //! XPBD's step (Macklin, Müller and Chentanez 2016; small steps, Macklin et al. 2019,
 //! algorithm 1): predict from the external forces, project every spring's constraint once
-//! a substep (on a grid's stencil, `lattice/xpbd.rs`; otherwise `xpbd.rs`), then the
+//! a substep (on a grid's stencil, `lattice/xpbd.rs`; otherwise `xpbd.rs`), a fabric's
+//! bending hinges (`bending.rs`), then the
 //! tethers to the pins (Kim, Chentanez and Müller 2012, `tethers.rs`); velocities are the
 //! change from the prediction over `h`.
 
@@ -50,7 +51,7 @@ impl ModelSteps for XpbdParams {
             return;
         };
         let h = cloth.clock.h;
-        let (springs, limit) = (&cloth.params.springs, cloth.params.strain_limit);
+        let (springs, limit) = (&cloth.params.springs_in_use(), cloth.params.strain_limit);
         let families = SpringKind::ALL.map(|kind| {
             let k = family_stiffness(springs, kind);
             let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
@@ -59,6 +60,10 @@ impl ModelSteps for XpbdParams {
         match &mut cloth.structure.stencil {
             Some(stencil) => stencil.project_xpbd(&mut cloth.particles, &families, h),
             None => constraints.project(&mut cloth.particles, &families, h),
+        }
+        if let Some(fabric) = cloth.params.fabric {
+            let hinges = &cloth.structure.hinges;
+            hinges.project(&mut cloth.particles, fabric.bending, h);
         }
         let pins = &cloth.drivers.pins;
         constraints.tethers.project(&mut cloth.particles, pins, h);

@@ -89,6 +89,30 @@ enum Verb {
     /// row (or corners) with our XPBD without and with tethers, rapier-cloth-core and a
     /// Verlet + sticks baseline, each over a sweep of its cost setting.
     Peers(PeersArgs),
+    /// The cantilever test (ASTM D1388): a fabric strip 2.5 cm wide pushed over a ledge
+    /// until its tip falls 41.5°; its bending length against `(B / (ρ_A g))^(1/3)`.
+    Cantilever(CantileverArgs),
+}
+
+#[derive(Args)]
+struct CantileverArgs {
+    /// The fabric preset (denim, interlock, rib-knit, ponte, sweatshirt, swimsuit,
+    /// polyester, tablecloth, jacket, twill).
+    #[arg(long, required_unless_present = "all")]
+    fabric: Option<String>,
+    /// Every preset.
+    #[arg(long)]
+    all: bool,
+    /// The models, comma separated: xpbd, mass-spring.
+    #[arg(long, value_delimiter = ',', default_values_t = [String::from("xpbd"), String::from("mass-spring")])]
+    models: Vec<String>,
+    /// Grid spacings in mm, comma separated (2.5 is the default resolution: 11
+    /// particles across the strip).
+    #[arg(long, value_delimiter = ',', default_values_t = [2.5])]
+    spacing: Vec<f32>,
+    /// Prints one JSON object a line instead of a table.
+    #[arg(long)]
+    json: bool,
 }
 
 #[derive(Args)]
@@ -266,6 +290,7 @@ fn main() -> ExitCode {
         Verb::Choose(args) => choose(args),
         Verb::Soak(args) => soak(args),
         Verb::Peers(args) => peers(args),
+        Verb::Cantilever(args) => cantilever(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -1338,6 +1363,63 @@ fn soak(args: SoakArgs) -> Result<(), String> {
 /// `cloth peers`: every configuration of every solver on every side, in one run; the
 /// table, then each solver's cheapest configuration within 1% and within 0.1% strain and
 /// its cost against rapier-cloth-core's in the same run.
+fn cantilever(args: CantileverArgs) -> Result<(), String> {
+    use bevy_cloth::fabric::Fabric;
+    use bevy_cloth_lab::cantilever::{self, StripModel};
+    let fabrics: Vec<(String, Fabric)> = match (&args.fabric, args.all) {
+        (_, true) => Fabric::PRESETS
+            .iter()
+            .map(|&(n, f)| (n.to_string(), f))
+            .collect(),
+        (Some(name), false) => vec![(
+            name.clone(),
+            Fabric::named(name).map_err(|e| e.to_string())?,
+        )],
+        (None, false) => return Err("give --fabric NAME or --all".into()),
+    };
+    let models = args
+        .models
+        .iter()
+        .map(|m| match m.as_str() {
+            "xpbd" => Ok(StripModel::Xpbd),
+            "mass-spring" => Ok(StripModel::MassSpring),
+            other => Err(format!("no model `{other}` here; known: xpbd, mass-spring")),
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    if let Some(s) = args.spacing.iter().find(|s| !(0.5..=12.5).contains(*s)) {
+        return Err(format!("a spacing of {s} mm; from 0.5 to 12.5 mm"));
+    }
+    if !args.json {
+        println!(
+            "| fabric | model | spacing mm | substeps | overhang mm | elastica mm | bending length mm | expected mm | error |"
+        );
+        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
+    }
+    for (name, fabric) in &fabrics {
+        for &model in &models {
+            for &mm in &args.spacing {
+                let m = cantilever::measure(name, *fabric, model, mm * 1e-3)?;
+                if args.json {
+                    println!("{}", serde_json::to_string(&m).map_err(|e| e.to_string())?);
+                } else {
+                    println!(
+                        "| {} | {:?} | {mm} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:+.1}% |",
+                        m.fabric,
+                        m.model,
+                        m.substeps,
+                        m.overhang * 1e3,
+                        m.elastica_overhang * 1e3,
+                        m.measured * 1e3,
+                        m.expected * 1e3,
+                        m.error * 100.0
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn peers(args: PeersArgs) -> Result<(), String> {
     let solvers = or_all(args.solvers, &PEER_SOLVERS);
     if args.one_thread {
