@@ -272,4 +272,15 @@ mod tests {
             "elastica overhang {l:.4} c gives c = {c:.4}"
         );
     }
+
+    #[test]
+    fn both_models_measure_one_bending_length_near_the_fabrics() {
+        // The 5% asked is not met (docs/fabric.md): at 2.5 mm the strips measure 10–17%
+        // short. This holds what is: XPBD and mass-spring agree within 1%, and the length
+        // is within 20% of (B/(ρ_A g))^(1/3) (a strip without bending would hang at once).
+        let xpbd = measure("ponte", Fabric::PONTE, StripModel::Xpbd, 0.0025).unwrap();
+        let ms = measure("ponte", Fabric::PONTE, StripModel::MassSpring, 0.0025).unwrap();
+        assert!((xpbd.measured / ms.measured - 1.0).abs() < 0.01, "{xpbd:?} {ms:?}");
+        assert!(xpbd.error.abs() < 0.2, "{xpbd:?}");
+    }
 }
