@@ -73,8 +73,7 @@ impl Hinges {
         let mut k = 0;
         while k < edges.len() {
             let mut end = k + 1;
-            while end < edges.len() && edges[end].0 == edges[k].0 && edges[end].1 == edges[k].1
-            {
+            while end < edges.len() && edges[end].0 == edges[k].0 && edges[end].1 == edges[k].1 {
                 end += 1;
             }
             if end - k == 2 {
@@ -240,7 +239,10 @@ mod tests {
             .collect();
         for hinges in [one, both] {
             let e = hinges.energy(&moved, 1.0);
-            assert!(e.abs() < 1e-9, "a flat cloth rotated and scaled stores {e} J");
+            assert!(
+                e.abs() < 1e-9,
+                "a flat cloth rotated and scaled stores {e} J"
+            );
         }
     }
 

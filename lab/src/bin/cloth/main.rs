@@ -1403,15 +1403,17 @@ fn cantilever(args: CantileverArgs) -> Result<(), String> {
                     println!("{}", serde_json::to_string(&m).map_err(|e| e.to_string())?);
                 } else {
                     println!(
-                        "| {} | {:?} | {mm} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:+.1}% |",
+                        "| {} | {:?} | {mm} | {:.2} | {:.2} | {:.2} | {:+.1}% | {:.2} | {:.2} | {:+.1}% | {:.2} |",
                         m.fabric,
                         m.model,
-                        m.substeps,
-                        m.overhang * 1e3,
-                        m.elastica_overhang * 1e3,
-                        m.measured * 1e3,
                         m.expected * 1e3,
-                        m.error * 100.0
+                        m.overhang * 1e3,
+                        m.measured * 1e3,
+                        m.error * 100.0,
+                        m.ledge_overhang * 1e3,
+                        m.ledge_measured * 1e3,
+                        m.ledge_error * 100.0,
+                        m.elastica_overhang * 1e3,
                     );
                 }
             }
