@@ -461,6 +461,13 @@ pub fn set_field(target: &mut dyn Reflect, path: &str, value: &str) -> Result<()
         } else {
             Some(number()?)
         };
+    } else if let Some(f) = field.try_downcast_mut::<Option<crate::fabric::Fabric>>() {
+        // A preset by name (`--set cloth.params.fabric=denim`), or `none`.
+        *f = if value.eq_ignore_ascii_case("none") {
+            None
+        } else {
+            Some(crate::fabric::Fabric::named(value).map_err(|e| e.to_string())?)
+        };
     } else if let Some(f) = field.try_downcast_mut::<crate::params::Model>() {
         use crate::params::{Model, PatchParams, ShapeMatchingParams, XpbdParams};
         *f = match value {

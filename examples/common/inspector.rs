@@ -341,6 +341,32 @@ fn spring_controls(ui: &mut egui::Ui, springs: &mut SpringParams, rigid: bool) {
     ui.add(slider(&mut springs.damping, 0.0..=0.05).text("spring damping, N·s/m"));
 }
 
+/// A fabric preset in physical units (its masses, springs and bending), or the seeds'
+/// per-spring parameters.
+fn fabric_controls(ui: &mut egui::Ui, fabric: &mut Option<Fabric>) {
+    let name = fabric.map_or("seed springs (per spring)", |f| {
+        f.name().unwrap_or("custom")
+    });
+    egui::ComboBox::from_label("fabric")
+        .selected_text(name)
+        .show_ui(ui, |ui| {
+            ui.selectable_value(fabric, None, "seed springs (per spring)");
+            for (name, preset) in Fabric::PRESETS {
+                ui.selectable_value(fabric, Some(preset), name);
+            }
+        });
+    if let Some(f) = fabric {
+        ui.label(format!(
+            "{:.0} g/m², stretch {:.0} N/m, shear {:.0} N/m, bending {:.1} µN·m (bending length {:.1} cm)",
+            f.areal_density * 1e3,
+            f.stretch,
+            f.shear,
+            f.bending * 1e6,
+            f.bending_length(9.81) * 100.0
+        ));
+    }
+}
+
 fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
     if let ClothShape::Grid {
         width,
@@ -367,13 +393,15 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             ui.selectable_value(&mut cloth.pins, ClothPins::None, "None");
         });
     let p = &mut cloth.params;
-    let mut grams = p.node_mass * 1e3;
-    ui.add(
-        slider(&mut grams, 0.001..=1.0)
-            .logarithmic(true)
-            .text("node mass, g"),
-    );
-    p.node_mass = grams * 1e-3;
+    if p.fabric.is_none() {
+        let mut grams = p.node_mass * 1e3;
+        ui.add(
+            slider(&mut grams, 0.001..=1.0)
+                .logarithmic(true)
+                .text("node mass, g"),
+        );
+        p.node_mass = grams * 1e-3;
+    }
     let current = p.model.kind();
     egui::ComboBox::from_label("model")
         .selected_text(current.name())
@@ -399,7 +427,10 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
             } else {
                 false
             };
-            spring_controls(ui, &mut p.springs, rigid);
+            fabric_controls(ui, &mut p.fabric);
+            if p.fabric.is_none() {
+                spring_controls(ui, &mut p.springs, rigid);
+            }
             if garment {
                 let s = &mut p.springs;
                 family(ui, "seam", &mut s.seam, rigid);
