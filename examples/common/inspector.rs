@@ -6,7 +6,7 @@
 use bevy::prelude::*;
 use bevy_cloth::StatSample;
 use bevy_cloth::params::{
-    Environment, GoalUpdate, Integrator, Model, ModelKind, PatchTargets, RotationMethod,
+    Air, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchTargets, RotationMethod,
     ShapeMatchingParams, SpringFamily, SpringParams, Substeps, WindField,
 };
 use bevy_cloth::prelude::*;
@@ -664,6 +664,32 @@ fn environment_controls(ui: &mut egui::Ui, env: &mut Environment) {
         } else {
             WindField::Constant
         };
+    }
+    // Air in physical units: a velocity along the wind's heading, the force from each
+    // triangle's area (the same for any resolution and mass).
+    let mut on = env.air.is_some();
+    ui.checkbox(
+        &mut on,
+        "air in physical units (drag and lift on triangles)",
+    );
+    match (on, &mut env.air) {
+        (true, None) => {
+            env.air = Some(Air {
+                velocity: env.wind.direction.normalize_or(Vec3::Z),
+                field: env.wind.field,
+                ..Air::default()
+            })
+        }
+        (false, Some(_)) => env.air = None,
+        (true, Some(air)) => {
+            let mut speed = air.velocity.length();
+            ui.add(slider(&mut speed, 0.0..=20.0).text("air speed, m/s (wind's heading)"));
+            air.velocity = env.wind.direction.normalize_or(Vec3::Z) * speed;
+            air.field = env.wind.field;
+            ui.add(slider(&mut air.drag, 0.0..=3.0).text("drag coefficient"));
+            ui.add(slider(&mut air.lift, 0.0..=3.0).text("lift coefficient"));
+        }
+        (false, None) => {}
     }
 }
 

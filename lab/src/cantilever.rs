@@ -248,7 +248,8 @@ pub fn clamped(fabric: Fabric, model: StripModel, spacing: f32) -> Result<f64, S
     let (mut a, mut b) = (guess, 0.9 * guess);
     let (mut fa, mut fb) = (angle(a)?, angle(b)?);
     for _ in 0..12 {
-        if fb.abs() < 0.005 || fa == fb {
+        // 0.02° is 0.03% of the overhang here (about 2° a millimetre).
+        if fb.abs() < 0.02 || fa == fb {
             break;
         }
         let c = b - fb * (b - a) / (fb - fa);
@@ -256,7 +257,8 @@ pub fn clamped(fabric: Fabric, model: StripModel, spacing: f32) -> Result<f64, S
         b = c.clamp(0.5 * guess, 2.0 * guess);
         fb = angle(b)?;
     }
-    if fb.abs() > 0.05 {
+    // The strip at rest is a little noisy (a settle of 4 s): 0.25° is 0.3% of the overhang.
+    if fb.abs() > 0.25 {
         return Err(format!(
             "the clamped strip did not settle on 41.5° ({fb:+.2}° off)"
         ));

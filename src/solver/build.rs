@@ -41,6 +41,7 @@ impl ClothSolver {
             disturbed: true,
             report: Default::default(),
             checkpoint: Default::default(),
+            air: Vec::new(),
         };
         cloth.clock.substeps = 1;
         cloth.reset();

@@ -6,7 +6,7 @@ use bevy::math::Vec3;
 use super::parallel;
 use super::state::ParticlePiece;
 use super::{ClothSolver, Particles, SpringKind, Springs};
-use crate::params::Environment;
+use crate::params::{Air, Environment};
 
 impl ClothSolver {
     /// Sets every particle's force to gravity (seed 002 eq. 1.6) and wind. The linear drag
@@ -42,6 +42,55 @@ impl ClothSolver {
             }
         };
         parallel::for_each(n, self.particles.pieces(), kernel);
+        if let Some(air) = env.air.as_ref().filter(|_| !held) {
+            self.air_forces(air);
+        }
+    }
+
+    /// Adds the air's force on every shown triangle, a third to each corner, each
+    /// particle's share scaled by the backward-Euler factor of its drag rate (see
+    /// [`Air`]).
+    fn air_forces(&mut self, air: &Air) {
+        let (h, time) = (self.clock.h, self.clock.time);
+        let (s, p) = (&self.structure, &mut self.particles);
+        let scratch = &mut self.air;
+        scratch.clear();
+        scratch.resize(p.len(), (Vec3::ZERO, 0.0));
+        let half_rho = 0.5 * air.density;
+        for (t, corners) in s.triangles.iter().enumerate() {
+            if !s.triangle_visible[t] {
+                continue;
+            }
+            let [a, b, c] = corners.map(|i| i as usize);
+            let (xa, xb, xc) = (p.position[a], p.position[b], p.position[c]);
+            let cross = (xb - xa).cross(xc - xa);
+            let twice_area = cross.length();
+            if twice_area <= 0.0 {
+                continue;
+            }
+            let (area, normal) = (0.5 * twice_area, cross / twice_area);
+            let centre = (xa + xb + xc) / 3.0;
+            let moving = (p.velocity[a] + p.velocity[b] + p.velocity[c]) / 3.0;
+            let w = air.velocity_at(centre, time) - moving;
+            let wn = w.dot(normal);
+            let across = w - wn * normal;
+            let drag = half_rho * air.drag * area * wn * wn.abs() * normal;
+            let lift_dir = (normal - normal.dot(w.normalize_or_zero()) * w.normalize_or_zero())
+                .normalize_or_zero();
+            let lift = half_rho * air.lift * area * wn * across.length() * lift_dir;
+            let share = (drag + lift) / 3.0;
+            let rate = half_rho * air.drag * area * wn.abs() / 3.0;
+            for i in [a, b, c] {
+                scratch[i].0 += share;
+                scratch[i].1 += rate;
+            }
+        }
+        for (i, &(force, rate)) in scratch.iter().enumerate() {
+            let w = p.inv_mass[i];
+            if w != 0.0 {
+                p.force[i] += force / (1.0 + h * rate * w);
+            }
+        }
     }
 
     /// Adds every acting spring's force (on a grid, by its stencil, `lattice.rs`).

@@ -43,7 +43,7 @@ pub use steps::{StageTimes, StepReport};
 pub use substeps::unit_hash;
 pub use topology::{SpringKind, Springs};
 
-use bevy::math::Affine3A;
+use bevy::math::{Affine3A, Vec3};
 
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model};
@@ -79,6 +79,9 @@ pub struct ClothSolver {
     report: StepReport,
     /// The state the step in progress started from.
     checkpoint: steps::Checkpoint,
+    /// Each particle's share of the air's force and its drag rate's numerator, this
+    /// substep (`forces.rs`; kept for its storage).
+    air: Vec<(Vec3, f32)>,
 }
 
 /// The active model's own state: none for mass-spring (or before the first step
