@@ -23,7 +23,6 @@
 use bevy::math::Vec3;
 
 use super::Particles;
-use super::topology::grid_triangles;
 
 /// The hinges of a cloth (see the module doc).
 #[derive(Clone, Debug, Default)]
@@ -32,26 +31,27 @@ pub(super) struct Hinges {
     corners: Vec<[u32; 4]>,
     /// The cotangent weights `K`.
     weights: Vec<[f32; 4]>,
-    /// `1/(A0 + A1)`, times the hinge's weight (½ on a grid, see [`Hinges::new`]).
+    /// `1/(A0 + A1)`, times the hinge's weight (½ where both splits of a rectangle are taken, see [`Hinges::new`]).
     inv_area: Vec<f32>,
 }
 
 impl Hinges {
     /// The hinges of `triangles` at the rest positions `rest`: every edge shared by
-    /// exactly two non-degenerate triangles. A grid (`grid` its width and height, its
-    /// triangles [`grid_triangles`]) takes the hinges of both of its quads' diagonal
-    /// splits at half the stiffness each: one split alone couples bending along the rows
-    /// to a twist (its hinges' stencils lean one way), and a strip bent along its length
-    /// then twists and bends more (a cantilever of denim sagged 13.6 mm where the
-    /// elastica sags 10.3).
-    pub fn new(triangles: &[[u32; 3]], rest: &[Vec3], grid: Option<(u32, u32)>) -> Self {
+    /// exactly two non-degenerate triangles. Where triangles pair up into rectangles
+    /// (a grid's, a garment's, any lattice cut from one: two triangles sharing their
+    /// longest edge, the rectangle's diagonal), the hinges of both diagonal splits are
+    /// taken at half the stiffness each ([`flipped`]): one split alone couples bending
+    /// along the rows to a twist (its hinges' stencils lean one way), and a strip bent
+    /// along its length then twists and bends more (a clamped denim strip sagged
+    /// 13.6 mm where the discrete elastica sags 11.9).
+    pub fn new(triangles: &[[u32; 3]], rest: &[Vec3]) -> Self {
         let mut hinges = Hinges::default();
-        match grid {
-            Some((w, h)) if w >= 2 && h >= 2 && triangles == grid_triangles(w, h) => {
+        match flipped(triangles, rest) {
+            Some(other) => {
                 hinges.add_all(triangles, rest, 0.5);
-                hinges.add_all(&other_split(w, h), rest, 0.5);
+                hinges.add_all(&other, rest, 0.5);
             }
-            _ => hinges.add_all(triangles, rest, 1.0),
+            None => hinges.add_all(triangles, rest, 1.0),
         }
         hinges
     }
@@ -176,17 +176,43 @@ impl Hinges {
     }
 }
 
-/// A `w × h` grid's quads split along their other diagonal (from `(i, j)` to
-/// `(i + 1, j + 1)`).
-fn other_split(w: u32, h: u32) -> Vec<[u32; 3]> {
-    let idx = |i: u32, j: u32| j * w + i;
-    (0..h - 1)
-        .flat_map(|j| (0..w - 1).map(move |i| (i, j)))
-        .flat_map(|(i, j)| {
-            let (a, b, c, d) = (idx(i, j), idx(i + 1, j), idx(i, j + 1), idx(i + 1, j + 1));
-            [[a, d, b], [a, c, d]]
+/// `triangles` with every rectangle they make split along its other diagonal (two
+/// triangles sharing their longest edge, whose far corners are as far apart as that
+/// edge's ends, within 1%); the others as they are. `None` when there is no rectangle.
+fn flipped(triangles: &[[u32; 3]], rest: &[Vec3]) -> Option<Vec<[u32; 3]>> {
+    let x = |i: u32| rest[i as usize];
+    // Each triangle's longest edge (low end, high end) and far corner.
+    let mut longest: Vec<(u32, u32, u32, usize)> = triangles
+        .iter()
+        .enumerate()
+        .map(|(t, tri)| {
+            let k = (0..3)
+                .max_by(|&i, &j| {
+                    let len = |k: usize| x(tri[k]).distance_squared(x(tri[(k + 1) % 3]));
+                    len(i).total_cmp(&len(j))
+                })
+                .unwrap_or(0);
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            (a.min(b), a.max(b), tri[(k + 2) % 3], t)
         })
-        .collect()
+        .collect();
+    longest.sort_unstable();
+    let mut out = triangles.to_vec();
+    let mut any = false;
+    for pair in longest.windows(2) {
+        let ((a, b, p, t), (a2, b2, q, u)) = (pair[0], pair[1]);
+        if (a, b) != (a2, b2) {
+            continue;
+        }
+        let (diagonal, other) = (x(a).distance(x(b)), x(p).distance(x(q)));
+        if (diagonal - other).abs() > 0.01 * diagonal {
+            continue;
+        }
+        out[t] = [p, q, a];
+        out[u] = [q, p, b];
+        any = true;
+    }
+    any.then_some(out)
 }
 
 /// Each particle's share of the triangles' rest area: a third of each triangle it is a
@@ -206,6 +232,7 @@ pub(super) fn particle_areas(triangles: &[[u32; 3]], rest: &[Vec3]) -> Vec<f32> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::solver::topology::grid_triangles;
 
     /// A `w × h` grid of spacing `s` in the xy plane.
     fn grid(w: u32, h: u32, s: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
@@ -226,12 +253,19 @@ mod tests {
             .collect()
     }
 
+    /// The hinges of `t` as they are (one diagonal split), at full stiffness.
+    fn one_split(t: &[[u32; 3]], x: &[Vec3]) -> Hinges {
+        let mut hinges = Hinges::default();
+        hinges.add_all(t, x, 1.0);
+        hinges
+    }
+
     #[test]
     fn a_flat_cloth_stores_nothing_however_it_moves() {
         let (x, t) = grid(9, 7, 0.1);
-        let one = Hinges::new(&t, &x, None);
+        let one = one_split(&t, &x);
         assert_eq!(one.len(), 3 * 8 * 6 - 8 - 6, "every inner edge is a hinge");
-        let both = Hinges::new(&t, &x, Some((9, 7)));
+        let both = Hinges::new(&t, &x);
         assert_eq!(both.len(), 2 * one.len(), "both splits' inner edges");
         let moved: Vec<Vec3> = x
             .iter()
@@ -253,8 +287,12 @@ mod tests {
         let (w, s) = (81, 1.0 / 80.0);
         let (x, t) = grid(w, 41, s);
         let (b, kappa, area) = (2e-5, 2.0, 1.0 * 0.5);
-        for grid in [None, Some((w, 41))] {
-            let hinges = Hinges::new(&t, &x, grid);
+        for grid in [false, true] {
+            let hinges = if grid {
+                Hinges::new(&t, &x)
+            } else {
+                one_split(&t, &x)
+            };
             let e = hinges.energy(&wrapped(&x, kappa), b);
             let ratio = e / (0.5 * b * kappa * kappa * area);
             assert!(
@@ -267,7 +305,7 @@ mod tests {
     #[test]
     fn the_force_is_minus_the_energy_gradient() {
         let (x, t) = grid(5, 5, 0.1);
-        let hinges = Hinges::new(&t, &x, Some((5, 5)));
+        let hinges = Hinges::new(&t, &x);
         let bent = wrapped(&x, 3.0);
         let mut p = Particles::with_len(x.len());
         p.position.clone_from(&bent);

@@ -70,7 +70,7 @@ impl Structure {
             springs.rest_length[structural.clone()].iter().sum::<f32>() / structural.len() as f32
         };
         Structure {
-            hinges: Hinges::new(&triangles, &local, grid),
+            hinges: Hinges::new(&triangles, &local),
             area: particle_areas(&triangles, &local),
             torn_this_step: Vec::with_capacity(springs.len()),
             springs,

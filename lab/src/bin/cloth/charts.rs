@@ -633,3 +633,61 @@ impl Chart for Peers<'_> {
         Ok(())
     }
 }
+
+/// The drape test's shadows, one panel per fabric side by side (two rows of five), each
+/// with the discs and the flat circle outlined and its drape coefficient.
+struct DrapePanels<'a>(&'a [bevy_cloth_lab::drape::Drape]);
+
+impl Chart for DrapePanels<'_> {
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()> {
+        use bevy_cloth_lab::drape::{DISC_RADIUS, FABRIC_RADIUS};
+        let columns = self.0.len().clamp(1, 5);
+        let rows = self.0.len().div_ceil(columns);
+        let panels = area.split_evenly((rows, columns));
+        let reach = f64::from(FABRIC_RADIUS) * 1.08;
+        for (panel, d) in panels.iter().zip(self.0) {
+            let caption = format!(
+                "{}: DC {:.2} (c {:.1} cm)",
+                d.fabric,
+                d.coefficient,
+                d.bending_length * 100.0
+            );
+            let mut chart = ChartBuilder::on(panel)
+                .caption(caption, (FONT, 16))
+                .margin(6)
+                .build_cartesian_2d(-reach..reach, -reach..reach)
+                .map_err(|e| e.to_string())?;
+            let fill = PALETTE[1].mix(0.8).filled();
+            chart
+                .draw_series(d.outline.iter().map(|t| {
+                    Polygon::new(
+                        t.iter()
+                            .map(|&(x, z)| (f64::from(x), f64::from(z)))
+                            .collect::<Vec<_>>(),
+                        fill,
+                    )
+                }))
+                .map_err(|e| e.to_string())?;
+            for (r, colour) in [
+                (DISC_RADIUS, BLACK),
+                (FABRIC_RADIUS, RGBColor(150, 150, 150)),
+            ] {
+                let ring = (0..=96).map(|k| {
+                    let a = k as f64 / 96.0 * std::f64::consts::TAU;
+                    (f64::from(r) * a.cos(), f64::from(r) * a.sin())
+                });
+                chart
+                    .draw_series(LineSeries::new(ring, colour.stroke_width(1)))
+                    .map_err(|e| e.to_string())?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Draws the drape test's panels to `png` and an SVG beside it.
+pub fn drape(png: &Path, drapes: &[bevy_cloth_lab::drape::Drape]) -> Result<()> {
+    let columns = drapes.len().clamp(1, 5) as u32;
+    let rows = drapes.len().div_ceil(columns as usize) as u32;
+    both(png, (260 * columns, 280 * rows), &DrapePanels(drapes))
+}

@@ -92,6 +92,24 @@ enum Verb {
     /// The cantilever test (ASTM D1388): a fabric strip 2.5 cm wide pushed over a ledge
     /// until its tip falls 41.5°; its bending length against `(B / (ρ_A g))^(1/3)`.
     Cantilever(CantileverArgs),
+    /// The drape test (Cusick): a 30 cm circle of fabric clamped between 18 cm discs,
+    /// its drape coefficient from its shadow, with a picture of the shadows side by side.
+    Drape(DrapeArgs),
+}
+
+#[derive(Args)]
+struct DrapeArgs {
+    /// The fabric preset.
+    #[arg(long, required_unless_present = "all")]
+    fabric: Option<String>,
+    /// Every preset.
+    #[arg(long)]
+    all: bool,
+    /// Grid spacing in mm.
+    #[arg(long, default_value_t = 10.0)]
+    spacing: f32,
+    #[command(flatten)]
+    output: Output,
 }
 
 #[derive(Args)]
@@ -291,6 +309,7 @@ fn main() -> ExitCode {
         Verb::Soak(args) => soak(args),
         Verb::Peers(args) => peers(args),
         Verb::Cantilever(args) => cantilever(args),
+        Verb::Drape(args) => drape(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -1363,20 +1382,62 @@ fn soak(args: SoakArgs) -> Result<(), String> {
 /// `cloth peers`: every configuration of every solver on every side, in one run; the
 /// table, then each solver's cheapest configuration within 1% and within 0.1% strain and
 /// its cost against rapier-cloth-core's in the same run.
-fn cantilever(args: CantileverArgs) -> Result<(), String> {
+/// The presets `--fabric NAME` or `--all` name.
+fn chosen_fabrics(
+    fabric: &Option<String>,
+    all: bool,
+) -> Result<Vec<(String, bevy_cloth::fabric::Fabric)>, String> {
     use bevy_cloth::fabric::Fabric;
-    use bevy_cloth_lab::cantilever::{self, StripModel};
-    let fabrics: Vec<(String, Fabric)> = match (&args.fabric, args.all) {
-        (_, true) => Fabric::PRESETS
+    match (fabric, all) {
+        (_, true) => Ok(Fabric::PRESETS
             .iter()
             .map(|&(n, f)| (n.to_string(), f))
-            .collect(),
-        (Some(name), false) => vec![(
+            .collect()),
+        (Some(name), false) => Ok(vec![(
             name.clone(),
             Fabric::named(name).map_err(|e| e.to_string())?,
-        )],
-        (None, false) => return Err("give --fabric NAME or --all".into()),
-    };
+        )]),
+        (None, false) => Err("give --fabric NAME or --all".into()),
+    }
+}
+
+fn drape(args: DrapeArgs) -> Result<(), String> {
+    let fabrics = chosen_fabrics(&args.fabric, args.all)?;
+    if !(2.5..=30.0).contains(&args.spacing) {
+        return Err(format!(
+            "a spacing of {} mm; from 2.5 to 30 mm",
+            args.spacing
+        ));
+    }
+    if !args.output.json {
+        println!("| fabric | bending length mm | B µN·m | drape coefficient |");
+        println!("|---|---:|---:|---:|");
+    }
+    let mut drapes = Vec::new();
+    for (name, fabric) in &fabrics {
+        let d = bevy_cloth_lab::drape::drape(name, *fabric, args.spacing * 1e-3)?;
+        if args.output.json {
+            println!("{}", serde_json::to_string(&d).map_err(|e| e.to_string())?);
+        } else {
+            println!(
+                "| {} | {:.1} | {:.2} | {:.3} |",
+                d.fabric,
+                d.bending_length * 1e3,
+                fabric.bending * 1e6,
+                d.coefficient
+            );
+        }
+        drapes.push(d);
+    }
+    if let Some(png) = &args.output.chart {
+        charts::drape(png, &drapes)?;
+    }
+    Ok(())
+}
+
+fn cantilever(args: CantileverArgs) -> Result<(), String> {
+    use bevy_cloth_lab::cantilever::{self, StripModel};
+    let fabrics = chosen_fabrics(&args.fabric, args.all)?;
     let models = args
         .models
         .iter()
@@ -1391,9 +1452,9 @@ fn cantilever(args: CantileverArgs) -> Result<(), String> {
     }
     if !args.json {
         println!(
-            "| fabric | model | spacing mm | substeps | overhang mm | elastica mm | bending length mm | expected mm | error |"
+            "| fabric | model | spacing mm | expected c mm | clamped: overhang mm | c mm | error | ledge: overhang mm | c mm | error | elastica overhang mm |"
         );
-        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|");
+        println!("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     }
     for (name, fabric) in &fabrics {
         for &model in &models {
