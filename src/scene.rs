@@ -421,8 +421,6 @@ pub fn set_field(target: &mut dyn Reflect, path: &str, value: &str) -> Result<()
     use bevy::reflect::ReflectMut;
     use bevy::reflect::enums::{DynamicEnum, DynamicVariant};
 
-    use crate::params::Substeps;
-
     let field = target
         .reflect_path_mut(path)
         .map_err(|e| format!("no field `{path}`: {e}"))?;
@@ -461,36 +459,8 @@ pub fn set_field(target: &mut dyn Reflect, path: &str, value: &str) -> Result<()
         } else {
             Some(number()?)
         };
-    } else if let Some(f) = field.try_downcast_mut::<Option<crate::fabric::Fabric>>() {
-        // A preset by name (`--set cloth.params.fabric=denim`), or `none`.
-        *f = if value.eq_ignore_ascii_case("none") {
-            None
-        } else {
-            Some(crate::fabric::Fabric::named(value).map_err(|e| e.to_string())?)
-        };
-    } else if let Some(f) = field.try_downcast_mut::<crate::params::Model>() {
-        use crate::params::{Model, PatchParams, ShapeMatchingParams, XpbdParams};
-        *f = match value {
-            "MassSpring" => Model::MassSpring,
-            "ShapeMatching" => Model::ShapeMatching(ShapeMatchingParams::default()),
-            "Patches" => Model::Patches(PatchParams::default()),
-            "Xpbd" => Model::Xpbd(XpbdParams::default()),
-            _ => {
-                return Err(format!(
-                    "`{value}` is not MassSpring, ShapeMatching, Patches or Xpbd"
-                ));
-            }
-        };
-    } else if let Some(f) = field.try_downcast_mut::<Substeps>() {
-        *f = if value.eq_ignore_ascii_case("auto") {
-            Substeps::default()
-        } else {
-            Substeps::Fixed(
-                value
-                    .parse()
-                    .map_err(|_| format!("`{value}` is not `auto` or a substep count"))?,
-            )
-        };
+    } else if let Some(done) = set_by_name(field, value) {
+        done?;
     } else if let ReflectMut::Enum(e) = field.reflect_mut() {
         let unit = DynamicEnum::new(value, DynamicVariant::Unit);
         e.try_apply(&unit).map_err(|_| {
@@ -504,6 +474,51 @@ pub fn set_field(target: &mut dyn Reflect, path: &str, value: &str) -> Result<()
         return Err(format!("`{path}` cannot be set from the command line"));
     }
     Ok(())
+}
+
+/// The fields [`set_field`] takes by name: a model (with its defaults), a fabric preset
+/// (or `none`), substeps (`auto` or a count). `None` when `field` is none of those.
+fn set_by_name(
+    field: &mut dyn bevy::reflect::PartialReflect,
+    value: &str,
+) -> Option<Result<(), String>> {
+    use crate::fabric::Fabric;
+    use crate::params::{Model, PatchParams, ShapeMatchingParams, Substeps, XpbdParams};
+    if let Some(f) = field.try_downcast_mut::<Option<Fabric>>() {
+        // A preset by name (`--set cloth.params.fabric=denim`), or `none`.
+        *f = if value.eq_ignore_ascii_case("none") {
+            None
+        } else {
+            match Fabric::named(value) {
+                Ok(fabric) => Some(fabric),
+                Err(e) => return Some(Err(e.to_string())),
+            }
+        };
+    } else if let Some(f) = field.try_downcast_mut::<Model>() {
+        *f = match value {
+            "MassSpring" => Model::MassSpring,
+            "ShapeMatching" => Model::ShapeMatching(ShapeMatchingParams::default()),
+            "Patches" => Model::Patches(PatchParams::default()),
+            "Xpbd" => Model::Xpbd(XpbdParams::default()),
+            _ => {
+                return Some(Err(format!(
+                    "`{value}` is not MassSpring, ShapeMatching, Patches or Xpbd"
+                )));
+            }
+        };
+    } else if let Some(f) = field.try_downcast_mut::<Substeps>() {
+        *f = if value.eq_ignore_ascii_case("auto") {
+            Substeps::default()
+        } else {
+            match value.parse() {
+                Ok(n) => Substeps::Fixed(n),
+                Err(_) => return Some(Err(format!("`{value}` is not `auto` or a substep count"))),
+            }
+        };
+    } else {
+        return None;
+    }
+    Some(Ok(()))
 }
 
 fn error_field(e: &crate::error::ClothError) -> &'static str {
