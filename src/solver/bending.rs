@@ -131,27 +131,25 @@ impl Hinges {
         if b <= 0.0 {
             return;
         }
+        // `Δλ = −C / (Σ w_k K_k² + α̃)` and `Δx_k = w_k K_k v̂ Δλ` with `C = |v|`: the length
+        // cancels, `Δx_k = −w_k K_k v / (Σ w K² + α̃)` (no square root, and nothing to
+        // skip at `v = 0`). `α̃ = (A0 + A1)/(B h²)`.
+        let (inv_h, per_area) = (1.0 / h, 1.0 / (b * h * h));
         for e in 0..self.len() {
-            let v = self.curvature(e, &p.position);
-            let c = v.length();
-            if c <= f32::EPSILON * 1e-3 {
-                continue;
-            }
-            let n = v / c;
             let (corners, k) = (self.corners[e], self.weights[e]);
-            let alpha = 1.0 / (b * self.inv_area[e] * h * h);
-            let w: f32 = (0..4)
-                .map(|j| p.inv_mass[corners[j] as usize] * k[j] * k[j])
-                .sum();
-            if w == 0.0 {
-                continue;
-            }
-            let lambda = -c / (w + alpha);
+            let i = corners.map(|i| i as usize);
+            let w = i.map(|i| p.inv_mass[i]);
+            let v = k[0] * p.position[i[0]]
+                + k[1] * p.position[i[1]]
+                + k[2] * p.position[i[2]]
+                + k[3] * p.position[i[3]];
+            let stiffness =
+                w[0] * k[0] * k[0] + w[1] * k[1] * k[1] + w[2] * k[2] * k[2] + w[3] * k[3] * k[3];
+            let scale = -1.0 / (stiffness + per_area / self.inv_area[e]);
             for j in 0..4 {
-                let i = corners[j] as usize;
-                let dx = n * (p.inv_mass[i] * k[j] * lambda);
-                p.position[i] += dx;
-                p.velocity[i] += dx / h;
+                let dx = v * (w[j] * k[j] * scale);
+                p.position[i[j]] += dx;
+                p.velocity[i[j]] += dx * inv_h;
             }
         }
     }
