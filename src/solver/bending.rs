@@ -161,6 +161,23 @@ impl Hinges {
             .sum()
     }
 
+    /// The hinges' mean `B Σ w K² / (A0 + A1)` (`w` the inverse masses, pinned corners
+    /// 0): how much a substep of one iteration softens them (`fabric_floor`), 0 without
+    /// hinges.
+    pub fn mean_load(&self, inv_mass: &[f32], b: f32) -> f32 {
+        if self.len() == 0 {
+            return 0.0;
+        }
+        let total: f64 = (0..self.len())
+            .map(|e| {
+                let (c, k) = (self.corners[e], self.weights[e]);
+                let sum: f32 = (0..4).map(|j| inv_mass[c[j] as usize] * k[j] * k[j]).sum();
+                f64::from(b * self.inv_area[e] * sum)
+            })
+            .sum();
+        (total / self.len() as f64) as f32
+    }
+
     /// Gershgorin's bound on each particle's row of the bending stiffness `B K Kᵀ/(A0+A1)`
     /// for `b = 1`, added into `rows` (for the explicit models' substeps).
     pub fn add_gershgorin_rows(&self, rows: &mut [f32]) {

@@ -28,6 +28,10 @@ pub(super) struct Clock {
     /// XPBD's measured substeps of the last step, for (parameters, dt); empty after a
     /// reset.
     pub xpbd_loop: SubstepLoop,
+    /// For XPBD's least substeps with a fabric (`ClothSolver::fabric_floor`): the
+    /// parameters they were taken for, the free particles' mean inverse mass and the
+    /// hinges' mean load.
+    pub fabric_loads: Option<(crate::params::ClothParams, f32, f32)>,
 }
 
 impl Clock {

@@ -263,6 +263,7 @@ impl ClothSolver {
                 } else {
                     self.refresh_substep_cache(dt)
                 };
+                let needed = needed.max(self.fabric_floor(dt));
                 self.clock.under_resolved = needed > cap;
                 needed.clamp(1, cap)
             }
