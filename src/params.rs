@@ -965,17 +965,19 @@ impl Air {
     /// The air's velocity at `position` at simulated time `time`: `velocity`, or with
     /// seed 002's gusts their pattern at the speed of `velocity`.
     pub fn velocity_at(&self, position: Vec3, time: f32) -> Vec3 {
-        match self.field {
-            WindField::Constant => self.velocity,
-            WindField::Trigonometric => {
-                let wind = Wind {
-                    direction: self.velocity,
-                    strength: self.velocity.length(),
-                    field: self.field,
-                };
-                wind.force_at(position, time)
-            }
+        self.at_time(time).force_at(position)
+    }
+
+    /// The air at simulated time `time`, what does not depend on position worked out
+    /// once: its velocity at a position is the returned pattern's
+    /// [`WindAt::force_at`] (a per-triangle loop calls it).
+    pub fn at_time(&self, time: f32) -> WindAt {
+        Wind {
+            direction: self.velocity,
+            strength: self.velocity.length(),
+            field: self.field,
         }
+        .at_time(time)
     }
 
     /// Checks the velocity, density and coefficients.

@@ -57,6 +57,7 @@ impl ClothSolver {
         scratch.clear();
         scratch.resize(p.len(), (Vec3::ZERO, 0.0));
         let half_rho = 0.5 * air.density;
+        let flow = air.at_time(time);
         for (t, corners) in s.triangles.iter().enumerate() {
             if !s.triangle_visible[t] {
                 continue;
@@ -71,7 +72,7 @@ impl ClothSolver {
             let (area, normal) = (0.5 * twice_area, cross / twice_area);
             let centre = (xa + xb + xc) / 3.0;
             let moving = (p.velocity[a] + p.velocity[b] + p.velocity[c]) / 3.0;
-            let w = air.velocity_at(centre, time) - moving;
+            let w = flow.force_at(centre) - moving;
             let wn = w.dot(normal);
             let across = w - wn * normal;
             let drag = half_rho * air.drag * area * wn * wn.abs() * normal;
