@@ -242,3 +242,45 @@ fn the_lightest_seed_material_in_the_curtains_air_keeps_its_strain_limit() {
         first * 100.0
     );
 }
+
+#[test]
+fn a_fabric_set_on_a_built_cloth_bends_like_one_built_with_it() {
+    // The hinges are built when a fabric first arrives, at build or by `set_params`.
+    let params = ClothParams {
+        fabric: Some(Fabric::DENIM),
+        ..ClothParams::default()
+    };
+    let shape = ClothShape::Grid {
+        width: 9,
+        height: 9,
+        spacing: 0.02,
+    };
+    // Level, held by its top row: it swings down and bends over the row.
+    let level = Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let mut built = shape
+        .build_solver(&ClothPins::TopRow, &params, level)
+        .unwrap();
+    let mut later = shape
+        .build_solver(&ClothPins::TopRow, &ClothParams::default(), level)
+        .unwrap();
+    later.set_params(&params).unwrap();
+    let env = Environment::default();
+    for _ in 0..30 {
+        built.step(0.016, &env);
+        later.step(0.016, &env);
+    }
+    assert_eq!(built.positions(), later.positions());
+    // Without bending it would have come out elsewhere (the test can tell).
+    let mut without = params;
+    without.fabric = Some(Fabric {
+        bending: 0.0,
+        ..Fabric::DENIM
+    });
+    let mut limp = shape
+        .build_solver(&ClothPins::TopRow, &without, level)
+        .unwrap();
+    for _ in 0..30 {
+        limp.step(0.016, &env);
+    }
+    assert_ne!(built.positions(), limp.positions());
+}

@@ -44,6 +44,9 @@ impl ClothSolver {
             air: Vec::new(),
         };
         cloth.clock.substeps = 1;
+        if params.fabric.is_some() {
+            cloth.structure.build_hinges();
+        }
         cloth.reset();
         Ok(cloth)
     }

@@ -154,6 +154,9 @@ impl ClothSolver {
         let reweigh =
             params.node_mass != self.params.node_mass || params.fabric != self.params.fabric;
         self.params = *params;
+        if params.fabric.is_some() {
+            self.structure.build_hinges();
+        }
         if reweigh {
             for i in 0..self.particles.len() {
                 self.particles.mass[i] = self.particle_mass(i);

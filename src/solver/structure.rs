@@ -39,7 +39,8 @@ pub(super) struct Structure {
     pub length_scale: f32,
     pub torn_this_step: Vec<u32>,
     pub torn_count: usize,
-    /// The quadratic bending model's hinges (`bending.rs`), for a fabric.
+    /// The quadratic bending model's hinges (`bending.rs`): built once a fabric is set
+    /// ([`Structure::build_hinges`]), empty until then.
     pub hinges: Hinges,
     /// Each particle's share of the triangles' rest area, m² (a fabric's masses).
     pub area: Vec<f32>,
@@ -70,7 +71,7 @@ impl Structure {
             springs.rest_length[structural.clone()].iter().sum::<f32>() / structural.len() as f32
         };
         Structure {
-            hinges: Hinges::new(&triangles, &local),
+            hinges: Hinges::default(),
             area: particle_areas(&triangles, &local),
             torn_this_step: Vec::with_capacity(springs.len()),
             springs,
@@ -92,6 +93,14 @@ impl Structure {
             stencil,
             length_scale,
             torn_count: 0,
+        }
+    }
+
+    /// Builds the hinges if they are not yet (a cloth without a fabric never pays for
+    /// them: about 6 a particle, sorted twice).
+    pub fn build_hinges(&mut self) {
+        if self.hinges.len() == 0 && !self.triangles.is_empty() {
+            self.hinges = Hinges::new(&self.triangles, &self.local_rest);
         }
     }
 
