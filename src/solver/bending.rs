@@ -139,6 +139,8 @@ impl Hinges {
             let (corners, k) = (self.corners[e], self.weights[e]);
             let i = corners.map(|i| i as usize);
             let w = i.map(|i| p.inv_mass[i]);
+            // `curvature`, written out: calling it (or a free function of the corners)
+            // made the denim curtain's step 17% slower (2.2 against 1.87 ms).
             let v = k[0] * p.position[i[0]]
                 + k[1] * p.position[i[1]]
                 + k[2] * p.position[i[2]]

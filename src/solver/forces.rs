@@ -76,8 +76,8 @@ impl ClothSolver {
             let wn = w.dot(normal);
             let across = w - wn * normal;
             let drag = half_rho * air.drag * area * wn * wn.abs() * normal;
-            let lift_dir = (normal - normal.dot(w.normalize_or_zero()) * w.normalize_or_zero())
-                .normalize_or_zero();
+            let flow_dir = w.normalize_or_zero();
+            let lift_dir = (normal - normal.dot(flow_dir) * flow_dir).normalize_or_zero();
             let lift = half_rho * air.lift * area * wn * across.length() * lift_dir;
             let share = (drag + lift) / 3.0;
             let rate = half_rho * air.drag * area * wn.abs() / 3.0;

@@ -99,9 +99,10 @@ impl ClothSolver {
         let s = &self.structure.springs;
         let p = &mut self.particles;
         let mut unconverged = false;
+        let springs = self.params.springs_in_use();
         for kind in [SpringKind::Structural, SpringKind::Shear] {
-            if !self.params.springs_in_use().structural.enabled && kind == SpringKind::Structural
-                || !self.params.springs_in_use().shear.enabled && kind == SpringKind::Shear
+            if !springs.structural.enabled && kind == SpringKind::Structural
+                || !springs.shear.enabled && kind == SpringKind::Shear
             {
                 continue;
             }
