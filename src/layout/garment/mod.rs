@@ -224,19 +224,7 @@ impl GarmentLayout {
             }
             let (pattern, warnings) = read_pattern(&piece.pattern)?;
             layout.warnings.extend(warnings);
-            // The refined grid's size before it is allocated.
-            let refined = |n: u32| (n as u64 - 1) * resolution as u64 + 1;
-            let nodes = refined(pattern.width) * refined(pattern.height);
-            if nodes > crate::limits::MAX_PATTERN_NODES as u64 {
-                return Err(error(
-                    &format!("\"{}\"", piece.name),
-                    format!(
-                        "piece `{}` at resolution {resolution} has {nodes} grid nodes, more than the limit of {} (limits.rs)",
-                        piece.name,
-                        crate::limits::MAX_PATTERN_NODES
-                    ),
-                ));
-            }
+            check_nodes(&pattern, &piece.name, resolution, &error)?;
             let pattern = pattern.rescale(resolution);
             let start = layout.positions.len() as u32;
             let index = add_piece(&mut layout, &pattern, piece, spacing);
@@ -263,24 +251,58 @@ impl GarmentLayout {
                 .extend(pairs.iter().map(|p| (SpringKind::Seam, p[0], p[1])));
             layout.seams.push((seam.name.clone(), pairs));
         }
-        for run in &desc.runs {
-            let needle = format!("\"{}\"", run.name);
-            if desc.runs.iter().filter(|r| r.name == run.name).count() > 1 {
-                return Err(error(&needle, format!("two runs are named `{}`", run.name)));
-            }
-            let label = format!("run `{}`", run.name);
-            let particles = edge_particles(
-                &run.nodes,
-                (&label, &needle),
-                &desc.pieces,
-                &grids,
-                resolution,
-                &error,
-            )?;
-            layout.runs.push((run.name.clone(), particles));
-        }
+        layout.runs = runs(&desc, &grids, resolution, &error)?;
         Ok(layout)
     }
+}
+
+/// The refined grid of `pattern` at `resolution` within the limit, before it is
+/// allocated.
+fn check_nodes(
+    pattern: &Pattern,
+    piece: &str,
+    resolution: u32,
+    error: &dyn Fn(&str, String) -> ClothError,
+) -> Result<(), ClothError> {
+    let refined = |n: u32| (n as u64 - 1) * resolution as u64 + 1;
+    let nodes = refined(pattern.width) * refined(pattern.height);
+    if nodes > crate::limits::MAX_PATTERN_NODES as u64 {
+        return Err(error(
+            &format!("\"{piece}\""),
+            format!(
+                "piece `{piece}` at resolution {resolution} has {nodes} grid nodes, more than the limit of {} (limits.rs)",
+                crate::limits::MAX_PATTERN_NODES
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The garment's named runs: each its particles along its nodes (names unique).
+fn runs(
+    desc: &GarmentFile,
+    grids: &[(Pattern, Vec<u32>)],
+    resolution: u32,
+    error: &dyn Fn(&str, String) -> ClothError,
+) -> Result<Vec<(String, Vec<u32>)>, ClothError> {
+    let mut runs = Vec::with_capacity(desc.runs.len());
+    for run in &desc.runs {
+        let needle = format!("\"{}\"", run.name);
+        if desc.runs.iter().filter(|r| r.name == run.name).count() > 1 {
+            return Err(error(&needle, format!("two runs are named `{}`", run.name)));
+        }
+        let label = format!("run `{}`", run.name);
+        let particles = edge_particles(
+            &run.nodes,
+            (&label, &needle),
+            &desc.pieces,
+            grids,
+            resolution,
+            error,
+        )?;
+        runs.push((run.name.clone(), particles));
+    }
+    Ok(runs)
 }
 
 /// The garment file's own numbers: a positive spacing, a resolution in range, a piece.
