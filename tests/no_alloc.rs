@@ -5,7 +5,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use bevy::math::{Affine3A, Vec3};
-use bevy_cloth::params::{Environment, Model, PatchParams, SpringParams, Wind, WindField};
+use bevy_cloth::params::{
+    Environment, Model, PatchParams, SelfCollision, SpringParams, Wind, WindField,
+};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::ClothSolver;
 
@@ -121,4 +123,53 @@ fn patch_steps_allocate_nothing_even_with_a_state_dependent_pull() {
     });
     assert!(cloth.patches().is_some());
     assert_eq!(allocated, 0, "{allocated} allocations in 50 patch steps");
+}
+
+/// Self-collision's listing (the grid, the rest neighbours' marks, the pieces' pair
+/// lists) keeps its storage: a cloth swinging down from level relists every step and,
+/// once its scratch has grown over the first second, allocates nothing.
+#[test]
+fn self_collision_steps_allocate_nothing() {
+    let params = ClothParams {
+        self_collision: SelfCollision::on(),
+        ..ClothParams::default()
+    };
+    let shape = ClothShape::Grid {
+        width: 16,
+        height: 16,
+        spacing: 0.05,
+    };
+    let level = Affine3A::from_rotation_x(std::f32::consts::FRAC_PI_2);
+    let mut cloth = shape
+        .build_solver(&ClothPins::TopRow, &params, level)
+        .unwrap();
+    let env = Environment::default();
+    for _ in 0..60 {
+        cloth.step(0.016, &env);
+    }
+    let mut relisted = 0;
+    let mut before = cloth.positions().to_vec();
+    let allocated = allocations_during(|| {
+        // A step relists once a particle has moved d/4 relative to the mean.
+        for _ in 0..60 {
+            cloth.step(0.016, &env);
+            let x = cloth.positions();
+            let shift = x.iter().zip(&before).map(|(a, b)| *a - *b).sum::<Vec3>() / 256.0;
+            let most = x
+                .iter()
+                .zip(&before)
+                .map(|(a, b)| (*a - *b - shift).length());
+            relisted += (most.fold(0.0, f32::max) > 0.25 * 0.05) as usize;
+            before.copy_from_slice(x);
+        }
+    });
+    assert!(cloth.self_collision_distance() > 0.0);
+    assert!(
+        relisted > 10,
+        "the cloth moves enough to relist: {relisted} steps"
+    );
+    assert_eq!(
+        allocated, 0,
+        "{allocated} allocations in 60 self-collision steps"
+    );
 }

@@ -2,14 +2,17 @@
 //! not pass through themselves (Müller, "Ten Minute Physics" #15, "Self-collision"; the
 //! method of NvCloth's self-collision).
 //!
-//! Once a step, a spatial hash over the particles (cells the size of the query radius, a
-//! dense table of at least twice the particle count filled by counting sort: no allocation once
-//! grown) lists the pairs closer than `2.5 d`; the list is kept while no particle has
-//! moved `d/4` relative to the cloth's mean since, so every pair off it is at least `2 d`
-//! apart and can come within `d` during a step only by closing in faster than `d` a
-//! step. Pairs joined by a structural, shear or seam spring are never
-//! listed: they are the cloth's own structure (closer than `d` at rest), and a seam's
-//! two ends are meant to meet. Each substep, after the model's constraints and before contact:
+//! Once a step, a uniform grid over the cloth's box (cells the size of the query radius,
+//! at most four a particle, filled by counting sort: no allocation once grown) lists the
+//! pairs closer than `2.5 d`; the list is kept while no particle has moved `d/4`
+//! relative to the cloth's mean since, so every pair off it is at least `2 d` apart and
+//! can come within `d` during a step only by closing in faster than `d` a step. Rest
+//! neighbours are not listed (NvCloth and Ten Minute Physics #15 leave them out too):
+//! particles joined by a structural, shear or seam spring never (they are the cloth's
+//! own structure, closer than `d` at rest, and a seam's two ends are meant to meet), and
+//! particles two such springs apart only once closer than `1.75 d`, where the cloth
+//! folds sharply between them. A flat or gently curved cloth so lists no pair at all.
+//! Each substep, after the model's constraints and before contact:
 //! 1. every free particle's motion relative to the mean is clamped to `d/2` a substep
 //!    (the velocity clamp): two particles then close in by at most `d` in a substep, so
 //!    one cannot pass another between two substeps' tests;
@@ -37,9 +40,9 @@
 //! not slowed; only its parts' motion relative to one another is bounded, to `d/2` per
 //! substep (at 13 substeps of 16 ms and `d` = 3 cm, 12 m/s).
 
-use bevy::math::Vec3;
+use bevy::math::{Vec3, Vec3A};
 
-use super::parallel::{self, PIECE};
+use super::parallel;
 use super::{Particles, SpringKind, Springs};
 use crate::params::SelfCollision;
 
@@ -52,21 +55,27 @@ pub(super) struct SelfContact {
     reach: f32,
     /// Coulomb's coefficient between two particles.
     friction: f32,
-    /// Each particle's partners by a structural, shear or seam spring, sorted:
-    /// `excluded[excluded_start[i]..excluded_start[i + 1]]`.
+    /// Each particle's rest neighbours (within two structural, shear or seam springs),
+    /// sorted: `excluded[excluded_start[i]..excluded_start[i + 1]]`.
     excluded_start: Vec<u32>,
     excluded: Vec<u32>,
     /// The spring count and particle count the exclusions were built for.
     built_for: Option<(usize, usize)>,
     /// The cloth's rest spacing: the median structural rest length.
     spacing: f32,
-    /// This step's pairs, `i < j`, in increasing order.
+    /// This step's pairs, `i < j`, in the hash's slot order.
     pairs: Vec<[u32; 2]>,
-    /// The hash: each slot's first entry in `entries` (particle indices by slot).
-    slot_start: Vec<u32>,
+    /// The grid: its box's low corner, its cell size and cells a side, each cell's first
+    /// entry in `entries` (particle indices by cell, each cell's in increasing order),
+    /// and each entry's position.
+    grid: Grid,
+    cell_start: Vec<u32>,
     entries: Vec<u32>,
-    /// Each particle's cell when the list was made.
-    cells: Vec<[i32; 3]>,
+    entry_x: Vec<Vec3A>,
+    /// Each particle's cell (scratch of the counting sort).
+    cells: Vec<u32>,
+    /// Each piece's first cell while the pairs are listed, and the grid's cell count.
+    piece_cells: Vec<usize>,
     /// Each piece's pairs while they are listed (kept for their storage).
     found: Vec<Vec<[u32; 2]>>,
     /// Pairs pushed apart since the step began.
@@ -147,7 +156,7 @@ impl SelfContact {
             return;
         }
         self.pairs.clear();
-        self.fill_hash(&p.position, radius);
+        self.fill_grid(&p.position, radius);
         self.find_pairs(p, radius);
         if !self.others.is_empty() {
             let (mean, _) = mean_of_free(p, |i| p.velocity[i]);
@@ -177,41 +186,56 @@ impl SelfContact {
         })
     }
 
-    /// Every particle's partners by a structural, shear or seam spring (torn ones too: a
-    /// tear's two sides start where they were), and the rest spacing. Bend springs join
-    /// particles two spacings apart, farther than `d`: those pairs are kept apart like
-    /// any other, so a crease cannot fold flat within two rows (where an edge would pass
-    /// through the next cell's triangles without any pair coming closer than `d`).
+    /// Every particle's rest neighbours, and the rest spacing: the particles one
+    /// structural, shear or seam spring from it (torn ones too: a tear's two sides start
+    /// where they were), then those two such springs from it, tagged [`TWO_SPRINGS`] (listed
+    /// only once closer than [`FOLDED`]` d`). On a grid that is the 5 × 5 block around a
+    /// particle, every particle within `LIST_RADIUS · d` of it while the cloth lies flat,
+    /// so a flat or gently curved cloth lists no pair and pays nothing a substep.
     fn exclude_springs(&mut self, springs: &Springs, n: usize) {
         let joined: Vec<usize> = [SpringKind::Structural, SpringKind::Shear, SpringKind::Seam]
             .into_iter()
             .flat_map(|kind| springs.ranges[kind as usize].clone())
             .collect();
-        let mut count = vec![0u32; n + 1];
+        // The partners by one spring, as rows `near[start[i]..start[i + 1]]`.
+        let mut start = vec![0u32; n + 1];
         for &s in &joined {
-            count[springs.a[s] as usize] += 1;
-            count[springs.b[s] as usize] += 1;
-        }
-        self.excluded_start.clear();
-        self.excluded_start.push(0);
-        let mut total = 0;
-        for c in &count[..n] {
-            total += c;
-            self.excluded_start.push(total);
-        }
-        self.excluded.clear();
-        self.excluded.resize(total as usize, 0);
-        let mut fill: Vec<u32> = self.excluded_start[..n].to_vec();
-        for &s in &joined {
-            let (a, b) = (springs.a[s], springs.b[s]);
-            self.excluded[fill[a as usize] as usize] = b;
-            fill[a as usize] += 1;
-            self.excluded[fill[b as usize] as usize] = a;
-            fill[b as usize] += 1;
+            start[springs.a[s] as usize + 1] += 1;
+            start[springs.b[s] as usize + 1] += 1;
         }
         for i in 0..n {
-            let (start, end) = (self.excluded_start[i], self.excluded_start[i + 1]);
-            self.excluded[start as usize..end as usize].sort_unstable();
+            start[i + 1] += start[i];
+        }
+        let mut near = vec![0u32; start[n] as usize];
+        let mut fill: Vec<u32> = start[..n].to_vec();
+        for &s in &joined {
+            let (a, b) = (springs.a[s], springs.b[s]);
+            near[fill[a as usize] as usize] = b;
+            fill[a as usize] += 1;
+            near[fill[b as usize] as usize] = a;
+            fill[b as usize] += 1;
+        }
+        let row = |i: usize| &near[start[i] as usize..start[i + 1] as usize];
+        // Their partners too (tagged `TWO_SPRINGS`), sorted and each once.
+        self.excluded_start.clear();
+        self.excluded_start.push(0);
+        self.excluded.clear();
+        let mut two: Vec<u32> = Vec::new();
+        for i in 0..n {
+            let one = row(i);
+            two.clear();
+            for &k in one {
+                two.extend(
+                    row(k as usize)
+                        .iter()
+                        .filter(|&&j: &&u32| j as usize != i && !one.contains(&j)),
+                );
+            }
+            two.sort_unstable();
+            two.dedup();
+            self.excluded.extend_from_slice(one);
+            self.excluded.extend(two.iter().map(|&j| j | TWO_SPRINGS));
+            self.excluded_start.push(self.excluded.len() as u32);
         }
         let structural = springs.ranges[SpringKind::Structural as usize].clone();
         let mut lengths = springs.rest_length[structural].to_vec();
@@ -223,63 +247,95 @@ impl SelfContact {
         self.built_for = Some((springs.len(), n));
     }
 
-    /// Whether `i` and `j` are joined by a spring.
-    fn excluded(&self, i: u32, j: u32) -> bool {
-        let (start, end) = (
-            self.excluded_start[i as usize],
-            self.excluded_start[i as usize + 1],
-        );
-        self.excluded[start as usize..end as usize]
-            .binary_search(&j)
-            .is_ok()
-    }
-
-    /// Sorts the particles into the hash's slots by their cell of size `cell`.
-    fn fill_hash(&mut self, x: &[Vec3], cell: f32) {
-        let slots = table_size(x.len());
+    /// Sorts the particles into the cells of a grid over their box, cells of size
+    /// `cell` or larger (at most [`CELLS_PER_PARTICLE`] cells a particle: a cloth spread
+    /// through a large box gets larger cells, more candidates and no more memory), with
+    /// each entry's position copied in entry order (the listing reads them in runs).
+    fn fill_grid(&mut self, x: &[Vec3], cell: f32) {
+        let (lo, hi) = bounds(x);
+        let most = CELLS_PER_PARTICLE * x.len().max(64);
+        self.grid = Grid::new(lo, hi, cell, most);
+        self.cell_start.clear();
+        self.cell_start.reserve(most + 1); // once: the grid never has more
+        let grid = &self.grid;
         self.cells.clear();
-        self.cells.extend(x.iter().map(|&xi| cell_of(xi, cell)));
-        self.slot_start.clear();
-        self.slot_start.resize(slots + 1, 0);
+        self.cells
+            .extend(x.iter().map(|&xi| grid.index(grid.cell(xi))));
+        self.cell_start.resize(grid.len() + 1, 0);
         for &c in &self.cells {
-            self.slot_start[slot(c, slots)] += 1;
+            self.cell_start[c as usize] += 1;
         }
         let mut total = 0;
-        for start in self.slot_start.iter_mut() {
+        for start in self.cell_start.iter_mut() {
             total += *start;
             *start = total;
         }
-        // Filled from the back, so each slot's entries end up in increasing order and
-        // `slot_start[k]` at the slot's first.
+        // Filled from the back, so each cell's entries end up in increasing order and
+        // `cell_start[k]` at the cell's first.
         self.entries.clear();
         self.entries.resize(x.len(), 0);
         for (i, &c) in self.cells.iter().enumerate().rev() {
-            let k = slot(c, slots);
-            self.slot_start[k] -= 1;
-            self.entries[self.slot_start[k] as usize] = i as u32;
+            self.cell_start[c as usize] -= 1;
+            self.entries[self.cell_start[c as usize] as usize] = i as u32;
         }
+        self.entry_x.clear();
+        self.entry_x
+            .extend(self.entries.iter().map(|&i| Vec3A::from(x[i as usize])));
     }
 
-    /// The pairs closer than `radius`, not joined by a spring and not both pinned, on
-    /// both cores from 16,384 particles (`parallel::PARALLEL_FROM`). Each particle looks in its own cell (at higher indices) and in the 13 cells after it
-    /// (all of theirs), so each pair is met once; an entry of a slot is taken only if
-    /// its cell is the one looked for (cells sharing a slot are told apart), so nothing
-    /// is met twice and no sort is needed. Deterministic: particle order, then cells.
+    /// The entries of the cells from `(x0, y, z)` to `(x1, y, z)`: one run, as a row's
+    /// cells follow one another.
+    fn row(&self, x0: i32, x1: i32, y: i32, z: i32) -> std::ops::Range<usize> {
+        let g = &self.grid;
+        let (x0, x1) = (x0.max(0), x1.min(g.size[0] - 1));
+        if y < 0 || y >= g.size[1] || z < 0 || z >= g.size[2] || x0 > x1 {
+            return 0..0;
+        }
+        let first = g.index([x0, y, z]) as usize;
+        let last = g.index([x1, y, z]) as usize;
+        self.cell_start[first] as usize..self.cell_start[last + 1] as usize
+    }
+
+    /// The pairs closer than `radius`, not rest neighbours and not both pinned, in pieces
+    /// of cells over the pool (each piece's pairs in its own list, the lists joined in
+    /// piece order: the same list on any number of threads; one fork-join a step, so
+    /// from two pieces on). Each entry looks at the later entries of its own cell and
+    /// the 13 cells after it, in five runs of consecutive cells (its cell and the next
+    /// along x; the row above; the three rows of the next layer), so each pair is met
+    /// once, with no hashing, no cell check and no sort.
     fn find_pairs(&mut self, p: &Particles, radius: f32) {
-        let n = p.len();
-        let pieces = n.div_ceil(PIECE);
+        self.pairs.clear();
+        if !self.grid.cell.is_finite() {
+            return; // a particle at infinity: nothing to list by (the step is undone)
+        }
+        // Pieces of about `LIST_PIECE` particles, cut at cell boundaries (a piece of
+        // cells would hold most of the cloth where it lies in a band of the grid).
+        let (cells, n) = (self.grid.len(), p.len());
+        let mut bounds = std::mem::take(&mut self.piece_cells);
+        bounds.clear();
+        bounds.extend((0..n.div_ceil(LIST_PIECE)).map(|k| {
+            self.cell_start
+                .partition_point(|&s| (s as usize) <= k * LIST_PIECE)
+                .saturating_sub(1)
+        }));
+        bounds.push(cells);
+        let pieces = bounds.len() - 1;
         let mut found = std::mem::take(&mut self.found);
         found.resize_with(pieces, Vec::new);
         let this = &*self;
-        // In pieces of particles over the pool (each piece's pairs in its own list, the
-        // lists joined in piece order: the same list on any number of threads).
-        parallel::for_each(n, found.iter_mut().enumerate(), |(piece, pairs)| {
+        let r2 = radius * radius;
+        let r2_folded = (radius * FOLDED / LIST_RADIUS).powi(2);
+        let work = found.iter_mut().zip(bounds.windows(2));
+        parallel::for_each_from(2 * LIST_PIECE, n, work, |(pairs, cells)| {
             pairs.clear();
-            let start = piece * PIECE;
-            for i in start..(start + PIECE).min(n) {
-                this.pairs_of(i, p, radius * radius, pairs);
-            }
+            MARK.with_borrow_mut(|mark| {
+                if mark.len() < p.len() {
+                    mark.resize(p.len(), 0);
+                }
+                this.pairs_in(cells[0]..cells[1], p, (r2, r2_folded), mark, pairs);
+            });
         });
+        self.piece_cells = bounds;
         self.pairs.clear();
         for pairs in &found {
             self.pairs.extend_from_slice(pairs);
@@ -287,27 +343,57 @@ impl SelfContact {
         self.found = found;
     }
 
-    /// Particle `i`'s pairs closer than `√r2` (see [`Self::find_pairs`]) into `pairs`.
-    fn pairs_of(&self, i: usize, p: &Particles, r2: f32, pairs: &mut Vec<[u32; 2]>) {
-        let (x, slots) = (&p.position, table_size(p.len()));
-        let c = self.cells[i];
-        for (n, o) in FORWARD.iter().enumerate() {
-            let cell = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
-            let k = slot(cell, slots);
-            let (start, end) = (self.slot_start[k], self.slot_start[k + 1]);
-            for &j in &self.entries[start as usize..end as usize] {
-                let ju = j as usize;
-                // The own cell (the first offset): each pair from its lower index.
-                if (n == 0 && ju <= i) || self.cells[ju] != cell {
-                    continue;
+    /// The pairs of the entries of `cells` (see [`Self::find_pairs`]) into `pairs`.
+    /// `mark` is all false, and is left so: a particle's rest neighbours are marked
+    /// while its candidates are looked at.
+    fn pairs_in(
+        &self,
+        cells: std::ops::Range<usize>,
+        p: &Particles,
+        (r2, r2_folded): (f32, f32),
+        mark: &mut [u8],
+        pairs: &mut Vec<[u32; 2]>,
+    ) {
+        for k in cells {
+            let (start, end) = (self.cell_start[k] as usize, self.cell_start[k + 1] as usize);
+            if start == end {
+                continue;
+            }
+            let [x, y, z] = self.grid.coords(k);
+            let own = self.row(x, x + 1, y, z);
+            let runs = [
+                self.row(x - 1, x + 1, y + 1, z),
+                self.row(x - 1, x + 1, y - 1, z + 1),
+                self.row(x - 1, x + 1, y, z + 1),
+                self.row(x - 1, x + 1, y + 1, z + 1),
+            ];
+            for a in start..end {
+                let (i, xi) = (self.entries[a] as usize, self.entry_x[a]);
+                let near = self.excluded_start[i] as usize..self.excluded_start[i + 1] as usize;
+                for &j in &self.excluded[near.clone()] {
+                    mark[(j & !TWO_SPRINGS) as usize] = if j & TWO_SPRINGS == 0 { 1 } else { 2 };
                 }
-                if x[ju].distance_squared(x[i]) >= r2 {
-                    continue;
+                let pinned = p.inv_mass[i] == 0.0;
+                for run in std::iter::once(a + 1..own.end).chain(runs.iter().cloned()) {
+                    for b in run {
+                        let l2 = self.entry_x[b].distance_squared(xi);
+                        if l2 >= r2 {
+                            continue;
+                        }
+                        let j = self.entries[b] as usize;
+                        let neighbour = match mark[j] {
+                            0 => false,
+                            1 => true,
+                            _ => l2 >= r2_folded,
+                        };
+                        let both_pinned = pinned && p.inv_mass[j] == 0.0;
+                        if !(neighbour || both_pinned) {
+                            pairs.push([i.min(j) as u32, i.max(j) as u32]);
+                        }
+                    }
                 }
-                let (a, b) = (i.min(ju) as u32, i.max(ju) as u32);
-                let pinned = p.inv_mass[i] == 0.0 && p.inv_mass[ju] == 0.0;
-                if !pinned && !self.excluded(a, b) {
-                    pairs.push([a, b]);
+                for &j in &self.excluded[near] {
+                    mark[(j & !TWO_SPRINGS) as usize] = 0;
                 }
             }
         }
@@ -315,30 +401,37 @@ impl SelfContact {
 
     /// The pairs of a particle of this cloth and one of `others` that can meet in the
     /// step: closer than `radius` plus 1.5× the other's travel relative to this cloth's
-    /// mean velocity `mean` (at most three cells away).
+    /// mean velocity `mean` (at most three times `radius`).
     fn find_cross_pairs(&mut self, x: &[Vec3], radius: f32, mean: Vec3, dt: f32) {
-        let slots = table_size(x.len());
+        let g = self.grid;
+        if !g.cell.is_finite() {
+            return;
+        }
         for (k, o) in self.others.iter().enumerate() {
             let reach = (radius + 1.5 * (o.v - mean).length() * dt).min(3.0 * radius);
-            let c = cell_of(o.x, radius);
-            let m = (reach / radius).ceil() as i32;
-            for dz in -m..=m {
-                for dy in -m..=m {
-                    for dx in -m..=m {
-                        let k2 = slot([c[0] + dx, c[1] + dy, c[2] + dz], slots);
-                        let (start, end) = (self.slot_start[k2], self.slot_start[k2 + 1]);
-                        for &i in &self.entries[start as usize..end as usize] {
-                            if x[i as usize].distance_squared(o.x) < reach * reach {
-                                self.cross.push([i, k as u32]);
-                            }
+            // The cells the reach overlaps (every particle of this cloth is in the grid's
+            // box, so the rest hold none).
+            let (lo, hi) = (g.cell(o.x - reach), g.cell(o.x + reach));
+            let outside = (0..3).any(|a| {
+                let (l, h) = (o.x[a] - reach, o.x[a] + reach);
+                h < g.lo[a] || l > g.lo[a] + g.size[a] as f32 * g.cell
+            });
+            if outside {
+                continue;
+            }
+            for z in lo[2]..=hi[2] {
+                for y in lo[1]..=hi[1] {
+                    for b in self.row(lo[0], hi[0], y, z) {
+                        let i = self.entries[b];
+                        if x[i as usize].distance_squared(o.x) < reach * reach {
+                            self.cross.push([i, k as u32]);
                         }
                     }
                 }
             }
         }
-        // Two cells may share a slot: each pair once.
+        // In this cloth's particle order.
         self.cross.sort_unstable();
-        self.cross.dedup();
     }
 
     /// One substep's self-collision (see the module doc): the clamp on each particle's
@@ -479,28 +572,25 @@ fn mean_of_free(p: &Particles, v: impl Fn(usize) -> Vec3) -> (Vec3, usize) {
 /// --sides 64 --hang swing --solvers tethers,self`), against ≤ 0.5× asked.
 const LIST_RADIUS: f32 = 2.5;
 
-/// A cell and the 13 after it (of the 26 around it, those with the first non-zero
-/// offset positive): every two neighbouring cells are met once, from the first.
-const FORWARD: [[i32; 3]; 14] = [
-    [0, 0, 0],
-    [1, 0, 0],
-    [-1, 1, 0],
-    [0, 1, 0],
-    [1, 1, 0],
-    [-1, -1, 1],
-    [0, -1, 1],
-    [1, -1, 1],
-    [-1, 0, 1],
-    [0, 0, 1],
-    [1, 0, 1],
-    [-1, 1, 1],
-    [0, 1, 1],
-    [1, 1, 1],
-];
+/// Rest neighbours two springs apart are listed once closer than this many times `d`:
+/// a crease folding on one particle (the two across it closing in to `d`), where the
+/// particles three springs apart are not yet close. On a grid they are `2 d` and
+/// `√5 d` apart while the cloth lies flat, so a flat cloth lists none of them.
+/// Without them (every pair within two springs left out) a mass-spring cloth of the stack
+/// of `assets/scenes/stack.ron` passed edges through its own triangles.
+const FOLDED: f32 = 1.75;
 
-/// The hash table's slots for `n` particles: a power of two, at least `2n`.
-fn table_size(n: usize) -> usize {
-    (2 * n).next_power_of_two()
+/// The tag of a rest neighbour two springs apart in `excluded`.
+const TWO_SPRINGS: u32 = 1 << 31;
+
+/// Particles a piece of the listing (it is one fork-join a step: smaller pieces than
+/// the substeps' kernels share two threads more evenly).
+const LIST_PIECE: usize = 512;
+
+thread_local! {
+    /// Each thread's marks of one particle's rest neighbours while its candidates are
+    /// looked at (all false between particles; grown once to the largest cloth).
+    static MARK: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// The list is made again once a particle has moved this many times `d` relative to the
@@ -508,20 +598,80 @@ fn table_size(n: usize) -> usize {
 /// `(LIST_RADIUS − 2·RELIST_AFTER)·d = 2 d` apart.
 const RELIST_AFTER: f32 = 0.25;
 
-/// The cell of size `cell` that `x` is in (float-to-int casts saturate: a far point
-/// lands in an edge cell, which only costs a candidate).
-fn cell_of(x: Vec3, cell: f32) -> [i32; 3] {
-    let c = (x / cell).floor();
-    [c.x as i32, c.y as i32, c.z as i32]
+/// The most cells the grid has a particle. A cloth lying in a plane fills about one
+/// cell in six of its box at cells of `2.5 d`; a crumpled or swinging one spreads through
+/// more, and its cells grow to stay within this (the scratch stays a few bytes a particle).
+const CELLS_PER_PARTICLE: usize = 4;
+
+/// A uniform grid over a box: cells `size` a side, of side `cell`, from `lo`, indexed
+/// x fastest (so a row of cells along x is one run of entries).
+#[derive(Clone, Copy, Debug, Default)]
+struct Grid {
+    lo: Vec3,
+    cell: f32,
+    size: [i32; 3],
 }
 
-/// The hash slot of cell `c` among `slots`, a power of two (Teschner et al. 2003's
-/// primes; a mask, not a division: this runs 27 times a particle a step).
-fn slot(c: [i32; 3], slots: usize) -> usize {
-    let h = (c[0].wrapping_mul(92_837_111))
-        ^ (c[1].wrapping_mul(689_287_499))
-        ^ (c[2].wrapping_mul(283_923_481));
-    (h as u32 as usize) & (slots - 1)
+impl Grid {
+    /// The grid over `lo..=hi` with cells of `cell` or, if that takes more than
+    /// `most` cells, the smallest larger cells that take at most that many.
+    fn new(lo: Vec3, hi: Vec3, cell: f32, most: usize) -> Self {
+        let extent = hi - lo;
+        if !(extent.is_finite() && cell.is_finite() && cell > 0.0) {
+            // Nothing to list by: one cell (a non-finite step is undone after).
+            return Self {
+                lo,
+                cell: f32::INFINITY,
+                size: [1, 1, 1],
+            };
+        }
+        let mut cell = cell;
+        loop {
+            let size = (extent / cell).floor().as_ivec3() + 1;
+            let count = size.x as f64 * size.y as f64 * size.z as f64;
+            if count <= most as f64 {
+                return Self {
+                    lo,
+                    cell,
+                    size: size.to_array(),
+                };
+            }
+            cell *= (count / most as f64).cbrt().max(1.01) as f32;
+        }
+    }
+
+    /// The cell holding `x`, clamped to the grid (every particle listed is inside it).
+    fn cell(&self, x: Vec3) -> [i32; 3] {
+        let c = ((x - self.lo) / self.cell).floor();
+        let clamp = |v: f32, n: i32| (v.max(0.0) as i32).min(n - 1);
+        [
+            clamp(c.x, self.size[0]),
+            clamp(c.y, self.size[1]),
+            clamp(c.z, self.size[2]),
+        ]
+    }
+
+    fn index(&self, [x, y, z]: [i32; 3]) -> u32 {
+        ((z * self.size[1] + y) * self.size[0] + x) as u32
+    }
+
+    fn coords(&self, k: usize) -> [i32; 3] {
+        let k = k as i32;
+        let (nx, ny) = (self.size[0], self.size[1]);
+        [k % nx, (k / nx) % ny, k / (nx * ny)]
+    }
+
+    fn len(&self) -> usize {
+        self.size.iter().map(|&n| n as usize).product()
+    }
+}
+
+/// The box around `x`.
+fn bounds(x: &[Vec3]) -> (Vec3, Vec3) {
+    x.iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        })
 }
 
 /// Cloth–cloth contact for the step about to begin (see the module doc): each cloth of
@@ -537,13 +687,7 @@ pub fn collide_cloths(cloths: &mut [(&mut super::ClothSolver, bool)]) {
         .collect();
     let boxes: Vec<(Vec3, Vec3)> = cloths
         .iter()
-        .map(|(c, _)| {
-            let x = &c.particles.position;
-            x.iter()
-                .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-                    (lo.min(p), hi.max(p))
-                })
-        })
+        .map(|(c, _)| bounds(&c.particles.position))
         .collect();
     for a in 0..cloths.len() {
         let mut others = std::mem::take(&mut cloths[a].0.self_contact.others);
