@@ -115,8 +115,20 @@ impl SceneRun {
                 let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
                 solver::collide_cloths(&mut all);
             }
+            // The cloths in contact with others step together, substep by substep; the
+            // rest alone (the plugin does the same).
+            let (mut touching, mut substeps) = (Vec::new(), Vec::new());
             for (_, cloth) in &mut self.cloths {
-                cloth.step(self.timestep, &env);
+                if cloth.touches_other_cloths() {
+                    substeps.push(cloth.begin_step(self.timestep));
+                    touching.push(cloth);
+                } else {
+                    cloth.step(self.timestep, &env);
+                }
+            }
+            solver::substep_together(&mut touching, &substeps, &env);
+            for cloth in touching {
+                cloth.end_step();
             }
             times.push(start.elapsed().as_secs_f64() * 1e3);
             each(step, &self.cloths);

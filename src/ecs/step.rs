@@ -196,15 +196,37 @@ pub(crate) fn run_substeps(
     // The solver's pool, not `Query::par_iter_mut`: on two cores Bevy gives its compute
     // pool one thread, and `par_iter_mut` then runs on the calling thread alone; a scope
     // has the calling thread work beside the pool's.
+    // Cloths in contact with other cloths step together in one task, substep by substep
+    // (`solver::substep_together`); every other cloth in its own.
+    let mut touching = Vec::new();
     let active = cloths.iter_mut(world);
     solver::task_pool().scope(|scope| {
         for (mut sim, mut progress) in active {
+            if sim.solver.touches_other_cloths() {
+                touching.push((sim, progress));
+                continue;
+            }
             scope.spawn(async move {
                 let start = Instant::now();
                 for _ in 0..progress.substeps {
                     sim.solver.substep(&env);
                 }
                 progress.elapsed += start.elapsed();
+            });
+        }
+        if !touching.is_empty() {
+            scope.spawn(async move {
+                let start = Instant::now();
+                let substeps: Vec<u32> = touching.iter().map(|(_, p)| p.substeps).collect();
+                let mut group: Vec<_> = touching.iter_mut().map(|(s, _)| &mut s.solver).collect();
+                solver::substep_together(&mut group, &substeps, &env);
+                // The group's time is shared among its cloths by their substeps.
+                let total: u32 = substeps.iter().sum::<u32>().max(1);
+                let elapsed = start.elapsed();
+                for (_, progress) in &mut touching {
+                    let share = elapsed * progress.substeps / total;
+                    progress.elapsed += share;
+                }
             });
         }
     });
@@ -248,6 +270,12 @@ fn fit_targets(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
 }
 
 fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
+    // Cloth–cloth contact keeps apart from where the other cloths are now.
+    let mut all: Vec<_> = cloths.iter_mut().map(|(sim, _)| sim).collect();
+    if all.iter().any(|sim| sim.solver.touches_other_cloths()) {
+        let mut solvers: Vec<_> = all.iter_mut().map(|sim| &mut sim.solver).collect();
+        solver::exchange_cloths(&mut solvers);
+    }
     for_each_active(&plan, &mut cloths, solver::ClothSolver::constrain);
 }
 

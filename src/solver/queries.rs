@@ -123,6 +123,13 @@ impl ClothSolver {
         self.self_contact.pushed()
     }
 
+    /// Whether other cloths' particles are near enough to meet this step (after
+    /// [`collide_cloths`](super::collide_cloths)): such cloths step together
+    /// ([`substep_together`](super::substep_together)).
+    pub fn touches_other_cloths(&self) -> bool {
+        self.self_contact.touches_others()
+    }
+
     /// Number of particles.
     pub fn particle_count(&self) -> usize {
         self.particles.len()

@@ -24,18 +24,21 @@
 //!
 //! Cloth–cloth contact is the same test between a cloth's particles and those of the
 //! other cloths near it ([`collide_cloths`]): once a step each cloth takes a copy of their
-//! particles (position, velocity, inverse mass) and keeps its own `d` from where they
-//! were when the step began. Each cloth moves only its own particle, by its share of the
-//! correction (`w_i/(w_i + w_k)`), so the two cloths' steps together make the whole
-//! correction and neither waits for the other (they step in parallel, each with its own
-//! substeps). The push adds no velocity (the other has moved since: a push against a
-//! stale position must not launch), only the approach is stopped. Tried and dropped:
-//! predicting the others along their velocity (a cloth stopped by a collider is then
-//! predicted through it, and the noisy last-substep velocities of a settling cloth made
-//! the stack of `assets/scenes/stack.ron` go non-finite); the cost of the stale positions
-//! is that two cloths falling together closer than `d` plus a step's fall hold each
-//! other back a little.
-//!
+//! particles (position, velocity, inverse mass) and lists the pairs that can meet in
+//! the step. Cloths with such a copy step together ([`substep_together`]): their
+//! substeps interleaved in time, and before each substep's constraints the copy is
+//! refreshed to where the others are then, so each keeps its `d` from where they were
+//! one substep ago. Each cloth moves only its own particle, by its share of the
+//! correction (`w_i/(w_i + w_k)`), so the two cloths' substeps together make the whole
+//! correction (a Jacobi split across the cloths; Gauss–Seidel within one). The push
+//! adds no velocity (the other has moved since: a push against a stale position must not
+//! launch), only the approach is stopped. Tried and dropped: predicting the others along
+//! their velocity (a cloth stopped by a collider is then predicted through it, and the
+//! stack of `assets/scenes/stack.ron` went non-finite); keeping the copy a whole step
+//! old (the cloths could then step apart in parallel, but that stack never came to
+//! rest: particles jittered by up to 1 m/s, each cloth pushed off where the others had
+//! been); under-relaxing the share, or a cloth taking the whole correction (no better).
+
 //! The clamp is relative to the mean motion, so a cloth falling or carried as a whole is
 //! not slowed; only its parts' motion relative to one another is bounded, to `d/2` per
 //! substep (at 13 substeps of 16 ms and `d` = 3 cm, 12 m/s).
@@ -88,6 +91,8 @@ pub(super) struct SelfContact {
     others: Vec<Other>,
     /// This step's pairs of a particle and another cloth's, `[i, k]` (`k` in `others`).
     cross: Vec<[u32; 2]>,
+    /// This cloth's place among those the last [`collide_cloths`] was given.
+    tag: Option<u32>,
 }
 
 /// A particle of another cloth, as it was when the step began.
@@ -96,6 +101,10 @@ struct Other {
     x: Vec3,
     v: Vec3,
     w: f32,
+    /// Where it comes from: its cloth's place among those given to [`collide_cloths`],
+    /// and its index there ([`exchange_cloths`] reads it again).
+    cloth: u32,
+    particle: u32,
 }
 
 impl SelfContact {
@@ -107,6 +116,11 @@ impl SelfContact {
     /// The pairs listed this step.
     pub fn pair_count(&self) -> usize {
         self.pairs.len()
+    }
+
+    /// Whether the last [`collide_cloths`] gave this cloth other cloths' particles.
+    pub fn touches_others(&self) -> bool {
+        !self.others.is_empty()
     }
 
     /// Pairs pushed apart since the step began (a pair counts once per substep).
@@ -690,6 +704,7 @@ pub fn collide_cloths(cloths: &mut [(&mut super::ClothSolver, bool)]) {
         .map(|(c, _)| bounds(&c.particles.position))
         .collect();
     for a in 0..cloths.len() {
+        cloths[a].0.self_contact.tag = Some(a as u32);
         let mut others = std::mem::take(&mut cloths[a].0.self_contact.others);
         others.clear();
         if on[a] {
@@ -708,11 +723,78 @@ pub fn collide_cloths(cloths: &mut [(&mut super::ClothSolver, bool)]) {
                             x,
                             v: p.velocity[i],
                             w: if moving { p.inv_mass[i] } else { 0.0 },
+                            cloth: b as u32,
+                            particle: i as u32,
                         });
                     }
                 }
             }
         }
         cloths[a].0.self_contact.others = others;
+    }
+}
+
+/// Refreshes every cloth's copy of the other cloths' particles ([`collide_cloths`]) to
+/// where those are now, for cloths stepped stage by stage together: each substep's
+/// cloth–cloth contact then keeps apart from where the others were one substep ago, not
+/// one step ago. `cloths` may be any of those given to [`collide_cloths`], in any order;
+/// a copy of a cloth not among them stays as it was.
+pub fn exchange_cloths(cloths: &mut [&mut super::ClothSolver]) {
+    for a in 0..cloths.len() {
+        refresh(cloths, a);
+    }
+}
+
+/// Cloth `a`'s copy of the others' particles, refreshed from those of `cloths` (matched
+/// by the place [`collide_cloths`] gave each).
+fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
+    let mut others = std::mem::take(&mut cloths[a].self_contact.others);
+    let mut from: Option<(u32, usize)> = None; // the last source found (they come in runs)
+    for o in &mut others {
+        let found = match from {
+            Some((tag, b)) if tag == o.cloth => Some(b),
+            _ => cloths
+                .iter()
+                .position(|c| c.self_contact.tag == Some(o.cloth)),
+        };
+        let Some(b) = found else { continue };
+        from = Some((o.cloth, b));
+        if let Some(&x) = cloths[b].particles.position.get(o.particle as usize) {
+            o.x = x;
+        }
+    }
+    cloths[a].self_contact.others = others;
+}
+
+/// Runs the substeps of cloths in contact with one another ([`collide_cloths`], after
+/// each one's `begin_step`, which gave its substep count: `substeps[k]`) interleaved in
+/// time: the next substep is the one that ends earliest (the lower place first on a tie),
+/// and before its constraints the cloth's copy of the others is refreshed. Cloths with
+/// the same substep count so go in lockstep. With the others one step old, as when each
+/// cloth takes its step alone, three cloths stacked on a cushion jittered by up to 1 m/s
+/// for as long as they lay there (`assets/scenes/stack.ron`); so, they come to rest.
+pub fn substep_together(
+    cloths: &mut [&mut super::ClothSolver],
+    substeps: &[u32],
+    env: &crate::params::Environment,
+) {
+    // A cloth's substeps taken this step are counted in its report.
+    let done = |c: &super::ClothSolver| c.report.taken;
+    loop {
+        // The unfinished cloth whose next substep ends first: (k + 1) / n smallest.
+        let next = (0..cloths.len())
+            .filter(|&c| done(cloths[c]) < substeps[c])
+            .min_by(|&a, &b| {
+                let ta = u64::from(done(cloths[a]) + 1) * u64::from(substeps[b]);
+                let tb = u64::from(done(cloths[b]) + 1) * u64::from(substeps[a]);
+                ta.cmp(&tb).then(a.cmp(&b))
+            });
+        let Some(c) = next else { break };
+        let cloth = &mut *cloths[c];
+        cloth.accumulate_forces(env);
+        cloth.integrate();
+        cloth.fit_targets();
+        refresh(cloths, c);
+        cloths[c].constrain();
     }
 }
