@@ -156,23 +156,32 @@ fn from_segment(x: Vec3, a: Vec3, b: Vec3) -> f32 {
     x.distance(a + (b - a) * t)
 }
 
-#[test]
-fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
+/// What a run of [`run_cape`] saw.
+struct CapeRun {
+    /// The closest any cape particle came to the body's axis, m.
+    closest: f32,
+    /// The cape's mean from the body and the body's centre, at frames 90 and 215.
+    trail: Vec<(Vec3, Vec3)>,
+    /// Frames with a cape edge through a cape triangle, and the most such edges in one.
+    crossing_frames: usize,
+    most_crossing: usize,
+}
+
+/// avian's physics running beside the cloth: a capsule body (radius 0.3, 1.6 m tall)
+/// on a half-space ground, driven by setting its velocity; a cape attached by its top
+/// edge just behind its shoulders, with self-collision on or off. It runs 1.5 s along −z
+/// at 3 m/s, stops dead for 1 s (the cape swings forward into its back), then turns to
+/// face +x over 0.2 s and runs that way for 0.8 s (the cape swings round its side).
+fn run_cape(self_collision: bool) -> CapeRun {
     use avian3d::prelude::{LinearVelocity, LockedAxes, RigidBody, Rotation};
     use bevy::prelude::*;
-    // avian's physics running beside the cloth: a capsule body (radius 0.3, 1.6 m tall)
-    // on a half-space ground, driven by setting its velocity; a cape attached by its top
-    // edge just behind its shoulders. It runs 1.5 s along −z at 3 m/s, stops dead for 1 s
-    // (the cape swings forward into its back), then turns to face +x over 0.2 s and runs
-    // that way for 0.8 s (the cape swings round its side). Every step every cape particle
-    // stays outside the body, and while running the cape trails behind it.
     let mut app = avian_app(ClothAvianPlugin::default());
     app.world_mut().spawn((
         RigidBody::Static,
         Collider::half_space(Vec3::Y),
         Transform::default(),
     ));
-    let (radius, half_length) = (0.3, 0.5);
+    let (radius, half_length) = (RADIUS, 0.5);
     let body = app
         .world_mut()
         .spawn((
@@ -184,17 +193,25 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
         ))
         .id();
     let (width, height) = (12, 14);
+    let mut params = ClothParams::default();
+    params.self_collision.enabled = self_collision;
     let cape = app
         .world_mut()
         .spawn((
-            Cloth::grid(width, height, 0.05).with_pins(ClothPins::None),
+            Cloth::grid(width, height, 0.05)
+                .with_pins(ClothPins::None)
+                .with_params(params),
             // The grid hangs from the middle of its top edge, here 2 cm behind the back.
             Transform::from_xyz(0.0, 1.25, radius + 0.02),
             ClothAttachments(vec![ClothAttachment::indices(body, (0..width).collect())]),
         ))
         .id();
-    let mut closest = f32::MAX;
-    let mut trail = Vec::new();
+    let mut run = CapeRun {
+        closest: f32::MAX,
+        trail: Vec::new(),
+        crossing_frames: 0,
+        most_crossing: 0,
+    };
     for frame in 0..220 {
         let velocity = match frame {
             0..94 => Vec3::new(0.0, 0.0, -3.0),
@@ -219,19 +236,34 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
         let up = app.world().get::<Transform>(body).unwrap().rotation * Vec3::Y;
         let (a, b) = (centre - up * half_length, centre + up * half_length);
         for &x in sim.solver.positions() {
-            closest = closest.min(from_segment(x, a, b));
+            run.closest = run.closest.min(from_segment(x, a, b));
         }
         assert!(sim.solver.is_stable(), "frame {frame}");
+        let crossing = common::edges_through_triangles(&[&sim.solver]);
+        run.crossing_frames += (crossing > 0) as usize;
+        run.most_crossing = run.most_crossing.max(crossing);
         if frame == 90 || frame == 215 {
             let mean = sim.solver.positions().iter().sum::<Vec3>() / (width * height) as f32;
-            trail.push((mean - centre, centre));
+            run.trail.push((mean - centre, centre));
         }
     }
-    eprintln!("closest particle to the body's axis: {closest} m (radius {radius}); {trail:?}");
+    run
+}
+
+/// The cape's body's radius, m.
+const RADIUS: f32 = 0.3;
+
+#[test]
+fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
+    // Every step every cape particle stays outside the body, and while running the cape
+    // trails behind it.
+    let run = run_cape(false);
+    let (closest, trail) = (run.closest, &run.trail);
+    eprintln!("closest particle to the body's axis: {closest} m (radius {RADIUS}); {trail:?}");
     assert!(
-        closest > radius,
+        closest > RADIUS,
         "a particle went {} m into the body",
-        radius - closest
+        RADIUS - closest
     );
     // Running along −z, the cape's middle is behind (+z) the body; along +x, behind (−x).
     let ((along_z, at_z), (along_x, at_x)) = (trail[0], trail[1]);
@@ -240,13 +272,32 @@ fn a_cape_on_a_running_avian_capsule_trails_behind_and_never_goes_through_it() {
         "the body ran: {at_z}, {at_x}"
     );
     assert!(
-        along_z.z > radius + 0.1,
+        along_z.z > RADIUS + 0.1,
         "running along −z: the cape at {along_z}"
     );
     assert!(
-        along_x.x < -(radius + 0.1),
+        along_x.x < -(RADIUS + 0.1),
         "running along +x: the cape at {along_x}"
     );
+}
+
+/// The same run with self-collision on (as the cape example has it): no cape edge ever
+/// passes through a cape triangle (the exact test of `tests/self_collision.rs`), and the
+/// cape still stays out of the body; with it off the cape does pass through itself.
+#[test]
+fn a_cape_with_self_collision_never_passes_through_itself() {
+    let on = run_cape(true);
+    let off = run_cape(false);
+    eprintln!(
+        "crossing frames, most edges: on {} {}, off {} {}; closest on {}",
+        on.crossing_frames, on.most_crossing, off.crossing_frames, off.most_crossing, on.closest
+    );
+    assert!(
+        off.crossing_frames > 0,
+        "without self-collision it should cross"
+    );
+    assert_eq!(on.crossing_frames, 0, "an edge through a triangle");
+    assert!(on.closest > RADIUS, "a particle went into the body");
 }
 
 #[test]
