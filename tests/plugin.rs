@@ -84,6 +84,8 @@ fn mesh_positions(app: &App, handle: &Handle<Mesh>) -> Vec<[f32; 3]> {
 #[test]
 fn mesh_is_created_and_rewritten_in_place() {
     let mut app = app();
+    // Drawn where the last step ended (see a_hidden_cloth_steps_but_writes_its_mesh_only_when_shown).
+    app.insert_resource(ClothInterpolation(false));
     let (e, handle) = spawn_small_cloth(&mut app);
     let read = |app: &App| mesh_positions(app, &handle);
     let before = read(&app);
@@ -601,6 +603,9 @@ fn a_scene_spawns_its_cloths_colliders_and_world() {
 #[test]
 fn a_hidden_cloth_steps_but_writes_its_mesh_only_when_shown() {
     let mut app = app();
+    // Drawn where the last step ended (with interpolation, at 16 ms updates and no time
+    // over, a mesh shows where the step began: the_mesh_is_drawn_between_the_last_two_steps).
+    app.insert_resource(ClothInterpolation(false));
     let (e, handle) = spawn_small_cloth(&mut app);
     let read = |app: &App| mesh_positions(app, &handle);
     app.world_mut().entity_mut(e).insert(Visibility::Hidden);
@@ -1128,6 +1133,7 @@ fn every_public_component_resource_message_and_event_is_reflected_and_registered
     );
     round_trips(&app, ClothEnvironment::default(), false);
     round_trips(&app, ClothPause::default(), false);
+    round_trips(&app, ClothInterpolation(false), false);
     round_trips(&app, bevy_cloth::ClothControls::default(), false);
     round_trips(&app, bevy_cloth::StatSample::default(), false);
     round_trips(&app, ClothWake(e), false);
@@ -1232,4 +1238,48 @@ fn observers_on_a_cloth_see_it_built_torn_asleep_woken_and_invalid() {
     let seen = app.world().resource::<Seen>();
     assert_eq!(seen.invalid.len(), 1, "{seen:?}");
     assert!(app.world().get::<ClothInvalid>(e).is_some());
+}
+
+/// The mesh is drawn between the last two fixed steps: after an update that leaves half
+/// a timestep over (8 of 16 ms), each vertex is midway between where the last step
+/// began and where it ended; with interpolation off it is where the step ended.
+#[test]
+fn the_mesh_is_drawn_between_the_last_two_steps() {
+    use bevy::time::TimeUpdateStrategy;
+    use std::time::Duration;
+    for on in [true, false] {
+        let mut app = app();
+        app.insert_resource(ClothInterpolation(on));
+        let (e, handle) = spawn_small_cloth(&mut app);
+        for _ in 0..5 {
+            app.update();
+        }
+        let positions = |app: &App| {
+            let sim = app.world().get::<ClothSimulation>(e).unwrap();
+            sim.solver.positions().to_vec()
+        };
+        let before = positions(&app);
+        app.update(); // one 16 ms step, nothing over
+        let after = positions(&app);
+        app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(8)));
+        app.update(); // no step: half a timestep over
+        assert_eq!(positions(&app), after, "an 8 ms update stepped");
+        let drawn = mesh_positions(&app, &handle);
+        let mut moved = 0.0f32;
+        for i in 0..after.len() {
+            // The cloth's frame is a translation by 2 m up.
+            let want = if on {
+                before[i].lerp(after[i], 0.5)
+            } else {
+                after[i]
+            };
+            let got = Vec3::from(drawn[i]) + Vec3::new(0.0, 2.0, 0.0);
+            assert!(
+                got.distance(want) < 1e-5,
+                "interpolation {on}: vertex {i} drawn at {got}, not {want}"
+            );
+            moved = moved.max(before[i].distance(after[i]));
+        }
+        assert!(moved > 1e-3, "the cloth moved in that step: {moved} m");
+    }
 }

@@ -154,6 +154,12 @@ pub struct ClothSimulation {
     pub(crate) colliders_from: Vec<u32>,
     /// Wall-clock time of the last fixed step, in ms.
     pub last_step_ms: f32,
+    /// The positions when the last fixed step began, and whether that step moved the
+    /// cloth: the mesh is then drawn between them and the positions now
+    /// ([`ClothInterpolation`]).
+    #[reflect(ignore)]
+    pub(crate) previous: Vec<Vec3>,
+    pub(crate) blending: bool,
 }
 
 impl ClothSimulation {
@@ -167,6 +173,8 @@ impl ClothSimulation {
             layers: Layers::DEFAULT,
             colliders_from: Vec::new(),
             last_step_ms: 0.0,
+            previous: Vec::new(),
+            blending: false,
         }
     }
 
@@ -174,6 +182,36 @@ impl ClothSimulation {
     pub fn reset(&mut self) {
         self.solver.reset();
         self.mesh_dirty = true;
+        self.blending = false;
+    }
+
+    /// Notes where the cloth is as a fixed step begins (`steps`: whether it steps), for
+    /// drawing between that step's start and end.
+    pub(crate) fn note_step(&mut self, steps: bool) {
+        // A cloth that stops stepping is drawn once more, where it is.
+        self.mesh_dirty |= self.blending && !steps;
+        self.blending = steps;
+        if steps {
+            self.previous.clear();
+            self.previous.extend_from_slice(self.solver.positions());
+        }
+    }
+}
+
+/// Whether cloth meshes are drawn between the last two fixed steps (as avian's
+/// `TransformInterpolation` draws bodies): each frame the mesh shows the positions a
+/// fraction `Time<Fixed>::overstep_fraction()` of the way from where the last step began
+/// to where it ended, so a cloth and the bodies it hangs from are drawn at the same
+/// instant. On by default when the cloths step in a fixed schedule (the default,
+/// `FixedPostUpdate`); off when they step in another schedule, where `Time<Fixed>` says
+/// nothing of their steps. Off, the mesh shows where the last step left the cloth.
+#[derive(Resource, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Resource, Debug, PartialEq)]
+pub struct ClothInterpolation(pub bool);
+
+impl Default for ClothInterpolation {
+    fn default() -> Self {
+        Self(true)
     }
 }
 

@@ -3,9 +3,9 @@
 use bevy::asset::RenderAssetUsages;
 use bevy::math::Vec3;
 use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
-use bevy::prelude::{Assets, Mesh3d, Query, ResMut, Visibility};
+use bevy::prelude::{Assets, Fixed, Mesh3d, Query, Res, ResMut, Time, Visibility};
 
-use crate::ecs::cloth::ClothSimulation;
+use crate::ecs::cloth::{ClothInterpolation, ClothSimulation};
 
 use crate::error::ClothError;
 use crate::solver;
@@ -47,19 +47,36 @@ pub fn write_mesh(
     normals: &mut [Vec3],
     faces_changed: bool,
 ) {
-    let to_local = cloth.frame().inverse();
     cloth.normals_into(normals);
+    write_blended(mesh, cloth, normals, faces_changed, None);
+}
+
+/// [`write_mesh`] with the normals given, the positions drawn a fraction `t` of the way
+/// from `from` (the positions when the last step began) to the cloth's now, when
+/// `blend` is `Some((from, t))`.
+fn write_blended(
+    mesh: &mut Mesh,
+    cloth: &solver::ClothSolver,
+    normals: &[Vec3],
+    faces_changed: bool,
+    blend: Option<(&[Vec3], f32)>,
+) {
+    let to_local = cloth.frame().inverse();
     if let Some(VertexAttributeValues::Float32x3(out)) =
         mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
     {
         let x = cloth.positions();
-        solver::for_each_indexed(out, |i, o| {
-            *o = to_local.transform_point3(x[i]).to_array();
-        });
+        match blend.filter(|(from, _)| from.len() == x.len()) {
+            Some((from, t)) => solver::for_each_indexed(out, |i, o| {
+                *o = to_local.transform_point3(from[i].lerp(x[i], t)).to_array();
+            }),
+            None => solver::for_each_indexed(out, |i, o| {
+                *o = to_local.transform_point3(x[i]).to_array();
+            }),
+        }
     }
     if let Some(VertexAttributeValues::Float32x3(out)) = mesh.attribute_mut(Mesh::ATTRIBUTE_NORMAL)
     {
-        let normals = &*normals;
         solver::for_each_indexed(out, |i, o| {
             *o = to_local
                 .transform_vector3(normals[i])
@@ -147,12 +164,21 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
 /// Bevy's visibility systems run; and not for frustum culling: Bevy takes a mesh's
 /// bounding box from what was written, so an unwritten cloth that swings into view
 /// would stay culled.)
+///
+/// With [`ClothInterpolation`] on, a cloth that moved in its last step is written every
+/// frame, between where that step began and where it ended (its normals are the step's
+/// end's, computed once a step).
 pub(crate) fn write_meshes(
     mut meshes: ResMut<Assets<Mesh>>,
+    interpolation: Option<Res<ClothInterpolation>>,
+    fixed: Res<Time<Fixed>>,
     mut cloths: Query<(&mut ClothSimulation, &Mesh3d, Option<&Visibility>)>,
 ) {
+    let blend = interpolation.is_some_and(|i| i.0);
+    let t = fixed.overstep_fraction().clamp(0.0, 1.0);
     for (mut sim, mesh3d, visibility) in &mut cloths {
-        if !sim.mesh_dirty || visibility == Some(&Visibility::Hidden) {
+        let blending = blend && sim.blending;
+        if !(sim.mesh_dirty || blending) || visibility == Some(&Visibility::Hidden) {
             continue;
         }
         let Some(mut mesh) = meshes.get_mut(&mesh3d.0) else {
@@ -160,7 +186,11 @@ pub(crate) fn write_meshes(
         };
         let sim = &mut *sim;
         let faces_changed = sim.solver.take_faces_changed();
-        write_mesh(&mut mesh, &sim.solver, &mut sim.normals, faces_changed);
+        if sim.mesh_dirty {
+            sim.solver.normals_into(&mut sim.normals);
+        }
+        let from = blending.then_some((sim.previous.as_slice(), t));
+        write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from);
         sim.mesh_dirty = false;
     }
 }

@@ -19,7 +19,9 @@ pub(crate) mod stats;
 pub(crate) mod step;
 
 pub use attach::{AttachParticles, ClothAttachment, ClothAttachments};
-pub use cloth::{Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation};
+pub use cloth::{
+    Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
+};
 pub use colliders::{ClothCollider, ColliderKind, TELEPORT_SPEED};
 pub use controls::{ClothControls, ClothControlsPlugin};
 pub use events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};

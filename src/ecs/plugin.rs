@@ -13,7 +13,8 @@
 //! ClothSystems::Finish       end each step: tearing, sleep, statistics, events
 //! ```
 //! and in `PostUpdate`, once per frame after the fixed loop, `ClothSystems::WriteMesh`
-//! writes positions and normals into each cloth's mesh buffers in place.
+//! writes positions and normals into each cloth's mesh buffers in place, drawn between
+//! the last two fixed steps by `Time<Fixed>`'s overstep ([`ClothInterpolation`]).
 //!
 //! A substep schedule (as avian's `SubstepSchedule`) makes each phase a real system set
 //! that runs every substep, so a game can add its own forces in a system ordered
@@ -29,7 +30,9 @@ use bevy::prelude::*;
 
 use crate::ecs::attach::{AttachParticles, ClothAttachment, ClothAttachments, attach_cloths};
 use crate::ecs::build::{build_cloths, watch_garments};
-use crate::ecs::cloth::{Cloth, ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation};
+use crate::ecs::cloth::{
+    Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
+};
 use crate::ecs::colliders::{
     ClothCollider, ColliderKind, PlacedColliders, give_colliders, place_colliders,
 };
@@ -120,6 +123,15 @@ impl Plugin for ClothPlugin {
             app.insert_resource(Time::<Fixed>::from_duration(step));
         }
         app.insert_resource(ClothSchedule(self.schedule));
+        // Drawn between fixed steps only when the steps are fixed ones.
+        let fixed = [
+            FixedFirst.intern(),
+            FixedPreUpdate.intern(),
+            FixedUpdate.intern(),
+            FixedPostUpdate.intern(),
+            FixedLast.intern(),
+        ];
+        app.insert_resource(ClothInterpolation(fixed.contains(&self.schedule)));
         register_types(app);
         // Every cloth can sleep (a game turns it off per cloth with `ClothSleep::never()`).
         app.register_required_components::<Cloth, ClothSleep>();
@@ -203,6 +215,7 @@ fn register_types(app: &mut App) {
         .register_type::<WindField>()
         .register_type::<ClothEnvironment>()
         .register_type::<ClothPause>()
+        .register_type::<ClothInterpolation>()
         .register_type::<ClothSleep>()
         .register_type::<ClothLod>()
         .register_type::<ClothSimulation>()

@@ -143,11 +143,9 @@ pub(crate) fn begin_steps(
     for (entity, mut sim, progress, sleep) in &mut cloths {
         let start = Instant::now();
         let awake = sleep.is_none_or(|s| !s.asleep);
-        let substeps = if run && awake {
-            sim.solver.begin_step(dt)
-        } else {
-            0
-        };
+        let steps = run && awake;
+        sim.note_step(steps);
+        let substeps = if steps { sim.solver.begin_step(dt) } else { 0 };
         let progress_now = StepProgress {
             substeps,
             elapsed: start.elapsed(),
