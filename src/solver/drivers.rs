@@ -1,7 +1,9 @@
 //! Kinematic drivers: what moves particles by prescription rather than by force. Pins
 //! follow the cloth's frame and a grabbed particle follows its tool, both over the
 //! substeps of a step; seams shorten from their starting gap to their rest length over
-//! the sewing time (seed 002 §1.4).
+//! the sewing time (seed 002 §1.4); motion constraints keep particles within a distance
+//! of targets that move (NvCloth's motion constraints, Unreal's painted max distance: a
+//! skirt on a walking body).
 
 use bevy::math::{Affine3A, Vec3};
 
@@ -24,6 +26,48 @@ pub(super) struct Drivers {
     /// The frame (local → world) the pins follow.
     pub frame: Affine3A,
     pub grab: Option<Grab>,
+    /// Motion constraints (empty: none).
+    pub motion: Motion,
+}
+
+/// Motion constraints: each particle with a finite `radius` kept within it of its
+/// target, which goes from `from` to `to` over the step as pins do. A radius of 0 makes
+/// the particle an attached pin instead (exactly at its target); `f32::INFINITY`, free.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Motion {
+    pub from: Vec<Vec3>,
+    pub to: Vec<Vec3>,
+    pub radius: Vec<f32>,
+    /// The targets given for the next step.
+    pub next: Vec<Vec3>,
+}
+
+impl Motion {
+    /// Starts a step: the targets go from where the last step's ended to those given.
+    fn begin_step(&mut self) {
+        if self.next.len() != self.to.len() {
+            self.to.clone_from(&self.next);
+        }
+        std::mem::swap(&mut self.from, &mut self.to);
+        self.to.clone_from(&self.next);
+    }
+
+    /// Pulls each constrained free particle back within its radius of where its target
+    /// is a fraction `t` through the step, with the velocity that leaves it there.
+    pub fn hold(&self, p: &mut Particles, t: f32, h: f32) {
+        for (i, &r) in self.radius.iter().enumerate() {
+            if !r.is_finite() || p.inv_mass[i] == 0.0 {
+                continue;
+            }
+            let centre = self.from[i].lerp(self.to[i], t);
+            let off = p.position[i] - centre;
+            let l2 = off.length_squared();
+            if l2 > r * r {
+                p.position[i] = centre + off * (r / l2.sqrt());
+                p.velocity[i] = (p.position[i] - p.previous[i]) / h;
+            }
+        }
+    }
 }
 
 impl Drivers {
@@ -37,6 +81,7 @@ impl Drivers {
             pins: pins.to_vec(),
             frame,
             grab: None,
+            motion: Motion::default(),
         }
     }
 
@@ -66,6 +111,9 @@ impl Drivers {
         }
         if let Some(g) = &mut self.grab {
             g.from = x[g.particle as usize];
+        }
+        if !self.motion.radius.is_empty() {
+            self.motion.begin_step();
         }
     }
 
@@ -140,6 +188,65 @@ impl ClothSolver {
         }
         self.disturbed = true;
         true
+    }
+
+    /// Motion constraints for the next step and on (NvCloth's motion constraints, a
+    /// painted "max distance"): particle `i` is kept within `max_distance[i]` m of
+    /// `targets[i]` (world points, such as where the character's skinning puts the
+    /// vertex), the targets moving from the last step's to these over the step's
+    /// substeps. A distance of 0 attaches the particle to its target
+    /// ([`ClothSolver::attach`]: exactly there at the step's end); `f32::INFINITY` leaves
+    /// it free. Each substep they act after self-collision and before contact, so a
+    /// collider between a particle and its target wins (a leg pushes a skirt out farther
+    /// than its distance rather than through the leg). Call it before each step with the
+    /// targets for that step's end; both slices have one entry per particle.
+    pub fn set_motion_constraints(
+        &mut self,
+        targets: &[Vec3],
+        max_distance: &[f32],
+    ) -> Result<(), ClothError> {
+        let n = self.particles.len();
+        if targets.len() != n || max_distance.len() != n {
+            return Err(ClothError::InvalidParameter {
+                field: "motion constraints",
+                value: targets.len().max(max_distance.len()) as f32,
+                expected: "one target and one distance per particle",
+            });
+        }
+        if let Some(&r) = max_distance.iter().find(|r| r.is_nan() || **r < 0.0) {
+            return Err(ClothError::InvalidParameter {
+                field: "motion constraint distance",
+                value: r,
+                expected: "a distance ≥ 0 m (f32::INFINITY: free)",
+            });
+        }
+        let was = std::mem::take(&mut self.drivers.motion.radius);
+        for (i, (&r, &target)) in max_distance.iter().zip(targets).enumerate() {
+            if r == 0.0 {
+                self.attach(i as u32, target)?;
+            } else if was.get(i) == Some(&0.0) {
+                self.detach(i as u32);
+            }
+        }
+        let motion = &mut self.drivers.motion;
+        motion.radius = was;
+        motion.radius.clear();
+        motion.radius.extend_from_slice(max_distance);
+        motion.next.clear();
+        motion.next.extend_from_slice(targets);
+        self.disturbed = true;
+        Ok(())
+    }
+
+    /// Drops the motion constraints; the particles they attached are let go.
+    pub fn clear_motion_constraints(&mut self) {
+        let radius = std::mem::take(&mut self.drivers.motion.radius);
+        for (i, &r) in radius.iter().enumerate() {
+            if r == 0.0 {
+                self.detach(i as u32);
+            }
+        }
+        self.drivers.motion = Motion::default();
     }
 
     /// The particles held from outside ([`ClothSolver::attach`]), in order.

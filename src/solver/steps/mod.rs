@@ -311,6 +311,7 @@ impl ClothSolver {
         let constrained = Instant::now();
         self.self_contact.resolve(&mut self.particles, h);
         let separated = Instant::now();
+        self.drivers.motion.hold(&mut self.particles, t, h);
         let tau = self.clock.left_after_substep();
         self.contact.resolve(&mut self.particles, tau, h);
         self.contact
