@@ -185,6 +185,7 @@ pub fn headless_app_in(assets: impl Into<String>) -> App {
         ClothPlugin::default().with_timestep(Duration::from_millis(16)),
     ))
     .init_asset::<Mesh>()
+    .init_asset::<bevy::mesh::skinning::SkinnedMeshInverseBindposes>()
     .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
         16,
     )));

@@ -113,3 +113,231 @@ fn motion_constraints_cleared_let_the_cloth_go() {
         "no negative distance"
     );
 }
+
+// ----- a cloth built from a skinned mesh, in the plugin ------------------------------
+
+use bevy::asset::RenderAssetUsages;
+use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
+use bevy::mesh::{Indices, Mesh, Mesh3d, PrimitiveTopology, VertexAttributeValues};
+use bevy::prelude::*;
+use bevy_cloth::ATTRIBUTE_MAX_DISTANCE;
+
+/// Columns and rows of the skinned panel's vertices, 4 cm apart.
+const COLUMNS: u32 = 6;
+const ROWS: u32 = 9;
+const STEP: f32 = 0.04;
+
+/// A hanging panel (a skirt's front, 20 × 32 cm) skinned to two joints: the hip (its
+/// top rows) and the knee, 16 cm down (its lower rows, blending in over the middle).
+/// Max distances painted 0 on the top row, growing 1.5 cm a row below.
+fn skinned_panel() -> Mesh {
+    let mut positions = Vec::new();
+    let (mut joints, mut weights, mut distances) = (Vec::new(), Vec::new(), Vec::new());
+    for j in 0..ROWS {
+        for i in 0..COLUMNS {
+            positions.push([(i as f32 - 2.5) * STEP, -(j as f32) * STEP, 0.1]);
+            let knee = ((j as f32 - 2.0) / 4.0).clamp(0.0, 1.0);
+            joints.push([0u16, 1, 0, 0]);
+            weights.push([1.0 - knee, knee, 0.0, 0.0]);
+            distances.push(0.015 * j as f32);
+        }
+    }
+    let mut indices = Vec::new();
+    for j in 0..ROWS - 1 {
+        for i in 0..COLUMNS - 1 {
+            let a = j * COLUMNS + i;
+            indices.extend([a, a + COLUMNS, a + 1, a + 1, a + COLUMNS, a + COLUMNS + 1]);
+        }
+    }
+    Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+    .with_inserted_attribute(
+        Mesh::ATTRIBUTE_JOINT_INDEX,
+        VertexAttributeValues::Uint16x4(joints),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT, weights)
+    .with_inserted_attribute(ATTRIBUTE_MAX_DISTANCE, distances)
+    .with_inserted_indices(Indices::U32(indices))
+}
+
+/// Where Bevy's skinning puts mesh-space `v` (its shader's linear blend).
+fn skinned(app: &App, skin: &SkinnedMesh, v: Vec3, joints: [u16; 4], weights: [f32; 4]) -> Vec3 {
+    let inverse = app
+        .world()
+        .resource::<Assets<SkinnedMeshInverseBindposes>>()
+        .get(&skin.inverse_bindposes)
+        .unwrap();
+    // The joints' global transforms, from their transforms (the headless app has no
+    // transform propagation): the hip's, and the knee's as the hip's child.
+    let local = |e: Entity| app.world().get::<Transform>(e).unwrap().compute_affine();
+    let globals = [
+        local(skin.joints[0]),
+        local(skin.joints[0]) * local(skin.joints[1]),
+    ];
+    (0..4)
+        .map(|k| {
+            let global = globals[joints[k] as usize];
+            (global * Affine3A::from_mat4(inverse[joints[k] as usize])).transform_point3(v)
+                * weights[k]
+        })
+        .sum()
+}
+
+/// A skirt panel on a hip that walks (1.2 m/s) and a knee that swings (±40° at 1 Hz):
+/// every frame each particle of distance 0 is where Bevy's skinning puts its vertex to
+/// 1e-5 m, and none is farther than its painted distance (+1e-5 m); the skin is taken off
+/// the entity (drawn as simulated) and the lower rows move within their distances.
+#[test]
+fn a_cloth_made_of_a_skinned_mesh_follows_its_bones_within_its_painted_distances() {
+    let mut app = bevy_cloth::headless::headless_app();
+    let hip_rest = Transform::from_xyz(0.0, 1.0, 0.0);
+    let knee_rest = Transform::from_xyz(0.0, -0.16, 0.0);
+    let hip = app.world_mut().spawn(hip_rest).id();
+    let knee = app.world_mut().spawn((knee_rest, ChildOf(hip))).id();
+    // Bind pose: the joints' global transforms as the mesh was made.
+    let inverse = vec![
+        hip_rest.to_matrix().inverse(),
+        (hip_rest.to_matrix() * knee_rest.to_matrix()).inverse(),
+    ];
+    let bindposes = app
+        .world_mut()
+        .resource_mut::<Assets<SkinnedMeshInverseBindposes>>()
+        .add(SkinnedMeshInverseBindposes::from(inverse));
+    let mesh = skinned_panel();
+    let rest: Vec<Vec3> = match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
+        Some(VertexAttributeValues::Float32x3(p)) => p.iter().map(|&p| Vec3::from(p)).collect(),
+        _ => unreachable!(),
+    };
+    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(mesh);
+    let skin = SkinnedMesh {
+        inverse_bindposes: bindposes,
+        joints: vec![hip, knee],
+    };
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Mesh3d(handle),
+            skin.clone(),
+            Cloth::from_mesh().with_pins(ClothPins::None),
+        ))
+        .id();
+    let (mut pinned_off, mut over, mut swing) = (0.0f32, f32::MIN, 0.0f32);
+    for frame in 0..150 {
+        let t = frame as f32 / 60.0;
+        let mut hip_now = hip_rest;
+        hip_now.translation.x += 1.2 * t;
+        *app.world_mut().get_mut::<Transform>(hip).unwrap() = hip_now;
+        let mut knee_now = knee_rest;
+        knee_now.rotation = Quat::from_rotation_x(0.7 * (std::f32::consts::TAU * t).sin());
+        *app.world_mut().get_mut::<Transform>(knee).unwrap() = knee_now;
+        app.update();
+        let Some(sim) = app.world().get::<ClothSimulation>(cloth) else {
+            continue;
+        };
+        assert!(
+            app.world().get::<SkinnedMesh>(cloth).is_none(),
+            "the skin comes off"
+        );
+        let x = sim.solver.positions();
+        assert_eq!(x.len(), rest.len());
+        for (k, &v) in rest.iter().enumerate() {
+            let j = k as u32 / COLUMNS;
+            let knee_weight = ((j as f32 - 2.0) / 4.0).clamp(0.0, 1.0);
+            let target = skinned(
+                &app,
+                &skin,
+                v,
+                [0, 1, 0, 0],
+                [1.0 - knee_weight, knee_weight, 0.0, 0.0],
+            );
+            let off = x[k].distance(target);
+            let distance = 0.015 * j as f32;
+            if j == 0 {
+                pinned_off = pinned_off.max(off);
+            } else {
+                over = over.max(off - distance);
+                swing = swing.max(off / distance);
+            }
+        }
+    }
+    eprintln!("distance 0: {pinned_off} m off; others: {over} m over, {swing} of their distance");
+    assert!(
+        pinned_off <= 1e-5,
+        "the waist is {pinned_off} m off its skin"
+    );
+    assert!(over <= 1e-5, "a particle went {over} m past its distance");
+    assert!(
+        swing > 0.3,
+        "the lower rows move within their distances: {swing}"
+    );
+}
+
+/// Pins given as a mesh's own vertex indices pin the particles those vertices were welded
+/// into: a 3 × 3 quad mesh split along its middle column (a UV seam: the column's three
+/// vertices twice, 12 vertices for 9 particles), pinned by two of the seam's second
+/// copies (vertices 9 and 11), holds the welded top-middle and bottom-middle particles.
+#[test]
+fn mesh_vertex_indices_pin_the_welded_particles() {
+    // Left half: columns 0 and 1 (vertices 0..6, row-major 2 a row); right half: columns
+    // 1 and 2 (vertices 6..12), column 1 again.
+    let mut positions = Vec::new();
+    for half in 0..2 {
+        for row in 0..3 {
+            for c in 0..2 {
+                positions.push([(half + c) as f32 * 0.1, -(row as f32) * 0.1, 0.0]);
+            }
+        }
+    }
+    let mut indices = Vec::new();
+    for half in 0..2u32 {
+        let base = half * 6;
+        for row in 0..2u32 {
+            let a = base + row * 2;
+            indices.extend([a, a + 2, a + 1, a + 1, a + 2, a + 3]);
+        }
+    }
+    let mesh = Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions.clone())
+    .with_inserted_indices(Indices::U32(indices));
+    let mut app = bevy_cloth::headless::headless_app();
+    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(mesh);
+    // Vertex 6 is the right half's top-left (the seam's top), 10 its bottom-left.
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Mesh3d(handle.clone()),
+            Cloth::from_mesh().with_pins(ClothPins::Indices(vec![6, 10])),
+        ))
+        .id();
+    for _ in 0..30 {
+        app.update();
+    }
+    let sim = app.world().get::<ClothSimulation>(cloth).expect("built");
+    let x = sim.solver.positions();
+    assert_eq!(x.len(), 9, "the seam is welded");
+    let pinned: Vec<Vec3> = sim.solver.pins().iter().map(|&i| x[i as usize]).collect();
+    assert_eq!(pinned.len(), 2);
+    for (want, got) in [positions[6], positions[10]].iter().zip(&pinned) {
+        assert!(
+            got.distance(Vec3::from(*want)) < 1e-5,
+            "pinned {got}, not at {want:?}"
+        );
+    }
+    // A vertex index past the mesh's 12 vertices is refused, naming the index.
+    let bad = app
+        .world_mut()
+        .spawn((
+            Mesh3d(handle),
+            Cloth::from_mesh().with_pins(ClothPins::Indices(vec![12])),
+        ))
+        .id();
+    app.update();
+    let invalid = app.world().get::<ClothInvalid>(bad).expect("refused");
+    assert!(invalid.0.to_string().contains("12"), "{}", invalid.0);
+}

@@ -1134,6 +1134,14 @@ fn every_public_component_resource_message_and_event_is_reflected_and_registered
     round_trips(&app, ClothEnvironment::default(), false);
     round_trips(&app, ClothPause::default(), false);
     round_trips(&app, ClothInterpolation(false), false);
+    round_trips(
+        &app,
+        ClothMaxDistance::VertexColor {
+            channel: 0,
+            scale: 0.2,
+        },
+        true,
+    );
     round_trips(&app, bevy_cloth::ClothControls::default(), false);
     round_trips(&app, bevy_cloth::StatSample::default(), false);
     round_trips(&app, ClothWake(e), false);

@@ -8,10 +8,13 @@ use bevy::transform::helper::TransformHelper;
 
 use crate::ecs::cloth::{Cloth, ClothInvalid, ClothSimulation, pause_invalid};
 use crate::ecs::events::ClothBuilt;
-use crate::ecs::mesh::{MeshSource, cloth_mesh, mesh_triangles};
+use bevy::mesh::skinning::SkinnedMesh;
+
+use crate::ecs::mesh::{cloth_mesh, mesh_triangles};
+use crate::ecs::skin::{ClothBody, ClothMaxDistance};
 use crate::error::ClothError;
 use crate::layout::garment::Garment;
-use crate::layout::shape::ClothShape;
+use crate::layout::shape::{ClothPins, ClothShape};
 use crate::params::ClothParams;
 use crate::solver::{self, Layout};
 
@@ -23,14 +26,26 @@ enum LayoutSource<'a> {
     Garment(Option<&'a Garment>),
 }
 
+/// What a mesh-shaped cloth may follow: the entity's skin (or the one taken off it at
+/// the last build) and where its maximum distances come from.
+#[derive(Clone, Copy, Default)]
+struct BodySource<'a> {
+    skin: Option<&'a SkinnedMesh>,
+    max: Option<&'a ClothMaxDistance>,
+}
+
+/// A built cloth: its solver, its mesh, and for a mesh-shaped cloth its body.
+type Built = (solver::ClothSolver, Mesh, Option<ClothBody>);
+
 /// Builds a cloth's solver and mesh. `Ok(None)`: its mesh or garment is not loaded yet.
 fn build_one(
     cloth: &Cloth,
     frame: bevy::math::Affine3A,
     source: LayoutSource,
-) -> Result<Option<(solver::ClothSolver, Mesh)>, ClothError> {
+    body: BodySource,
+) -> Result<Option<Built>, ClothError> {
     cloth.validate()?;
-    let (solver, uvs) = match (&cloth.shape, source) {
+    let (solver, uvs, body) = match (&cloth.shape, source) {
         (ClothShape::Garment { resolution, .. }, LayoutSource::Garment(garment)) => {
             let Some(garment) = garment else {
                 return Ok(None);
@@ -38,31 +53,55 @@ fn build_one(
             (
                 cloth.build_garment(garment.layout(*resolution)?, frame)?,
                 None,
+                None,
             )
         }
         (ClothShape::Mesh, LayoutSource::Mesh(mesh)) => {
             let Some(mesh) = mesh else {
                 return Ok(None);
             };
-            let MeshSource {
-                positions,
-                triangles,
-                uvs,
-            } = mesh_triangles(mesh)?;
-            let layout = Layout::from_mesh(&positions, &triangles)?;
-            let pins = cloth.pins.resolve_for(&layout)?;
-            let solver = solver::ClothSolver::new(layout, &pins, &cloth.params, frame)?;
-            (solver, uvs)
+            let source = mesh_triangles(mesh)?;
+            let layout = Layout::from_mesh(&source.positions, &source.triangles)?;
+            let pins = match &cloth.pins {
+                // The mesh's own vertex indices, each to the particle it was welded into.
+                ClothPins::Indices(vertices) => {
+                    let count = source.particle_of.len();
+                    let mut pins = vertices
+                        .iter()
+                        .map(|&v| {
+                            source
+                                .particle_of
+                                .get(v as usize)
+                                .copied()
+                                .ok_or(ClothError::PinOutOfRange { index: v, count })
+                        })
+                        .collect::<Result<Vec<u32>, _>>()?;
+                    pins.sort_unstable();
+                    pins.dedup();
+                    pins
+                }
+                pins => pins.resolve_for(&layout)?,
+            };
+            let body = ClothBody::read(mesh, &source, body.skin, body.max, &pins)?;
+            // A skinned cloth's pins follow its skin (distance 0), not the entity's frame.
+            let frame_pins = if body.as_ref().is_some_and(|b| b.skin.is_some()) {
+                Vec::new()
+            } else {
+                pins
+            };
+            let solver = solver::ClothSolver::new(layout, &frame_pins, &cloth.params, frame)?;
+            (solver, source.uvs, body)
         }
         _ => (
             cloth
                 .shape
                 .build_solver(&cloth.pins, &cloth.params, frame)?,
             None,
+            None,
         ),
     };
     let mesh = cloth_mesh(&solver, uvs);
-    Ok(Some((solver, mesh)))
+    Ok(Some((solver, mesh, body)))
 }
 
 /// Remembers the mesh a mesh-shaped cloth was made from (its `Mesh3d` is replaced by the
@@ -160,9 +199,16 @@ pub(crate) fn build_cloths(
         Option<&ClothSourceMesh>,
         Option<&mut ClothGarment>,
         Has<ClothInvalid>,
+        (
+            Option<&SkinnedMesh>,
+            Option<&ClothBody>,
+            Option<Ref<ClothMaxDistance>>,
+        ),
     )>,
 ) {
-    for (entity, cloth, sim, mesh3d, source, garment, invalid) in &mut cloths {
+    for (entity, cloth, sim, mesh3d, source, garment, invalid, (skin, body, max)) in &mut cloths {
+        // A changed max distance rebuilds, as a changed shape does.
+        let repainted = max.as_ref().is_some_and(|m| m.is_changed());
         let frame = transforms
             .compute_global_transform(entity)
             .map(|g| g.affine())
@@ -173,10 +219,11 @@ pub(crate) fn build_cloths(
             .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed));
         if let Some(mut sim) = sim {
             sim.solver.set_frame(frame);
-            if !cloth.is_changed() && !reload {
+            if !cloth.is_changed() && !reload && !repainted {
                 continue;
             }
-            if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !reload {
+            if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !reload && !repainted
+            {
                 apply_params(&mut commands, entity, &mut sim, &cloth.params, invalid);
                 continue;
             }
@@ -208,8 +255,13 @@ pub(crate) fn build_cloths(
             }
             ClothShape::Grid { .. } => LayoutSource::Description,
         };
-        match build_one(&cloth, frame, layout_source) {
-            Ok(Some((solver, mesh))) => {
+        let body_source = BodySource {
+            // The entity's skin, or the one taken off it when it was last built.
+            skin: skin.or(body.and_then(|b| b.skin.as_ref().map(|s| &s.mesh))),
+            max: max.as_deref(),
+        };
+        match build_one(&cloth, frame, layout_source, body_source) {
+            Ok(Some((solver, mesh, body))) => {
                 let sim = ClothSimulation::new(solver, &cloth);
                 let handle = meshes.add(mesh);
                 let mut entity_commands = commands.entity(entity);
@@ -219,6 +271,11 @@ pub(crate) fn build_cloths(
                 if let Some(source_handle) = source_handle {
                     entity_commands.insert(ClothSourceMesh(source_handle));
                 }
+                match body {
+                    // Drawn as simulated: the skin comes off the entity.
+                    Some(body) => entity_commands.insert(body).remove::<SkinnedMesh>(),
+                    None => entity_commands.remove::<ClothBody>(),
+                };
                 commands.trigger(ClothBuilt { entity });
             }
             Ok(None) => {}

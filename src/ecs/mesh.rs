@@ -106,6 +106,10 @@ pub struct MeshSource {
     pub triangles: Vec<[u32; 3]>,
     /// UVs, when the mesh has them.
     pub uvs: Option<Vec<[f32; 2]>>,
+    /// Each vertex of the mesh's particle (coincident vertices share one).
+    pub particle_of: Vec<u32>,
+    /// Each particle's first vertex (whose attributes it takes).
+    pub first_vertex: Vec<u32>,
 }
 
 /// Reads a triangle-list mesh's positions, triangles and UVs, for a mesh-shaped cloth.
@@ -141,13 +145,13 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
         .map(|t| [t[0], t[1], t[2]].map(|v| welded.particle_of[v as usize]))
         .filter(|t: &[u32; 3]| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
         .collect();
+    let mut first_vertex = vec![0u32; welded.positions.len()];
+    for (v, &k) in welded.particle_of.iter().enumerate().rev() {
+        first_vertex[k as usize] = v as u32;
+    }
     let uvs = match mesh.attribute(Mesh::ATTRIBUTE_UV_0) {
         Some(VertexAttributeValues::Float32x2(uv)) if uv.len() == positions.len() => {
-            let mut out = vec![[0.0; 2]; welded.positions.len()];
-            for (v, &k) in welded.particle_of.iter().enumerate().rev() {
-                out[k as usize] = uv[v];
-            }
-            Some(out)
+            Some(first_vertex.iter().map(|&v| uv[v as usize]).collect())
         }
         _ => None,
     };
@@ -155,6 +159,8 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
         positions: welded.positions,
         triangles,
         uvs,
+        particle_of: welded.particle_of,
+        first_vertex,
     })
 }
 

@@ -39,6 +39,7 @@ use crate::ecs::colliders::{
 use crate::ecs::events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
 use crate::ecs::lod::{ClothLod, choose_levels};
 use crate::ecs::mesh::write_meshes;
+use crate::ecs::skin::{ClothMaxDistance, move_bodies};
 use crate::ecs::sleep::{ClothSleep, ClothWake, wake_cloths};
 use crate::ecs::stats::{ClothStats, StatSample};
 use crate::ecs::step::{
@@ -163,6 +164,7 @@ impl Plugin for ClothPlugin {
                     choose_levels,
                     build_cloths,
                     attach_cloths,
+                    move_bodies,
                     place_colliders,
                     give_colliders,
                     wake_cloths,
@@ -216,6 +218,7 @@ fn register_types(app: &mut App) {
         .register_type::<ClothEnvironment>()
         .register_type::<ClothPause>()
         .register_type::<ClothInterpolation>()
+        .register_type::<ClothMaxDistance>()
         .register_type::<ClothSleep>()
         .register_type::<ClothLod>()
         .register_type::<ClothSimulation>()

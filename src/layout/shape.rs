@@ -149,7 +149,9 @@ pub enum ClothPins {
     /// The two top corners of a grid (seed 000 Slika 5).
     #[default]
     TopCorners,
-    /// Particles by index (`j·width + i` for a grid).
+    /// Particles by index: `j·width + i` for a grid; for a cloth made of a mesh, the
+    /// mesh's own vertex indices, each pinning the particle its vertex was welded into
+    /// (the copies of a vertex along a UV seam are one particle).
     Indices(Vec<u32>),
 }
 

@@ -1,0 +1,253 @@
+//! Cloth on animated characters: a mesh-shaped cloth whose mesh is skinned follows its
+//! bones, and a painted maximum distance keeps each vertex near where the body puts it
+//! (NvCloth's motion constraints, Unreal's "max distance": 0 at a skirt's waist, growing
+//! to its hem).
+//!
+//! When a cloth is built from a mesh with a `SkinnedMesh`, the plugin takes the skin off
+//! the entity (the simulated mesh is drawn as simulated, not skinned again on the GPU)
+//! and keeps it here. Each step it skins each particle's rest position on the CPU with
+//! the same linear blend Bevy's shader uses (`Σ wₖ · (jointₖ's global transform ·
+//! inverse bindposeₖ) · v`), from the joints' transforms as they are when the step
+//! begins, and gives the solver those points and the distances as motion constraints.
+//! A mesh that is not skinned can have distances too: its targets are its rest shape in
+//! the entity's frame.
+
+use bevy::math::Affine3A;
+use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
+use bevy::mesh::{MeshVertexAttribute, VertexFormat};
+use bevy::prelude::*;
+use bevy::transform::helper::TransformHelper;
+
+use crate::ecs::cloth::ClothSimulation;
+use crate::ecs::mesh::MeshSource;
+use crate::error::ClothError;
+
+/// A mesh's per-vertex maximum distance, m (`Float32`): how far the cloth may move from
+/// where the body (or the entity's frame) puts the vertex; 0 holds it there.
+pub const ATTRIBUTE_MAX_DISTANCE: MeshVertexAttribute =
+    MeshVertexAttribute::new("Cloth_MaxDistance", 2_094_662_831, VertexFormat::Float32);
+
+/// Where a mesh-shaped cloth ([`Cloth::from_mesh`](crate::Cloth::from_mesh)) reads each
+/// vertex's maximum distance from its target (its skinned position, or its rest position
+/// in the entity's frame). Without this component a mesh with an
+/// [`ATTRIBUTE_MAX_DISTANCE`] uses it; a skinned mesh without either has its pins at
+/// distance 0 and every other particle free. A welded vertex (a UV seam) takes the
+/// smallest of its copies'.
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Debug, PartialEq)]
+pub enum ClothMaxDistance {
+    /// The mesh's [`ATTRIBUTE_MAX_DISTANCE`].
+    Attribute,
+    /// A channel of the mesh's vertex colour (`Mesh::ATTRIBUTE_COLOR`: 0 red, 1 green,
+    /// 2 blue, 3 alpha), times `scale` m: what a painting tool writes.
+    VertexColor {
+        /// Which channel.
+        channel: u8,
+        /// Metres at a channel value of 1.
+        scale: f32,
+    },
+    /// One distance per vertex of the mesh, by the mesh's own vertex indices, m
+    /// (`f32::INFINITY`: free).
+    PerVertex(Vec<f32>),
+}
+
+/// What a mesh-shaped cloth follows of its body (internal): each particle's rest
+/// position in the mesh's frame, its skinning, its maximum distance.
+#[derive(Component, Clone, Debug)]
+pub(crate) struct ClothBody {
+    rest: Vec<Vec3>,
+    pub(crate) skin: Option<BodySkin>,
+    max_distance: Vec<f32>,
+    targets: Vec<Vec3>,
+    /// Whether the particles have been put where the body is (on the first step).
+    placed: bool,
+}
+
+/// A skinned cloth's skin: the entity's `SkinnedMesh` (taken off it) and each particle's
+/// joints and weights.
+#[derive(Clone, Debug)]
+pub(crate) struct BodySkin {
+    pub(crate) mesh: SkinnedMesh,
+    joints: Vec<[u16; 4]>,
+    weights: Vec<[f32; 4]>,
+    matrices: Vec<Affine3A>,
+}
+
+impl ClothBody {
+    /// The body of a cloth made of `mesh` (`source` is its welded layout), skinned by
+    /// `skin`, with distances read as `max` says and `pins` (particles) at distance 0
+    /// when skinned. `None`: a plain mesh without distances (a free cloth).
+    pub(crate) fn read(
+        mesh: &Mesh,
+        source: &MeshSource,
+        skin: Option<&SkinnedMesh>,
+        max: Option<&ClothMaxDistance>,
+        pins: &[u32],
+    ) -> Result<Option<Self>, ClothError> {
+        let bad = |reason: String| ClothError::BadMesh { reason };
+        let vertices = source.particle_of.len();
+        let painted = match max {
+            Some(max) => Some(max.clone()),
+            None if mesh.attribute(ATTRIBUTE_MAX_DISTANCE).is_some() => {
+                Some(ClothMaxDistance::Attribute)
+            }
+            None => None,
+        };
+        let per_vertex: Option<Vec<f32>> = match painted {
+            None => None,
+            Some(ClothMaxDistance::Attribute) => match mesh.attribute(ATTRIBUTE_MAX_DISTANCE) {
+                Some(bevy::mesh::VertexAttributeValues::Float32(d)) => Some(d.clone()),
+                _ => return Err(bad("it has no Float32 Cloth_MaxDistance attribute".into())),
+            },
+            Some(ClothMaxDistance::VertexColor { channel, scale }) => {
+                match (mesh.attribute(Mesh::ATTRIBUTE_COLOR), channel) {
+                    (Some(bevy::mesh::VertexAttributeValues::Float32x4(c)), 0..=3) => {
+                        Some(c.iter().map(|c| c[channel as usize] * scale).collect())
+                    }
+                    _ => {
+                        return Err(bad(format!(
+                            "max distance from colour channel {channel}: it needs Float32x4 \
+                             vertex colours and a channel from 0 to 3"
+                        )));
+                    }
+                }
+            }
+            Some(ClothMaxDistance::PerVertex(d)) => Some(d),
+        };
+        if let Some(d) = &per_vertex {
+            if d.len() != vertices {
+                return Err(bad(format!(
+                    "{} max distances for its {vertices} vertices",
+                    d.len()
+                )));
+            }
+            if let Some(r) = d.iter().find(|r| r.is_nan() || **r < 0.0) {
+                return Err(bad(format!("a max distance of {r} m (at least 0)")));
+            }
+        }
+        if skin.is_none() && per_vertex.is_none() {
+            return Ok(None);
+        }
+        let n = source.positions.len();
+        let mut max_distance = vec![f32::INFINITY; n];
+        if let Some(d) = &per_vertex {
+            for (v, &k) in source.particle_of.iter().enumerate() {
+                max_distance[k as usize] = max_distance[k as usize].min(d[v]);
+            }
+        }
+        let skin = match skin {
+            Some(skinned) => {
+                use bevy::mesh::VertexAttributeValues::{Float32x4, Uint16x4};
+                let (Some(Uint16x4(j)), Some(Float32x4(w))) = (
+                    mesh.attribute(Mesh::ATTRIBUTE_JOINT_INDEX),
+                    mesh.attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT),
+                ) else {
+                    return Err(bad(
+                        "it is skinned but has no Uint16x4 joint indices and Float32x4 \
+                         joint weights"
+                            .into(),
+                    ));
+                };
+                let joints: Vec<[u16; 4]> =
+                    source.first_vertex.iter().map(|&v| j[v as usize]).collect();
+                if let Some(k) = joints
+                    .iter()
+                    .flatten()
+                    .find(|&&k| k as usize >= skinned.joints.len())
+                {
+                    return Err(bad(format!(
+                        "joint index {k} is past its skin's {} joints",
+                        skinned.joints.len()
+                    )));
+                }
+                // Pins hold to where the skin puts them.
+                for &i in pins {
+                    max_distance[i as usize] = 0.0;
+                }
+                Some(BodySkin {
+                    mesh: skinned.clone(),
+                    joints,
+                    weights: source.first_vertex.iter().map(|&v| w[v as usize]).collect(),
+                    matrices: Vec::new(),
+                })
+            }
+            None => None,
+        };
+        Ok(Some(Self {
+            rest: source.positions.clone(),
+            skin,
+            max_distance,
+            targets: Vec::new(),
+            placed: false,
+        }))
+    }
+
+    /// Each particle's target now: skinned by the joints' `matrices`
+    /// (`global · inverse bindpose`), or its rest position in `frame`.
+    fn aim(&mut self, frame: Affine3A) {
+        self.targets.clear();
+        match &self.skin {
+            Some(skin) => {
+                let m = &skin.matrices;
+                self.targets
+                    .extend(self.rest.iter().enumerate().map(|(i, &v)| {
+                        let (j, w) = (skin.joints[i], skin.weights[i]);
+                        (0..4)
+                            .map(|k| m[j[k] as usize].transform_point3(v) * w[k])
+                            .sum::<Vec3>()
+                    }));
+            }
+            None => self
+                .targets
+                .extend(self.rest.iter().map(|&v| frame.transform_point3(v))),
+        }
+    }
+}
+
+/// Gives each cloth with a body its motion constraints for this step: the targets where
+/// its skin (from its joints' transforms now) or its frame puts each particle, and the
+/// distances. On a cloth's first step its particles are put at their targets.
+pub(crate) fn move_bodies(
+    transforms: TransformHelper,
+    bindposes: Option<Res<Assets<SkinnedMeshInverseBindposes>>>,
+    mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothBody)>,
+) {
+    for (entity, mut sim, mut body) in &mut cloths {
+        let body = &mut *body;
+        if let Some(skin) = &mut body.skin {
+            let inverse = bindposes.as_ref();
+            let Some(inverse) = inverse.and_then(|b| b.get(&skin.mesh.inverse_bindposes)) else {
+                continue; // not loaded yet (or no renderer's skinning in this app)
+            };
+            skin.matrices.clear();
+            for (&joint, inverse) in skin.mesh.joints.iter().zip(inverse.iter()) {
+                match transforms.compute_global_transform(joint) {
+                    Ok(global) => skin
+                        .matrices
+                        .push(global.affine() * Affine3A::from_mat4(*inverse)),
+                    Err(_) => break,
+                }
+            }
+            if skin.matrices.len() != skin.mesh.joints.len() {
+                warn_once!("cloth {entity}: a joint of its skin has no transform; not moved");
+                continue;
+            }
+        }
+        body.aim(sim.solver.frame());
+        if !body.placed {
+            let p = sim.solver.particles_mut();
+            for (i, &x) in body.targets.iter().enumerate() {
+                p.position[i] = x;
+                p.previous[i] = x;
+                p.velocity[i] = Vec3::ZERO;
+            }
+            body.placed = true;
+        }
+        if let Err(e) = sim
+            .solver
+            .set_motion_constraints(&body.targets, &body.max_distance)
+        {
+            warn_once!("cloth {entity}: {e}");
+        }
+    }
+}
