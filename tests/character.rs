@@ -341,3 +341,82 @@ fn mesh_vertex_indices_pin_the_welded_particles() {
     let invalid = app.world().get::<ClothInvalid>(bad).expect("refused");
     assert!(invalid.0.to_string().contains("12"), "{}", invalid.0);
 }
+
+/// The distance from `x` to the segment `a–b`.
+fn from_segment(x: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let t = ((x - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+    x.distance(a + (b - a) * t)
+}
+
+/// A thigh collider spanning a hip and a knee joint follows them as the hip swings the
+/// leg forward (±35° at 1 Hz) into a curtain hanging in front of it: the solver's capsule
+/// runs from the hip to the knee every step, and no particle ever gets inside it.
+#[test]
+fn a_capsule_spanning_two_joints_follows_them_and_keeps_the_cloth_out() {
+    let mut app = bevy_cloth::headless::headless_app();
+    let hip_rest = Transform::from_xyz(0.0, 1.0, 0.0);
+    let hip = app.world_mut().spawn(hip_rest).id();
+    let knee = app
+        .world_mut()
+        .spawn((Transform::from_xyz(0.0, -0.45, 0.0), ChildOf(hip)))
+        .id();
+    let radius = 0.08;
+    app.world_mut().spawn((
+        ClothCollider::capsule(radius, 0.0),
+        ClothColliderSpan {
+            from: hip,
+            to: knee,
+        },
+    ));
+    // 20 × 14 particles 2.5 cm apart, hung by their top row 12 cm in front of the hip.
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(20, 14, 0.025).with_pins(ClothPins::TopRow),
+            Transform::from_xyz(0.0, 1.05, 0.12),
+        ))
+        .id();
+    let (mut closest, mut worst_end) = (f32::INFINITY, 0.0f32);
+    for frame in 0..120 {
+        let t = frame as f32 / 60.0;
+        let swing = -0.6 * (std::f32::consts::TAU * t).sin();
+        *app.world_mut().get_mut::<Transform>(hip).unwrap() =
+            hip_rest.with_rotation(Quat::from_rotation_x(swing));
+        app.update();
+        let Some(sim) = app.world().get::<ClothSimulation>(cloth) else {
+            continue;
+        };
+        let Some(collider) = sim.solver.colliders().first() else {
+            continue;
+        };
+        let bevy_cloth::solver::ColliderShape::Capsule { a, b, radius: r } = collider.shape else {
+            panic!("a capsule: {:?}", collider.shape);
+        };
+        // The joints where this step put them.
+        let hip_at = hip_rest.with_rotation(Quat::from_rotation_x(swing));
+        let knee_at = hip_at.transform_point(Vec3::new(0.0, -0.45, 0.0));
+        worst_end = worst_end
+            .max(a.distance(hip_at.translation))
+            .max(b.distance(knee_at));
+        assert!((r - radius).abs() < 1e-6);
+        for &x in sim.solver.positions() {
+            closest = closest.min(from_segment(x, a, b));
+        }
+    }
+    eprintln!(
+        "ends off by {worst_end} m; closest particle {closest} m from the axis (radius {radius})"
+    );
+    assert!(
+        worst_end < 1e-5,
+        "the capsule's ends are {worst_end} m off the joints"
+    );
+    assert!(
+        closest >= radius - 1e-4,
+        "a particle went {} m into the thigh",
+        radius - closest
+    );
+    assert!(
+        reached < radius + 0.02,
+        "the thigh reached the cloth: {reached} m"
+    );
+}

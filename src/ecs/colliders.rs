@@ -426,12 +426,56 @@ impl PlacedColliders {
     }
 }
 
+/// Makes a capsule [`ClothCollider`] span two entities, a bone: each step its axis runs
+/// from `from`'s origin to `to`'s (a hip joint to a knee joint, as the animation has
+/// put them), whatever its own entity's transform; its radius is the collider's. Its
+/// motion since the last step (for friction and sweeping) is that of the segment's
+/// middle and direction. On a collider of another shape it does nothing.
+///
+/// ```
+/// use bevy::prelude::*;
+/// use bevy_cloth::prelude::*;
+/// # let mut world = World::new();
+/// let hip = world.spawn(Transform::from_xyz(0.1, 0.9, 0.0)).id();
+/// let knee = world.spawn(Transform::from_xyz(0.1, 0.5, 0.0)).id();
+/// world.spawn((ClothCollider::capsule(0.07, 0.0), ClothColliderSpan { from: hip, to: knee }));
+/// ```
+#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Component, Debug, PartialEq)]
+pub struct ClothColliderSpan {
+    /// The entity at one end of the axis.
+    pub from: Entity,
+    /// The entity at the other.
+    pub to: Entity,
+}
+
+impl ClothColliderSpan {
+    /// A transform whose y axis runs from `from` to `to` (its origin midway, its y scale
+    /// the length); `None` when an end has no transform.
+    fn transform(&self, transforms: &TransformHelper) -> Option<GlobalTransform> {
+        let a = transforms
+            .compute_global_transform(self.from)
+            .ok()?
+            .translation();
+        let b = transforms
+            .compute_global_transform(self.to)
+            .ok()?
+            .translation();
+        let axis = b - a;
+        let rotation = Quat::from_rotation_arc(Vec3::Y, axis.normalize_or(Vec3::Y));
+        let transform = Transform::from_translation(0.5 * (a + b))
+            .with_rotation(rotation)
+            .with_scale(Vec3::new(1.0, axis.length(), 1.0));
+        Some(GlobalTransform::from(transform))
+    }
+}
+
 /// Starts the step's colliders with every [`ClothCollider`] where its entity is now (each
 /// placed once per step, then copied to every cloth).
 pub(crate) fn place_colliders(
     time: Res<Time>,
     transforms: TransformHelper,
-    colliders: Query<(Entity, &ClothCollider)>,
+    colliders: Query<(Entity, &ClothCollider, Option<&ClothColliderSpan>)>,
     mut placed: ResMut<PlacedColliders>,
 ) {
     let placed = &mut *placed;
@@ -439,9 +483,21 @@ pub(crate) fn place_colliders(
     placed.colliders.clear();
     placed.bodies.clear();
     placed.layers.clear();
-    for (entity, collider) in &colliders {
-        let Ok(transform) = transforms.compute_global_transform(entity) else {
+    for (entity, collider, span) in &colliders {
+        let transform = match span {
+            Some(span) => span.transform(&transforms),
+            None => transforms.compute_global_transform(entity).ok(),
+        };
+        let Some(transform) = transform else {
             continue;
+        };
+        let mut collider = *collider;
+        if let (Some(_), ColliderKind::Capsule { half_length, .. }) = (span, &mut collider.shape) {
+            *half_length = 0.5 * transform.scale().y;
+        }
+        let transform = match span {
+            Some(_) => GlobalTransform::from(transform.compute_transform().with_scale(Vec3::ONE)),
+            None => transform,
         };
         let world = collider.to_world(&transform);
         placed.add(entity, entity, &transform, world, Layers::DEFAULT);

@@ -23,7 +23,7 @@ pub use attach::{AttachParticles, ClothAttachment, ClothAttachments};
 pub use cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
 };
-pub use colliders::{ClothCollider, ColliderKind, TELEPORT_SPEED};
+pub use colliders::{ClothCollider, ClothColliderSpan, ColliderKind, TELEPORT_SPEED};
 pub use controls::{ClothControls, ClothControlsPlugin};
 pub use events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
 pub use lod::ClothLod;

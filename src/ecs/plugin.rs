@@ -219,6 +219,7 @@ fn register_types(app: &mut App) {
         .register_type::<ClothPause>()
         .register_type::<ClothInterpolation>()
         .register_type::<ClothMaxDistance>()
+        .register_type::<crate::ecs::colliders::ClothColliderSpan>()
         .register_type::<ClothSleep>()
         .register_type::<ClothLod>()
         .register_type::<ClothSimulation>()
