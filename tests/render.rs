@@ -1,4 +1,4 @@
-//! The render test: each example (curtain, card, T-shirt, fold's stack scene, flag; the cape with `--features
+//! The render test: each example (curtain, card, T-shirt, fold's stack scene, flag, character; the cape with `--features
 //! avian`) under Xvfb with Mesa's software Vulkan, two screenshots, and checks from the
 //! pixels that the cloth is drawn where the camera looks and that it moved between them.
 //! Catches a black window, a mesh that is not updated and a frozen simulation.
@@ -230,6 +230,13 @@ fn flag_renders_and_moves() {
     // The textured flag on its pole, carried round a circle: its coloured bands are the
     // cloth's pixels, and it moves with the pole (issue 18's attachment and texture).
     renders_and_moves("flag", &[], (40, 120), 0.005..0.4);
+}
+
+#[test]
+fn character_renders_and_moves() {
+    // The walking skinned character: the blue skirt and the red cape are the cloth's
+    // pixels (the body and the ground are grey), and they move as it walks.
+    renders_and_moves("character", &[], (40, 120), 0.005..0.4);
 }
 
 #[cfg(feature = "avian")]
