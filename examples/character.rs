@@ -148,6 +148,17 @@ fn body_mesh() -> Mesh {
     }
     let (joints, weights): (Vec<[u16; 4]>, Vec<[f32; 4]>) =
         positions.iter().map(|&v| body_weights(v)).unzip();
+    skinned_mesh(positions, normals, indices, joints, weights)
+}
+
+/// A triangle mesh with the joint indices and weights a `SkinnedMesh` needs.
+fn skinned_mesh(
+    positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    indices: Vec<u32>,
+    joints: Vec<[u16; 4]>,
+    weights: Vec<[f32; 4]>,
+) -> Mesh {
     Mesh::new(
         PrimitiveTopology::TriangleList,
         RenderAssetUsages::default(),
@@ -186,19 +197,15 @@ fn skirt_mesh() -> Mesh {
         .map(|p| HEM_DISTANCE * ((HIP + 0.04 - p.y) / 0.42).clamp(0.0, 1.0).powi(2))
         .collect();
     let n = positions.len();
-    Mesh::new(
-        PrimitiveTopology::TriangleList,
-        RenderAssetUsages::default(),
+    let joints = vec![[0; 4]; n];
+    skinned_mesh(
+        positions,
+        normals,
+        indices,
+        joints,
+        vec![[1.0, 0.0, 0.0, 0.0]; n],
     )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
-    .with_inserted_attribute(Mesh::ATTRIBUTE_NORMAL, normals)
-    .with_inserted_attribute(
-        Mesh::ATTRIBUTE_JOINT_INDEX,
-        VertexAttributeValues::Uint16x4(vec![[0; 4]; n]),
-    )
-    .with_inserted_attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT, vec![[1.0, 0.0, 0.0, 0.0]; n])
     .with_inserted_attribute(ATTRIBUTE_MAX_DISTANCE, distance)
-    .with_inserted_indices(Indices::U32(indices))
 }
 
 fn setup(

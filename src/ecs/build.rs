@@ -184,6 +184,35 @@ fn load_error(file: &str, error: &AssetLoadError) -> ClothError {
     }
 }
 
+/// Where a cloth's layout comes from (see [`LayoutSource`]), and for a mesh-shaped cloth
+/// the handle of its source mesh (remembered, or the entity's `Mesh3d`); a garment's
+/// asset is loaded on first sight.
+#[allow(clippy::type_complexity)]
+fn layout_source<'a>(
+    cloth: &Cloth,
+    (source, mesh3d, garment): (
+        Option<&ClothSourceMesh>,
+        Option<&Mesh3d>,
+        Option<&ClothGarment>,
+    ),
+    meshes: &'a Assets<Mesh>,
+    (commands, entity): (&mut Commands, Entity),
+    (asset_server, garments): (&AssetServer, &'a Assets<Garment>),
+) -> Result<(LayoutSource<'a>, Option<Handle<Mesh>>), ClothError> {
+    Ok(match &cloth.shape {
+        ClothShape::Mesh => {
+            let handle = source.map(|s| s.0.clone()).or(mesh3d.map(|m| m.0.clone()));
+            let mesh = handle.as_ref().and_then(|h| meshes.get(h));
+            (LayoutSource::Mesh(mesh), handle)
+        }
+        ClothShape::Garment { file, .. } => {
+            let found = garment_source(commands, entity, file, garment, asset_server, garments)?;
+            (LayoutSource::Garment(found), None)
+        }
+        ClothShape::Grid { .. } => (LayoutSource::Description, None),
+    })
+}
+
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub(crate) fn build_cloths(
     mut commands: Commands,
@@ -217,9 +246,10 @@ pub(crate) fn build_cloths(
         let reload = garment
             .as_mut()
             .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed));
+        let changed = cloth.is_changed() || reload || repainted;
         if let Some(mut sim) = sim {
             sim.solver.set_frame(frame);
-            if !cloth.is_changed() && !reload && !repainted {
+            if !changed {
                 continue;
             }
             if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !reload && !repainted
@@ -227,33 +257,21 @@ pub(crate) fn build_cloths(
                 apply_params(&mut commands, entity, &mut sim, &cloth.params, invalid);
                 continue;
             }
-        } else if invalid && !cloth.is_changed() && !reload {
+        } else if invalid && !changed {
             continue;
         }
-        let mut source_handle = None;
-        let layout_source = match &cloth.shape {
-            ClothShape::Mesh => {
-                source_handle = source.map(|s| s.0.clone()).or(mesh3d.map(|m| m.0.clone()));
-                LayoutSource::Mesh(source_handle.as_ref().and_then(|h| meshes.get(h)))
+        let (layout_source, source_handle) = match layout_source(
+            &cloth,
+            (source, mesh3d, garment.as_deref()),
+            &meshes,
+            (&mut commands, entity),
+            (&asset_server, &garments),
+        ) {
+            Ok(found) => found,
+            Err(e) => {
+                invalidate(&mut commands, entity, e);
+                continue;
             }
-            ClothShape::Garment { file, .. } => {
-                let current = garment.as_deref();
-                match garment_source(
-                    &mut commands,
-                    entity,
-                    file,
-                    current,
-                    &asset_server,
-                    &garments,
-                ) {
-                    Ok(garment) => LayoutSource::Garment(garment),
-                    Err(e) => {
-                        invalidate(&mut commands, entity, e);
-                        continue;
-                    }
-                }
-            }
-            ClothShape::Grid { .. } => LayoutSource::Description,
         };
         let body_source = BodySource {
             // The entity's skin, or the one taken off it when it was last built.
@@ -261,27 +279,37 @@ pub(crate) fn build_cloths(
             max: max.as_deref(),
         };
         match build_one(&cloth, frame, layout_source, body_source) {
-            Ok(Some((solver, mesh, body))) => {
-                let sim = ClothSimulation::new(solver, &cloth);
-                let handle = meshes.add(mesh);
+            Ok(Some(built)) => {
                 let mut entity_commands = commands.entity(entity);
-                entity_commands
-                    .insert((sim, Mesh3d(handle)))
-                    .remove::<ClothInvalid>();
+                insert_built(&mut entity_commands, &cloth, built, &mut meshes);
                 if let Some(source_handle) = source_handle {
                     entity_commands.insert(ClothSourceMesh(source_handle));
                 }
-                match body {
-                    // Drawn as simulated: the skin comes off the entity.
-                    Some(body) => entity_commands.insert(body).remove::<SkinnedMesh>(),
-                    None => entity_commands.remove::<ClothBody>(),
-                };
                 commands.trigger(ClothBuilt { entity });
             }
             Ok(None) => {}
             Err(e) => invalidate(&mut commands, entity, e),
         }
     }
+}
+
+/// Puts a built cloth on its entity: the simulation, its mesh (the entity's `Mesh3d`
+/// now), and its body or none; a skinned cloth's skin comes off the entity, so it is
+/// drawn as simulated.
+fn insert_built(
+    entity: &mut EntityCommands,
+    cloth: &Cloth,
+    (solver, mesh, body): Built,
+    meshes: &mut Assets<Mesh>,
+) {
+    let sim = ClothSimulation::new(solver, cloth);
+    entity
+        .insert((sim, Mesh3d(meshes.add(mesh))))
+        .remove::<ClothInvalid>();
+    match body {
+        Some(body) => entity.insert(body).remove::<SkinnedMesh>(),
+        None => entity.remove::<ClothBody>(),
+    };
 }
 
 /// Applies edited parameters to a built cloth; bad ones pause it until they are fixed.

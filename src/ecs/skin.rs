@@ -84,47 +84,7 @@ impl ClothBody {
         max: Option<&ClothMaxDistance>,
         pins: &[u32],
     ) -> Result<Option<Self>, ClothError> {
-        let bad = |reason: String| ClothError::BadMesh { reason };
-        let vertices = source.particle_of.len();
-        let painted = match max {
-            Some(max) => Some(max.clone()),
-            None if mesh.attribute(ATTRIBUTE_MAX_DISTANCE).is_some() => {
-                Some(ClothMaxDistance::Attribute)
-            }
-            None => None,
-        };
-        let per_vertex: Option<Vec<f32>> = match painted {
-            None => None,
-            Some(ClothMaxDistance::Attribute) => match mesh.attribute(ATTRIBUTE_MAX_DISTANCE) {
-                Some(bevy::mesh::VertexAttributeValues::Float32(d)) => Some(d.clone()),
-                _ => return Err(bad("it has no Float32 Cloth_MaxDistance attribute".into())),
-            },
-            Some(ClothMaxDistance::VertexColor { channel, scale }) => {
-                match (mesh.attribute(Mesh::ATTRIBUTE_COLOR), channel) {
-                    (Some(bevy::mesh::VertexAttributeValues::Float32x4(c)), 0..=3) => {
-                        Some(c.iter().map(|c| c[channel as usize] * scale).collect())
-                    }
-                    _ => {
-                        return Err(bad(format!(
-                            "max distance from colour channel {channel}: it needs Float32x4 \
-                             vertex colours and a channel from 0 to 3"
-                        )));
-                    }
-                }
-            }
-            Some(ClothMaxDistance::PerVertex(d)) => Some(d),
-        };
-        if let Some(d) = &per_vertex {
-            if d.len() != vertices {
-                return Err(bad(format!(
-                    "{} max distances for its {vertices} vertices",
-                    d.len()
-                )));
-            }
-            if let Some(r) = d.iter().find(|r| r.is_nan() || **r < 0.0) {
-                return Err(bad(format!("a max distance of {r} m (at least 0)")));
-            }
-        }
+        let per_vertex = painted(mesh, max, source.particle_of.len())?;
         if skin.is_none() && per_vertex.is_none() {
             return Ok(None);
         }
@@ -137,39 +97,11 @@ impl ClothBody {
         }
         let skin = match skin {
             Some(skinned) => {
-                use bevy::mesh::VertexAttributeValues::{Float32x4, Uint16x4};
-                let (Some(Uint16x4(j)), Some(Float32x4(w))) = (
-                    mesh.attribute(Mesh::ATTRIBUTE_JOINT_INDEX),
-                    mesh.attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT),
-                ) else {
-                    return Err(bad(
-                        "it is skinned but has no Uint16x4 joint indices and Float32x4 \
-                         joint weights"
-                            .into(),
-                    ));
-                };
-                let joints: Vec<[u16; 4]> =
-                    source.first_vertex.iter().map(|&v| j[v as usize]).collect();
-                if let Some(k) = joints
-                    .iter()
-                    .flatten()
-                    .find(|&&k| k as usize >= skinned.joints.len())
-                {
-                    return Err(bad(format!(
-                        "joint index {k} is past its skin's {} joints",
-                        skinned.joints.len()
-                    )));
-                }
                 // Pins hold to where the skin puts them.
                 for &i in pins {
                     max_distance[i as usize] = 0.0;
                 }
-                Some(BodySkin {
-                    mesh: skinned.clone(),
-                    joints,
-                    weights: source.first_vertex.iter().map(|&v| w[v as usize]).collect(),
-                    matrices: Vec::new(),
-                })
+                Some(BodySkin::read(mesh, source, skinned)?)
             }
             None => None,
         };
@@ -201,6 +133,88 @@ impl ClothBody {
                 .targets
                 .extend(self.rest.iter().map(|&v| frame.transform_point3(v))),
         }
+    }
+}
+
+/// Each vertex's maximum distance as `max` says (or from the mesh's
+/// [`ATTRIBUTE_MAX_DISTANCE`] without it), checked: one per vertex, none negative.
+/// `None`: no distances.
+fn painted(
+    mesh: &Mesh,
+    max: Option<&ClothMaxDistance>,
+    vertices: usize,
+) -> Result<Option<Vec<f32>>, ClothError> {
+    use bevy::mesh::VertexAttributeValues::{Float32, Float32x4};
+    let bad = |reason: String| ClothError::BadMesh { reason };
+    let max = match max {
+        Some(max) => max.clone(),
+        None if mesh.attribute(ATTRIBUTE_MAX_DISTANCE).is_some() => ClothMaxDistance::Attribute,
+        None => return Ok(None),
+    };
+    let d = match max {
+        ClothMaxDistance::Attribute => match mesh.attribute(ATTRIBUTE_MAX_DISTANCE) {
+            Some(Float32(d)) => d.clone(),
+            _ => return Err(bad("it has no Float32 Cloth_MaxDistance attribute".into())),
+        },
+        ClothMaxDistance::VertexColor { channel, scale } => {
+            match (mesh.attribute(Mesh::ATTRIBUTE_COLOR), channel) {
+                (Some(Float32x4(c)), 0..=3) => {
+                    c.iter().map(|c| c[channel as usize] * scale).collect()
+                }
+                _ => {
+                    return Err(bad(format!(
+                        "max distance from colour channel {channel}: it needs Float32x4 \
+                         vertex colours and a channel from 0 to 3"
+                    )));
+                }
+            }
+        }
+        ClothMaxDistance::PerVertex(d) => d,
+    };
+    if d.len() != vertices {
+        return Err(bad(format!(
+            "{} max distances for its {vertices} vertices",
+            d.len()
+        )));
+    }
+    if let Some(r) = d.iter().find(|r| r.is_nan() || **r < 0.0) {
+        return Err(bad(format!("a max distance of {r} m (at least 0)")));
+    }
+    Ok(Some(d))
+}
+
+impl BodySkin {
+    /// The skin `skinned` of a cloth made of `mesh` (`source` its welded layout): each
+    /// particle's joints and weights, its first vertex's.
+    fn read(mesh: &Mesh, source: &MeshSource, skinned: &SkinnedMesh) -> Result<Self, ClothError> {
+        use bevy::mesh::VertexAttributeValues::{Float32x4, Uint16x4};
+        let bad = |reason: String| ClothError::BadMesh { reason };
+        let (Some(Uint16x4(j)), Some(Float32x4(w))) = (
+            mesh.attribute(Mesh::ATTRIBUTE_JOINT_INDEX),
+            mesh.attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT),
+        ) else {
+            return Err(bad(
+                "it is skinned but has no Uint16x4 joint indices and Float32x4 joint weights"
+                    .into(),
+            ));
+        };
+        let joints: Vec<[u16; 4]> = source.first_vertex.iter().map(|&v| j[v as usize]).collect();
+        if let Some(k) = joints
+            .iter()
+            .flatten()
+            .find(|&&k| k as usize >= skinned.joints.len())
+        {
+            return Err(bad(format!(
+                "joint index {k} is past its skin's {} joints",
+                skinned.joints.len()
+            )));
+        }
+        Ok(Self {
+            mesh: skinned.clone(),
+            joints,
+            weights: source.first_vertex.iter().map(|&v| w[v as usize]).collect(),
+            matrices: Vec::new(),
+        })
     }
 }
 
