@@ -45,7 +45,7 @@
 
 use bevy::math::{Vec3, Vec3A};
 
-use super::parallel;
+use super::parallel::{self, PIECE};
 use super::{Particles, SpringKind, Springs};
 use crate::params::SelfCollision;
 
@@ -93,6 +93,8 @@ pub(super) struct SelfContact {
     cross: Vec<[u32; 2]>,
     /// This cloth's place among those the last [`collide_cloths`] was given.
     tag: Option<u32>,
+    /// The clamp's sums of motion and free particles, piece by piece.
+    sums: Vec<(Vec3, usize)>,
 }
 
 /// A particle of another cloth, as it was when the step began.
@@ -546,22 +548,41 @@ impl SelfContact {
     }
 
     /// Clamps each free particle's motion over the substep, relative to the free
-    /// particles' mean, to `reach`.
-    fn clamp(&self, p: &mut Particles, h: f32) {
-        let (mean, _) = mean_of_free(p, |i| p.position[i] - p.previous[i]);
+    /// particles' mean, to `reach`; in pieces on both cores from 16,384 particles (the
+    /// mean summed piece by piece, the pieces' sums in order: the same bits on any pool).
+    fn clamp(&mut self, p: &mut Particles, h: f32) {
+        let n = p.len();
+        self.sums.clear();
+        self.sums.resize(n.div_ceil(PIECE), (Vec3::ZERO, 0));
+        let (x, previous, w) = (&p.position, &p.previous, &p.inv_mass);
+        parallel::for_each(n, self.sums.iter_mut().enumerate(), |(k, (sum, free))| {
+            for i in k * PIECE..((k + 1) * PIECE).min(n) {
+                if w[i] != 0.0 {
+                    *sum += x[i] - previous[i];
+                    *free += 1;
+                }
+            }
+        });
+        let (sum, free) = self
+            .sums
+            .iter()
+            .fold((Vec3::ZERO, 0), |(s, f), &(ps, pf)| (s + ps, f + pf));
+        let mean = sum / free.max(1) as f32;
         let reach = self.reach;
-        for i in 0..p.len() {
-            if p.inv_mass[i] == 0.0 {
-                continue;
+        parallel::for_each(n, p.pieces(), |piece| {
+            for k in 0..piece.position.len() {
+                if piece.inv_mass[k] == 0.0 {
+                    continue;
+                }
+                let relative = piece.position[k] - piece.previous[k] - mean;
+                let l2 = relative.length_squared();
+                if l2 > reach * reach {
+                    let relative = relative * (reach / l2.sqrt());
+                    piece.position[k] = piece.previous[k] + mean + relative;
+                    piece.velocity[k] = (mean + relative) / h;
+                }
             }
-            let relative = p.position[i] - p.previous[i] - mean;
-            let l2 = relative.length_squared();
-            if l2 > reach * reach {
-                let relative = relative * (reach / l2.sqrt());
-                p.position[i] = p.previous[i] + mean + relative;
-                p.velocity[i] = (mean + relative) / h;
-            }
-        }
+        });
     }
 }
 
