@@ -537,3 +537,69 @@ fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
     );
     assert!(closest < 0.02, "the thighs reach the skirt: {closest} m");
 }
+
+/// A plain (unskinned) mesh with painted distances: its targets are its rest shape in the
+/// entity's frame. The entity moves 1 m/s along x and turns; the top row (distance 0,
+/// given per vertex in code) stays on its target to 1e-5 m and the rest within 3 cm.
+#[test]
+fn a_plain_mesh_keeps_within_its_painted_distances_of_its_frame() {
+    let side = 5u32;
+    let mut positions = Vec::new();
+    for j in 0..side {
+        for i in 0..side {
+            positions.push([i as f32 * 0.05, -(j as f32) * 0.05, 0.0]);
+        }
+    }
+    let mut indices = Vec::new();
+    for j in 0..side - 1 {
+        for i in 0..side - 1 {
+            let a = j * side + i;
+            indices.extend([a, a + side, a + 1, a + 1, a + side, a + side + 1]);
+        }
+    }
+    let rest: Vec<Vec3> = positions.iter().map(|&p| Vec3::from(p)).collect();
+    let distance: Vec<f32> = (0..side * side)
+        .map(|k| if k < side { 0.0 } else { 0.03 })
+        .collect();
+    let mesh = Mesh::new(
+        PrimitiveTopology::TriangleList,
+        RenderAssetUsages::default(),
+    )
+    .with_inserted_attribute(Mesh::ATTRIBUTE_POSITION, positions)
+    .with_inserted_indices(Indices::U32(indices));
+    let mut app = bevy_cloth::headless::headless_app();
+    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(mesh);
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Mesh3d(handle),
+            Cloth::from_mesh().with_pins(ClothPins::None),
+            ClothMaxDistance::PerVertex(distance.clone()),
+            Transform::from_xyz(0.0, 1.0, 0.0),
+        ))
+        .id();
+    let (mut pinned_off, mut over) = (0.0f32, f32::MIN);
+    for frame in 0..120 {
+        let t = frame as f32 / 60.0;
+        let place = Transform::from_xyz(t, 1.0, 0.0).with_rotation(Quat::from_rotation_y(t));
+        *app.world_mut().get_mut::<Transform>(cloth).unwrap() = place;
+        app.update();
+        let Some(sim) = app.world().get::<ClothSimulation>(cloth) else {
+            continue;
+        };
+        for (k, &x) in sim.solver.positions().iter().enumerate() {
+            let off = x.distance(place.transform_point(rest[k]));
+            if distance[k] == 0.0 {
+                pinned_off = pinned_off.max(off);
+            } else {
+                over = over.max(off - distance[k]);
+            }
+        }
+    }
+    eprintln!("distance 0: {pinned_off} m off; the rest: {over} m over");
+    assert!(
+        pinned_off <= 1e-5,
+        "the top row is {pinned_off} m off its frame"
+    );
+    assert!(over <= 1e-5, "a particle went {over} m past its distance");
+}
