@@ -1291,3 +1291,65 @@ fn the_mesh_is_drawn_between_the_last_two_steps() {
         assert!(moved > 1e-3, "the cloth moved in that step: {moved} m");
     }
 }
+
+/// Two cloths in contact (self-collision on, one laid 2 cm over the other on the ground)
+/// step together: on the plugin's task path (`solver::substep_together`) and on its
+/// stage-by-stage path (a game system between the stages, `solver::exchange_cloths`
+/// before the constraints) they end on the same bits, and they did touch.
+#[test]
+fn cloths_in_contact_step_together_the_same_on_both_paths() {
+    let run = |with_system: bool| {
+        let mut app = app();
+        app.init_resource::<SubstepCalls>();
+        if with_system {
+            app.add_systems(
+                ClothSubstep,
+                count_substeps
+                    .after(ClothSubstepSystems::AccumulateForces)
+                    .before(ClothSubstepSystems::Integrate),
+            );
+        }
+        app.world_mut().spawn(ClothCollider::plane());
+        let cloths: Vec<Entity> = [0.1, 0.12]
+            .into_iter()
+            .map(|y| {
+                let (mut cloth, place) = common::lying_cloth(Vec3::new(0.0, y, 0.0));
+                cloth.params.self_collision.enabled = true;
+                cloth.params.substeps = Substeps::Fixed(5);
+                app.world_mut()
+                    .spawn((cloth, place, ClothSleep::never()))
+                    .id()
+            })
+            .collect();
+        let mut touched = false;
+        for _ in 0..40 {
+            app.update();
+            touched |= cloths.iter().any(|&e| {
+                app.world()
+                    .get::<ClothSimulation>(e)
+                    .is_some_and(|s| s.solver.touches_other_cloths())
+            });
+        }
+        let positions: Vec<Vec<Vec3>> = cloths
+            .iter()
+            .map(|&e| {
+                app.world()
+                    .get::<ClothSimulation>(e)
+                    .unwrap()
+                    .solver
+                    .positions()
+                    .to_vec()
+            })
+            .collect();
+        (positions, touched, app.world().resource::<SubstepCalls>().0)
+    };
+    let (alone, touched, none) = run(false);
+    let (with_system, _, calls) = run(true);
+    assert!(touched, "the cloths are in contact");
+    assert_eq!(none, 0);
+    assert!(calls > 0);
+    let top = alone[1].iter().map(|p| p.y).sum::<f32>() / 36.0;
+    let bottom = alone[0].iter().map(|p| p.y).sum::<f32>() / 36.0;
+    assert!(top > bottom + 0.02, "in layers: {top} over {bottom}");
+    assert!(alone == with_system, "the two paths differ");
+}

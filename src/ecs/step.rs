@@ -269,8 +269,11 @@ fn fit_targets(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
 
 fn constrain(plan: Res<ClothSubstepPlan>, mut cloths: ActiveCloths) {
     // Cloth–cloth contact keeps apart from where the other cloths are now.
-    let mut all: Vec<_> = cloths.iter_mut().map(|(sim, _)| sim).collect();
-    if all.iter().any(|sim| sim.solver.touches_other_cloths()) {
+    if cloths
+        .iter()
+        .any(|(sim, _)| sim.solver.touches_other_cloths())
+    {
+        let mut all: Vec<_> = cloths.iter_mut().map(|(sim, _)| sim).collect();
         let mut solvers: Vec<_> = all.iter_mut().map(|sim| &mut sim.solver).collect();
         solver::exchange_cloths(&mut solvers);
     }

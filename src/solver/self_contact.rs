@@ -789,33 +789,55 @@ fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
 
 /// Runs the substeps of cloths in contact with one another ([`collide_cloths`], after
 /// each one's `begin_step`, which gave its substep count: `substeps[k]`) interleaved in
-/// time: the next substep is the one that ends earliest (the lower place first on a tie),
-/// and before its constraints the cloth's copy of the others is refreshed. Cloths with
-/// the same substep count so go in lockstep. With the others one step old, as when each
-/// cloth takes its step alone, three cloths stacked on a cushion jittered by up to 1 m/s
-/// for as long as they lay there (`assets/scenes/stack.ron`); so, they come to rest.
+/// time: next come the substeps that end earliest, all cloths' that end then together.
+/// Those cloths take their forces, prediction and targets, then each one's copy of the
+/// others is refreshed, then each projects its constraints: the order the plugin's
+/// stage-by-stage path runs (the same bits for cloths of equal substep counts). With the
+/// others one step old, as when each cloth takes its step alone, three cloths stacked on
+/// a cushion jittered by up to 1 m/s for as long as they lay there
+/// (`assets/scenes/stack.ron`); so, they come to rest.
 pub fn substep_together(
     cloths: &mut [&mut super::ClothSolver],
     substeps: &[u32],
     env: &crate::params::Environment,
 ) {
-    // A cloth's substeps taken this step are counted in its report.
-    let done = |c: &super::ClothSolver| c.report.taken;
-    loop {
-        // The unfinished cloth whose next substep ends first: (k + 1) / n smallest.
-        let next = (0..cloths.len())
-            .filter(|&c| done(cloths[c]) < substeps[c])
-            .min_by(|&a, &b| {
-                let ta = u64::from(done(cloths[a]) + 1) * u64::from(substeps[b]);
-                let tb = u64::from(done(cloths[b]) + 1) * u64::from(substeps[a]);
-                ta.cmp(&tb).then(a.cmp(&b))
-            });
-        let Some(c) = next else { break };
-        let cloth = &mut *cloths[c];
-        cloth.accumulate_forces(env);
-        cloth.integrate();
-        cloth.fit_targets();
-        refresh(cloths, c);
-        cloths[c].constrain();
+    // The earliest end among the unfinished cloths' next substeps, while there is one.
+    let earliest = |cloths: &[&mut super::ClothSolver]| {
+        (0..cloths.len())
+            .filter_map(|c| next_end(cloths, substeps, c))
+            .min_by(|&(a, n), &(b, m)| (a * m).cmp(&(b * n)))
+    };
+    while let Some(first) = earliest(cloths) {
+        // The cloths whose next substep ends then (a cloth's `next_end` changes only
+        // when it takes its constraints, the last of the three).
+        let due = |cloths: &[&mut super::ClothSolver], c: usize| {
+            next_end(cloths, substeps, c).is_some_and(|(k, n)| k * first.1 == first.0 * n)
+        };
+        for c in 0..cloths.len() {
+            if due(cloths, c) {
+                let cloth = &mut *cloths[c];
+                cloth.accumulate_forces(env);
+                cloth.integrate();
+                cloth.fit_targets();
+            }
+        }
+        for c in 0..cloths.len() {
+            if due(cloths, c) {
+                refresh(cloths, c);
+            }
+        }
+        for c in 0..cloths.len() {
+            if due(cloths, c) {
+                cloths[c].constrain();
+            }
+        }
     }
+}
+
+/// When cloth `c`'s next substep ends, as a fraction of the step `(k, n)`: its
+/// substeps taken this step (counted in its report) plus one, over its count; `None`
+/// once it has taken them all.
+fn next_end(cloths: &[&mut super::ClothSolver], substeps: &[u32], c: usize) -> Option<(u64, u64)> {
+    let taken = cloths[c].report.taken;
+    (taken < substeps[c]).then(|| (u64::from(taken + 1), u64::from(substeps[c])))
 }
