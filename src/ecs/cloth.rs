@@ -185,13 +185,13 @@ impl ClothSimulation {
         self.blending = false;
     }
 
-    /// Notes where the cloth is as a fixed step begins (`steps`: whether it steps), for
-    /// drawing between that step's start and end.
-    pub(crate) fn note_step(&mut self, steps: bool) {
-        // A cloth that stops stepping is drawn once more, where it is.
-        self.mesh_dirty |= self.blending && !steps;
-        self.blending = steps;
-        if steps {
+    /// Notes where the cloth is as a fixed step begins, for drawing between that step's
+    /// start and end (`blend`: it steps, and meshes are drawn between steps).
+    pub(crate) fn note_step(&mut self, blend: bool) {
+        // A cloth that stops blending is drawn once more, where it is.
+        self.mesh_dirty |= self.blending && !blend;
+        self.blending = blend;
+        if blend {
             self.previous.clear();
             self.previous.extend_from_slice(self.solver.positions());
         }

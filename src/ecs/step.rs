@@ -9,7 +9,7 @@ use bevy::platform::time::Instant;
 use bevy::prelude::*;
 
 use crate::ecs::cloth::{
-    ClothEnvironment, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
+    ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
 };
 use crate::ecs::events::{ClothFellAsleep, ClothTorn};
 use crate::ecs::sleep::ClothSleep;
@@ -106,6 +106,7 @@ pub(crate) fn begin_steps(
     time: Res<Time>,
     mut pause: ResMut<ClothPause>,
     mut plan: ResMut<ClothSubstepPlan>,
+    interpolation: Option<Res<ClothInterpolation>>,
     mut cloths: Query<
         (
             Entity,
@@ -117,6 +118,7 @@ pub(crate) fn begin_steps(
     >,
 ) {
     let dt = time.delta_secs();
+    let interpolate = interpolation.is_some_and(|i| i.0);
     let run = !pause.paused || pause.pending_steps > 0;
     if pause.paused && run {
         pause.pending_steps -= 1;
@@ -144,7 +146,8 @@ pub(crate) fn begin_steps(
         let start = Instant::now();
         let awake = sleep.is_none_or(|s| !s.asleep);
         let steps = run && awake;
-        sim.note_step(steps);
+        // Where the step begins, kept only when the mesh is drawn between steps.
+        sim.note_step(steps && interpolate);
         let substeps = if steps { sim.solver.begin_step(dt) } else { 0 };
         let progress_now = StepProgress {
             substeps,

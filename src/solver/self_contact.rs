@@ -66,7 +66,7 @@ pub(super) struct SelfContact {
     built_for: Option<(usize, usize)>,
     /// The cloth's rest spacing: the median structural rest length.
     spacing: f32,
-    /// This step's pairs, `i < j`, in the hash's slot order.
+    /// This step's pairs, `i < j`, in the grid's cell order.
     pairs: Vec<[u32; 2]>,
     /// The grid: its box's low corner, its cell size and cells a side, each cell's first
     /// entry in `entries` (particle indices by cell, each cell's in increasing order),
