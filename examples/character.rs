@@ -321,13 +321,7 @@ fn setup(
                 node_mass: 2e-4,
                 ..default()
             }),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::srgb(0.15, 0.35, 0.75),
-            double_sided: true,
-            cull_mode: None,
-            perceptual_roughness: 0.85,
-            ..default()
-        })),
+        MeshMaterial3d(materials.add(fabric(Color::srgb(0.15, 0.35, 0.75), 0.85))),
         Name::new("skirt"),
     ));
     // The back, for the cape to lie against, and the cape hung from the spine joint by
@@ -348,13 +342,7 @@ fn setup(
             }),
         Transform::from_xyz(RADIUS, HIP + SPINE + 0.2, -0.19),
         ClothAttachments(vec![ClothAttachment::indices(spine, (0..width).collect())]),
-        MeshMaterial3d(materials.add(StandardMaterial {
-            base_color: Color::srgb(0.75, 0.12, 0.12),
-            double_sided: true,
-            cull_mode: None,
-            perceptual_roughness: 0.8,
-            ..default()
-        })),
+        MeshMaterial3d(materials.add(fabric(Color::srgb(0.75, 0.12, 0.12), 0.8))),
         Name::new("cape"),
     ));
     common::spawn_stage(
@@ -365,6 +353,17 @@ fn setup(
         4.2,
         0.0,
     );
+}
+
+/// A cloth's material: seen from both sides.
+fn fabric(base_color: Color, perceptual_roughness: f32) -> StandardMaterial {
+    StandardMaterial {
+        base_color,
+        double_sided: true,
+        cull_mode: None,
+        perceptual_roughness,
+        ..default()
+    }
 }
 
 /// The walk: the hips go round the circle facing along it and bob; the thighs swing

@@ -19,24 +19,29 @@ fn animated(local: Vec3, t: f32) -> Vec3 {
     sway * local + bob
 }
 
+/// An unpinned `width × height` grid 5 cm apart with the default parameters, as built.
+fn free_grid(width: u32, height: u32) -> bevy_cloth::solver::ClothSolver {
+    let shape = ClothShape::Grid {
+        width,
+        height,
+        spacing: 0.05,
+    };
+    shape
+        .build_solver(
+            &ClothPins::None,
+            &ClothParams::default(),
+            Affine3A::IDENTITY,
+        )
+        .unwrap()
+}
+
 /// A grid whose top row has distance 0 and whose rows below may swing 2 cm farther each:
 /// every frame of the animation the top row is at its target to 1e-5 m, and no particle
 /// is farther than its distance (+1e-5 m), though gravity and the motion pull them.
 #[test]
 fn particles_stay_within_their_distance_of_animated_targets() {
     let (w, h) = (12u32, 12u32);
-    let shape = ClothShape::Grid {
-        width: w,
-        height: h,
-        spacing: 0.05,
-    };
-    let mut cloth = shape
-        .build_solver(
-            &ClothPins::None,
-            &ClothParams::default(),
-            Affine3A::IDENTITY,
-        )
-        .unwrap();
+    let mut cloth = free_grid(w, h);
     let rest: Vec<Vec3> = cloth.positions().to_vec();
     let radius: Vec<f32> = (0..w * h).map(|k| 0.02 * (k / w) as f32).collect();
     let env = Environment::default();
@@ -76,18 +81,7 @@ fn particles_stay_within_their_distance_of_animated_targets() {
 /// Motion constraints can be dropped: the particles they attached are let go and fall.
 #[test]
 fn motion_constraints_cleared_let_the_cloth_go() {
-    let shape = ClothShape::Grid {
-        width: 4,
-        height: 4,
-        spacing: 0.05,
-    };
-    let mut cloth = shape
-        .build_solver(
-            &ClothPins::None,
-            &ClothParams::default(),
-            Affine3A::IDENTITY,
-        )
-        .unwrap();
+    let mut cloth = free_grid(4, 4);
     let rest = cloth.positions().to_vec();
     cloth.set_motion_constraints(&rest, &[0.0; 16]).unwrap();
     let env = Environment::default();

@@ -947,22 +947,29 @@ fn count_substeps(mut calls: ResMut<SubstepCalls>, mut cloths: Query<&mut ClothS
     }
 }
 
+/// The headless app counting the calls of a game system put between the stages, when
+/// `with_system` (else the count stays 0 and no game system is there).
+fn app_counting_substeps(with_system: bool) -> App {
+    let mut app = app();
+    app.init_resource::<SubstepCalls>();
+    if with_system {
+        app.add_systems(
+            ClothSubstep,
+            count_substeps
+                .after(ClothSubstepSystems::AccumulateForces)
+                .before(ClothSubstepSystems::Integrate),
+        );
+    }
+    app
+}
+
 /// A game's system put between the stages (`ClothSubstepSystems`) runs once per substep;
 /// without one, the plugin steps each cloth's substeps in one task. Both ways the cloths
 /// end on the same bits.
 #[test]
 fn a_system_between_the_stages_runs_every_substep_and_the_bits_do_not_depend_on_it() {
     let run = |with_system: bool| {
-        let mut app = app();
-        app.init_resource::<SubstepCalls>();
-        if with_system {
-            app.add_systems(
-                ClothSubstep,
-                count_substeps
-                    .after(ClothSubstepSystems::AccumulateForces)
-                    .before(ClothSubstepSystems::Integrate),
-            );
-        }
+        let mut app = app_counting_substeps(with_system);
         let params = ClothParams {
             substeps: Substeps::Fixed(5),
             ..quiet_params()
@@ -1299,16 +1306,7 @@ fn the_mesh_is_drawn_between_the_last_two_steps() {
 #[test]
 fn cloths_in_contact_step_together_the_same_on_both_paths() {
     let run = |with_system: bool| {
-        let mut app = app();
-        app.init_resource::<SubstepCalls>();
-        if with_system {
-            app.add_systems(
-                ClothSubstep,
-                count_substeps
-                    .after(ClothSubstepSystems::AccumulateForces)
-                    .before(ClothSubstepSystems::Integrate),
-            );
-        }
+        let mut app = app_counting_substeps(with_system);
         app.world_mut().spawn(ClothCollider::plane());
         let cloths: Vec<Entity> = [0.1, 0.12]
             .into_iter()
