@@ -102,6 +102,12 @@ impl Default for ClothPlugin {
 
 impl ClothPlugin {
     /// Steps cloths in `schedule` (its `Time` delta is the step) and leaves `Time<Fixed>`.
+    ///
+    /// `ClothPlugin::new(PostUpdate)` steps once a frame, by the frame's time, after
+    /// Bevy's animation has posed the joints and the transforms are propagated: the
+    /// choice for cloth on a character animated by an `AnimationClip`, whose skin is then
+    /// read in the pose it is drawn in (on the fixed clock it would be read a frame
+    /// late, as the animation runs after the fixed steps).
     pub fn new(schedule: impl ScheduleLabel) -> Self {
         Self {
             schedule: schedule.intern(),
@@ -147,6 +153,20 @@ impl Plugin for ClothPlugin {
             .add_systems(Update, watch_garments);
 
         app.add_schedule(substep_schedule());
+        // Stepping in `PostUpdate` is stepping after the frame's animation: the step
+        // begins once Bevy's animation and transform propagation have posed the joints
+        // (what a skinned cloth and its bone colliders read) and ends before the meshes
+        // are written, so a cloth is drawn with the pose of the frame it is drawn in, as
+        // game engines run cloth after animation.
+        if self.schedule == PostUpdate.intern() {
+            app.configure_sets(
+                PostUpdate,
+                (
+                    ClothSystems::Prepare.after(TransformSystems::Propagate),
+                    ClothSystems::Finish.before(ClothSystems::WriteMesh),
+                ),
+            );
+        }
 
         app.configure_sets(
             self.schedule,
