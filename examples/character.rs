@@ -1,7 +1,8 @@
 //! A character walking in a circle, wearing a skirt and a cape. The character is a
 //! skinned mesh built in code (as Bevy's custom skinned mesh example builds one: joints
-//! as entities, joint indices and weights on the vertices, inverse bindposes), animated
-//! by moving its joints. The skirt is a cloth made of a skinned mesh
+//! as entities, joint indices and weights on the vertices, inverse bindposes), walked by
+//! an `AnimationClip` of its joints, built in code. The cloths step after the animation
+//! (`ClothPlugin::new(PostUpdate)`). The skirt is a cloth made of a skinned mesh
 //! (`Cloth::from_mesh` on an entity with a `SkinnedMesh`): the plugin skins it on the CPU
 //! every step and keeps each vertex within its painted maximum distance
 //! (`ATTRIBUTE_MAX_DISTANCE`: 0 at the waist, growing to the hem) of where the skin puts
@@ -17,7 +18,9 @@ mod common;
 
 use std::f32::consts::TAU;
 
+use bevy::animation::{AnimatedBy, AnimationTargetId, animated_field};
 use bevy::asset::RenderAssetUsages;
+use bevy::math::curve::{Interval, SampleAutoCurve};
 use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
 use bevy::prelude::*;
@@ -54,15 +57,38 @@ enum Joint {
 
 fn main() {
     let args = common::ExampleArgs::parse("");
-    common::app("bevy_cloth — character", args)
+    // The cloths step after the animation, once a frame: the skirt's skin is read in the
+    // pose the body is drawn in.
+    common::app_with("bevy_cloth — character", args, ClothPlugin::new(PostUpdate))
         .add_plugins(common::tools::ToolsPlugin)
-        // The joints move on the fixed clock, before the cloth's step; the body is drawn
-        // where the last step left it, so the cloth is too (not between steps).
-        .insert_resource(ClothInterpolation(false))
-        .add_systems(Startup, setup)
-        .add_systems(FixedUpdate, walk.before(ClothSystems::Prepare))
+        .add_systems(Startup, (setup, animate).chain())
         .add_systems(Update, follow)
         .run();
+}
+
+/// Plays the walk on the skeleton: the hips hold the animation player, and every joint
+/// is a target of the clip, named by its `Name`.
+fn animate(
+    mut commands: Commands,
+    mut clips: ResMut<Assets<AnimationClip>>,
+    mut graphs: ResMut<Assets<AnimationGraph>>,
+    joints: Query<(Entity, &Joint, &Name)>,
+) {
+    let Some((hips, ..)) = joints.iter().find(|(_, j, _)| matches!(j, Joint::Hips)) else {
+        return;
+    };
+    let mut targets = Vec::new();
+    for (entity, &joint, name) in &joints {
+        let target = AnimationTargetId::from_name(name);
+        commands.entity(entity).insert((target, AnimatedBy(hips)));
+        targets.push((joint, target));
+    }
+    let (graph, walk) = AnimationGraph::from_clip(clips.add(walk_clip(&targets)));
+    let mut player = AnimationPlayer::default();
+    player.play(walk).repeat();
+    commands
+        .entity(hips)
+        .insert((player, AnimationGraphHandle(graphs.add(graph))));
 }
 
 /// Where a point `v` of the body in its bind pose is weighted, for the body's joints
@@ -366,35 +392,64 @@ fn fabric(base_color: Color, perceptual_roughness: f32) -> StandardMaterial {
     }
 }
 
-/// The walk: the hips go round the circle facing along it and bob; the thighs swing
-/// (±25°) in opposite phase, each knee bends as its leg comes forward, and the spine
-/// turns against the hips.
-fn walk(time: Res<Time>, mut joints: Query<(&Joint, &mut Transform)>) {
-    let t = time.elapsed_secs();
+/// The walk at time `t` (s) of its `LAP`-long loop: the hips go round the circle facing
+/// along it and bob; the thighs swing (±25°) in opposite phase, each knee bends as its
+/// leg comes forward, and the spine turns against the hips. A joint's translation (only
+/// the hips move theirs) and rotation.
+fn walk(joint: Joint, t: f32) -> (Option<Vec3>, Quat) {
     let lap = TAU * t / LAP;
     let stride = TAU * t / STRIDE;
-    for (joint, mut transform) in &mut joints {
-        match *joint {
-            Joint::Hips => {
-                let along = Vec3::new(-lap.sin(), 0.0, lap.cos());
-                transform.translation = Vec3::new(
-                    RADIUS * lap.cos(),
-                    HIP + 0.015 * (2.0 * stride).cos(),
-                    RADIUS * lap.sin(),
-                );
-                transform.rotation = Quat::from_rotation_y(along.x.atan2(along.z))
-                    * Quat::from_rotation_z(0.03 * stride.sin());
-            }
-            Joint::Spine => transform.rotation = Quat::from_rotation_y(-0.12 * stride.sin()),
-            Joint::Thigh(side) => {
-                transform.rotation = Quat::from_rotation_x(-0.45 * side * stride.sin());
-            }
-            Joint::Knee(side) => {
-                let bend = (side * stride.cos()).max(0.0);
-                transform.rotation = Quat::from_rotation_x(0.7 * bend);
-            }
+    match joint {
+        Joint::Hips => {
+            let along = Vec3::new(-lap.sin(), 0.0, lap.cos());
+            let at = Vec3::new(
+                RADIUS * lap.cos(),
+                HIP + 0.015 * (2.0 * stride).cos(),
+                RADIUS * lap.sin(),
+            );
+            let turn = Quat::from_rotation_y(along.x.atan2(along.z))
+                * Quat::from_rotation_z(0.03 * stride.sin());
+            (Some(at), turn)
+        }
+        Joint::Spine => (None, Quat::from_rotation_y(-0.12 * stride.sin())),
+        Joint::Thigh(side) => (None, Quat::from_rotation_x(-0.45 * side * stride.sin())),
+        Joint::Knee(side) => {
+            let bend = (side * stride.cos()).max(0.0);
+            (None, Quat::from_rotation_x(0.7 * bend))
         }
     }
+}
+
+/// The walk as an `AnimationClip` (what a game would load from its character's file):
+/// each joint's translation and rotation sampled 30 times a second over the loop, the
+/// joint named by its `AnimationTargetId`.
+fn walk_clip(joints: &[(Joint, AnimationTargetId)]) -> AnimationClip {
+    let keys = (LAP * 30.0) as usize;
+    let domain = Interval::new(0.0, LAP).expect("the loop has a length");
+    let times = move || (0..=keys).map(move |k| LAP * k as f32 / keys as f32);
+    let mut clip = AnimationClip::default();
+    for &(joint, target) in joints {
+        let rotations = SampleAutoCurve::new(domain, times().map(|t| walk(joint, t).1));
+        clip.add_curve_to_target(
+            target,
+            AnimatableCurve::new(
+                animated_field!(Transform::rotation),
+                rotations.expect("two keys or more"),
+            ),
+        );
+        if walk(joint, 0.0).0.is_some() {
+            let translations =
+                SampleAutoCurve::new(domain, times().map(|t| walk(joint, t).0.unwrap()));
+            clip.add_curve_to_target(
+                target,
+                AnimatableCurve::new(
+                    animated_field!(Transform::translation),
+                    translations.expect("two keys or more"),
+                ),
+            );
+        }
+    }
+    clip
 }
 
 /// The camera's focus follows the hips (the orbit camera still turns and zooms round it).

@@ -51,12 +51,21 @@ pub fn run(title: &str, default_scene: &str, focus: Vec3, radius: f32) {
 /// inspector, the orbit camera, screenshots (`args`) and the sky. The scene examples add the
 /// mouse tools; an example with keys of its own leaves them out.
 pub fn app(title: &str, args: ExampleArgs) -> App {
+    app_with(
+        title,
+        args,
+        ClothPlugin::default().with_timestep(std::time::Duration::from_millis(16)),
+    )
+}
+
+/// [`app`] with the cloths stepped as `cloth` says.
+pub fn app_with(title: &str, args: ExampleArgs, cloth: ClothPlugin) -> App {
     let mut app = App::new();
     app.add_plugins((
         DefaultPlugins.set(window_plugin(title)),
         EguiPlugin::default(),
         PanOrbitCameraPlugin,
-        ClothPlugin::default().with_timestep(std::time::Duration::from_millis(16)),
+        cloth,
         ClothControlsPlugin,
         inspector::InspectorPlugin,
         ScreenshotPlugin,
