@@ -665,7 +665,7 @@ mod walk_gltf {
         ) -> usize {
             let offset = self.bytes.len();
             self.bytes.extend_from_slice(data);
-            while self.bytes.len() % 4 != 0 {
+            while !self.bytes.len().is_multiple_of(4) {
                 self.bytes.push(0);
             }
             self.views
