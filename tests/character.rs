@@ -108,6 +108,80 @@ fn motion_constraints_cleared_let_the_cloth_go() {
     );
 }
 
+/// Distances painted anew: a 6 × 6 grid lying flat with a layout pin at a corner of its
+/// first row (particle 5), held by its first row (distance 0), then by its last row
+/// with the first row given 5 cm, then by both rows. Each time exactly the particles of
+/// distance 0 are attached, each at its own moving target; the far corner let go falls
+/// within its 5 cm; the layout's pin, held to a target while its distance is 0, goes
+/// back to its pinned place when it is not.
+#[test]
+fn distances_painted_anew_attach_and_let_go_the_right_particles() {
+    let shape = ClothShape::Grid {
+        width: 6,
+        height: 6,
+        spacing: 0.05,
+    };
+    let mut cloth = shape
+        .build_solver(
+            &ClothPins::Indices(vec![5]),
+            &ClothParams::default(),
+            // Lying flat, so that a particle let go falls.
+            Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        )
+        .unwrap();
+    let rest = cloth.positions().to_vec();
+    let env = Environment::default();
+    let first: Vec<u32> = (0..6).collect();
+    let last: Vec<u32> = (30..36).collect();
+    let both: Vec<u32> = first.iter().chain(&last).copied().collect();
+    let paint = |zero: &[u32], other: f32| -> Vec<f32> {
+        (0..36u32)
+            .map(|i| if zero.contains(&i) { 0.0 } else { other })
+            .collect()
+    };
+    for (held, distances) in [
+        (&first, paint(&first, f32::INFINITY)),
+        (&last, paint(&last, 0.05)),
+        (&both, paint(&both, f32::INFINITY)),
+    ] {
+        let mut targets = rest.clone();
+        for frame in 0..40 {
+            let shift = Vec3::new(0.005 * frame as f32, 0.0, 0.0);
+            targets = rest.iter().map(|&x| x + shift).collect();
+            cloth.set_motion_constraints(&targets, &distances).unwrap();
+            cloth.step(1.0 / 60.0, &env);
+            let x = cloth.positions();
+            for &i in held {
+                let off = x[i as usize].distance(targets[i as usize]);
+                assert!(off < 1e-5, "particle {i} is {off} m off its target");
+            }
+        }
+        // Attached: those of distance 0 but the layout's pin (a pin already).
+        let mut attached = cloth.attached().to_vec();
+        attached.sort();
+        let expected: Vec<u32> = held.iter().copied().filter(|&i| i != 5).collect();
+        assert_eq!(
+            attached, expected,
+            "exactly the particles of distance 0 are attached"
+        );
+        let x = cloth.positions();
+        if !held.contains(&0) {
+            let fell = rest[0].y - x[0].y;
+            let off = x[0].distance(targets[0]);
+            eprintln!("the far corner let go fell {fell} m, {off} m from its target");
+            assert!(fell > 0.01, "the far corner, let go, falls: {fell} m");
+            assert!(off <= 0.05 + 1e-5, "within its distance: {off} m");
+        }
+        if !held.contains(&5) {
+            let off = x[5].distance(rest[5]);
+            assert!(
+                off < 1e-5,
+                "the layout's pin is back at its place: {off} m off"
+            );
+        }
+    }
+}
+
 // ----- a cloth built from a skinned mesh, in the plugin ------------------------------
 
 use bevy::asset::RenderAssetUsages;

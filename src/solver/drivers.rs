@@ -40,6 +40,9 @@ pub(super) struct Motion {
     pub radius: Vec<f32>,
     /// The targets given for the next step.
     pub next: Vec<Vec3>,
+    /// Each particle's place among the pins while the constraints are set (kept for its
+    /// storage).
+    pub slot: Vec<u32>,
 }
 
 impl Motion {
@@ -143,6 +146,13 @@ impl ClothSolver {
     /// until [`ClothSolver::detach`] or a reset; the patch model's parts are rebuilt to
     /// hang from it.
     pub fn attach(&mut self, i: u32, target: Vec3) -> Result<(), ClothError> {
+        let slot = self.drivers.pins.iter().position(|&p| p == i);
+        self.attach_in(i, target, slot)
+    }
+
+    /// [`ClothSolver::attach`] with the particle's place among the pins known (`None`:
+    /// not held yet).
+    fn attach_in(&mut self, i: u32, target: Vec3, slot: Option<usize>) -> Result<(), ClothError> {
         let count = self.particles.len();
         if i as usize >= count {
             return Err(ClothError::PinOutOfRange { index: i, count });
@@ -154,7 +164,7 @@ impl ClothSolver {
                 expected: "a finite point within 1e5 m (limits::MAX_POSITION)",
             });
         }
-        if let Some(k) = self.drivers.pins.iter().position(|&p| p == i) {
+        if let Some(k) = slot {
             self.disturbed |= self.drivers.pin_goal[k] != Some(target);
             self.drivers.pin_goal[k] = Some(target);
             return Ok(());
@@ -221,14 +231,29 @@ impl ClothSolver {
             });
         }
         let was = std::mem::take(&mut self.drivers.motion.radius);
+        // Each particle's place among the pins (`u32::MAX`: none), so that holding a
+        // body's thousands of particles of distance 0 is a lookup each, not a search of
+        // the pins. Attaching only appends pins, which keeps the places; the particles
+        // let go (rare: their distance was painted anew) are detached after.
+        let mut slot = std::mem::take(&mut self.drivers.motion.slot);
+        slot.clear();
+        slot.resize(n, u32::MAX);
+        for (k, &p) in self.drivers.pins.iter().enumerate() {
+            slot[p as usize] = k as u32;
+        }
         for (i, (&r, &target)) in max_distance.iter().zip(targets).enumerate() {
             if r == 0.0 {
-                self.attach(i as u32, target)?;
-            } else if was.get(i) == Some(&0.0) {
+                let held = (slot[i] != u32::MAX).then_some(slot[i] as usize);
+                self.attach_in(i as u32, target, held)?;
+            }
+        }
+        for (i, &r) in max_distance.iter().enumerate() {
+            if r != 0.0 && was.get(i) == Some(&0.0) {
                 self.detach(i as u32);
             }
         }
         let motion = &mut self.drivers.motion;
+        motion.slot = slot;
         motion.radius = was;
         motion.radius.clear();
         motion.radius.extend_from_slice(max_distance);
