@@ -44,13 +44,14 @@ fn main() {
             v[v.len() / 2]
         };
         println!(
-            "self-collision {}: begin {:.3} ms, constraints {:.3}, self {:.3}, total {:.3} (pairs {})",
+            "self-collision {}: begin {:.3} ms, constraints {:.3}, self {:.3}, total {:.3} (pairs {}, listed {} times in 60 steps)",
             if on { "on " } else { "off" },
             median(0),
             median(1),
             median(2),
             median(3),
-            cloth.self_collision_pairs()
+            cloth.self_collision_pairs(),
+            cloth.self_collision_listings()
         );
     }
 }

@@ -117,6 +117,12 @@ impl ClothSolver {
         self.self_contact.pair_count()
     }
 
+    /// How many times self-collision has listed its pairs: at most once a step, when a
+    /// particle has moved out of the last list's reach.
+    pub fn self_collision_listings(&self) -> u64 {
+        self.self_contact.listings()
+    }
+
     /// The pairs self-collision pushed apart in the last step (a pair counts once per
     /// substep it was pushed in).
     pub fn self_collision_pushes(&self) -> usize {

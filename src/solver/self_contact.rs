@@ -87,6 +87,8 @@ pub(super) struct SelfContact {
     /// mean position then (`None`: no list).
     listed_at: Vec<Vec3>,
     listed: Option<(f32, Vec3)>,
+    /// How many lists have been made.
+    listings: u64,
     /// The other cloths' particles near this one, for the step about to begin ([`collide_cloths`]).
     others: Vec<Other>,
     /// This step's pairs of a particle and another cloth's, `[i, k]` (`k` in `others`).
@@ -123,6 +125,12 @@ impl SelfContact {
     /// Whether the last [`collide_cloths`] gave this cloth other cloths' particles.
     pub fn touches_others(&self) -> bool {
         !self.others.is_empty()
+    }
+
+    /// How many times the pairs have been listed (once a step at most, when the list
+    /// made before no longer holds).
+    pub fn listings(&self) -> u64 {
+        self.listings
     }
 
     /// Pairs pushed apart since the step began (a pair counts once per substep).
@@ -180,6 +188,7 @@ impl SelfContact {
         }
         self.listed_at.clone_from(&p.position);
         self.listed = Some((d, centre));
+        self.listings += 1;
     }
 
     /// Whether the last list still holds for `d`: no free particle has moved more than
