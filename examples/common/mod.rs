@@ -307,6 +307,7 @@ impl Plugin for ScreenshotPlugin {
 
 fn take_screenshots(
     mut commands: Commands,
+    time: Res<Time>,
     args: Res<ExampleArgs>,
     mut state: ResMut<ScreenshotState>,
     mut exit: MessageWriter<AppExit>,
@@ -321,6 +322,13 @@ fn take_screenshots(
     }
     for (frame, path) in &args.screenshots {
         if *frame == state.frame {
+            // The app's time too: under a software renderer a frame can be far longer
+            // than a 60th of a second.
+            info!(
+                "screenshot {} at frame {frame}, {:.2} s in",
+                path.display(),
+                time.elapsed_secs()
+            );
             commands
                 .spawn((Screenshot::primary_window(), PendingScreenshot))
                 .observe(save_to_disk(path.clone()))
