@@ -882,23 +882,15 @@ struct GltfWalk {
     walked: f32,
 }
 
-/// Loads `walk.gltf` (written by [`walk_gltf::write`]) as a user's character: the scene
-/// spawned, the skirt's mesh entity (found by its glTF mesh name) made a cloth, the walk
-/// played by the scene's animation player; the cloths step in `schedule`. Measures 110
-/// frames of 16 ms (within the 2 s clip) once the cloth is built.
-fn walk_a_gltf_character(
-    schedule: impl bevy::ecs::schedule::ScheduleLabel,
-    name: &str,
-) -> GltfWalk {
-    use bevy::animation::{AnimationPlugin, graph::AnimationGraphHandle};
-    use bevy::gltf::{GltfAssetLabel, GltfMeshName, GltfPlugin};
+/// A headless app that loads glTF files from `dir` and plays their animations, its
+/// cloths stepping in `schedule` every 16 ms update.
+fn gltf_app(dir: &std::path::Path, schedule: impl bevy::ecs::schedule::ScheduleLabel) -> App {
+    use bevy::animation::AnimationPlugin;
+    use bevy::gltf::{GltfMeshName, GltfPlugin};
     use bevy::time::TimeUpdateStrategy;
-    use bevy::world_serialization::{WorldAssetRoot, WorldInstanceReady, WorldSerializationPlugin};
-    use std::time::Duration;
+    use bevy::world_serialization::WorldSerializationPlugin;
 
-    let dir = std::env::temp_dir().join(format!("bevy_cloth_gltf_{}_{name}", std::process::id()));
-    walk_gltf::write(&dir);
-    let step = Duration::from_millis(16);
+    let step = std::time::Duration::from_millis(16);
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
@@ -940,6 +932,27 @@ fn walk_a_gltf_character(
     // The glTF loader is registered when the plugins finish (`App::run` would do it).
     app.finish();
     app.cleanup();
+    app
+}
+
+/// Loads `walk.gltf` (written by [`walk_gltf::write`]) as a user's character: the scene
+/// spawned, the skirt's mesh entity (found by its glTF mesh name) made a cloth, the walk
+/// played by the scene's animation player; the cloths step in `schedule`. Measures 110
+/// frames of 16 ms (within the 2 s clip) once the cloth is built.
+fn walk_a_gltf_character(
+    schedule: impl bevy::ecs::schedule::ScheduleLabel,
+    name: &str,
+) -> GltfWalk {
+    use bevy::animation::graph::AnimationGraphHandle;
+    use bevy::gltf::{GltfAssetLabel, GltfMeshName};
+    use bevy::world_serialization::{WorldAssetRoot, WorldInstanceReady};
+    use std::time::Duration;
+
+    let dir = std::env::temp_dir().join(format!("bevy_cloth_gltf_{}_{name}", std::process::id()));
+    walk_gltf::write(&dir);
+    let mut app = gltf_app(&dir, schedule);
+    // The plugin draws between steps exactly when they are fixed ones.
+    let fixed = app.world().resource::<ClothInterpolation>().0;
     let server = app.world().resource::<AssetServer>().clone();
     let scene = server.load(GltfAssetLabel::Scene(0).from_asset("walk.gltf"));
     let clip = server.load(GltfAssetLabel::Animation(0).from_asset("walk.gltf"));
@@ -1043,7 +1056,7 @@ fn walk_a_gltf_character(
         let drawn = skin(drawn_pose);
         // In the fixed schedule the step read the pose the last update left; after the
         // animation (`PostUpdate`), the one drawn now.
-        let read = match (schedule_is_fixed(&app), before) {
+        let read = match (fixed, before) {
             (true, Some(before)) => skin(before),
             (true, None) => continue, // the first frame: no pose before it was measured
             (false, _) => drawn.clone(),
@@ -1100,11 +1113,6 @@ fn walk_a_gltf_character(
         walk.swing
     );
     walk
-}
-
-/// Whether the app's cloths step in a fixed schedule (their drawing is interpolated then).
-fn schedule_is_fixed(app: &App) -> bool {
-    app.world().resource::<ClothInterpolation>().0
 }
 
 /// A character exported to glTF (a skirt skinned to two joints, its maximum distances in a
