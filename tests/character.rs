@@ -688,19 +688,27 @@ mod walk_gltf {
 
     use super::{COLUMNS, ROWS, STEP};
 
-    pub const ARMATURE: Vec3 = Vec3::new(0.5, 0.0, 0.0);
-    pub const HIPS: Vec3 = Vec3::new(0.0, 1.0, 0.0);
-    pub const KNEE: Vec3 = Vec3::new(0.0, -0.16, 0.0);
+    const ARMATURE: Vec3 = Vec3::new(0.5, 0.0, 0.0);
+    const HIPS: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+    const KNEE: Vec3 = Vec3::new(0.0, -0.16, 0.0);
     /// The animation's length (s) and its keys a second.
     const LENGTH: f32 = 2.0;
     const KEYS: u32 = 30;
 
     /// The hips' translation and the knee's rotation at time `t` of the walk.
-    pub fn hips_at(t: f32) -> Vec3 {
+    fn hips_at(t: f32) -> Vec3 {
         HIPS + Vec3::new(1.2 * t, 0.02 * (2.0 * TAU * t).sin(), 0.0)
     }
-    pub fn knee_at(t: f32) -> Quat {
+    fn knee_at(t: f32) -> Quat {
         Quat::from_rotation_x(0.7 * (TAU * t).sin())
+    }
+
+    /// The joints' bind poses (global, the armature's offset included), inverted: hips,
+    /// knee.
+    pub fn inverse_bindposes() -> [Mat4; 2] {
+        let hips_bind = Mat4::from_translation(ARMATURE + HIPS);
+        let knee_bind = hips_bind * Mat4::from_translation(KNEE);
+        [hips_bind.inverse(), knee_bind.inverse()]
     }
 
     /// The panel's vertices in the bind pose: position, joints' weights (hips, knee) and
@@ -801,10 +809,7 @@ mod walk_gltf {
         }
         let index_bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
         let index = buffer.add(&index_bytes, 5125, "SCALAR", indices.len(), json!({}));
-        // The joints' bind poses (global, the armature's offset included), inverted.
-        let hips_bind = Mat4::from_translation(ARMATURE + HIPS);
-        let knee_bind = hips_bind * Mat4::from_translation(KNEE);
-        let inverse: Vec<f32> = [hips_bind.inverse(), knee_bind.inverse()]
+        let inverse: Vec<f32> = inverse_bindposes()
             .iter()
             .flat_map(|m| m.to_cols_array())
             .collect();
@@ -985,12 +990,7 @@ fn walk_a_gltf_character(
             },
         );
     let vertices = walk_gltf::vertices();
-    let inverse = [
-        Mat4::from_translation(walk_gltf::ARMATURE + walk_gltf::HIPS).inverse(),
-        (Mat4::from_translation(walk_gltf::ARMATURE + walk_gltf::HIPS)
-            * Mat4::from_translation(walk_gltf::KNEE))
-        .inverse(),
-    ];
+    let inverse = walk_gltf::inverse_bindposes();
     let joint = |app: &App, name: &str| -> GlobalTransform {
         let world = app.world();
         let mut q = world.try_query::<(&Name, &GlobalTransform)>().unwrap();
