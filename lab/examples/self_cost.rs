@@ -14,7 +14,7 @@ fn main() {
     let substeps: u32 = std::env::var("SUBSTEPS").map_or(5, |s| s.parse().expect("SUBSTEPS"));
     bevy_cloth::solver::set_parallel(std::env::var("ONE").is_err());
     for on in [false, true] {
-        let mut params = ours_params(substeps, true);
+        let mut params = ours_params(substeps, true, true);
         if on {
             params.self_collision = SelfCollision::on();
         }

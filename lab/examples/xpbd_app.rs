@@ -25,7 +25,7 @@ fn main() {
                 .spawn((
                     Cloth::grid(256, 256, 0.05)
                         .with_pins(ClothPins::TopRow)
-                        .with_params(ours_params(substeps, true)),
+                        .with_params(ours_params(substeps, true, true)),
                     Transform::from_xyz(0.0, 2.0, 0.0),
                     ClothSleep::never(),
                 ))

@@ -10,7 +10,9 @@
 //!   cloth's rest height (what a viewer sees as stretch).
 //!
 //! The solvers:
-//! - ours: XPBD with every in-plane family inextensible (`k = inf`), at fixed substeps;
+//! - ours: XPBD with every in-plane family inextensible (`k = inf`), at fixed substeps,
+//!   its stretch constraints solved along lines (the default) or swept (the solver
+//!   before lines), with and without tethers;
 //! - rapier-cloth-core 0.3 (CPU XPBD, area masses, long-range tethers to its pins), its
 //!   steps a frame and iterations a step swept;
 //! - [`Sticks`]: the classic position Verlet with stick projection (Jakobsen 2001,
@@ -25,7 +27,9 @@ use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
 use bevy_cloth::layout::shape::{ClothPins, ClothShape};
-use bevy_cloth::params::{ClothParams, Environment, Model, SpringFamily, Substeps, XpbdParams};
+use bevy_cloth::params::{
+    ClothParams, Environment, Model, SpringFamily, Substeps, XpbdParams, XpbdSolve,
+};
 use bevy_cloth::stats::median;
 
 /// Rest spacing of the grid, m.
@@ -82,6 +86,8 @@ pub enum Peer {
         tethers: bool,
         /// Self-collision on (at the rest spacing).
         self_collision: bool,
+        /// The stretch constraints solved along lines (`XpbdSolve::Lines`), or swept.
+        lines: bool,
     },
     /// rapier-cloth-core: `steps` steps a frame of `iterations` iterations each.
     Rapier {
@@ -98,7 +104,7 @@ pub enum Peer {
 }
 
 /// The solvers by the names `cloth peers --solvers` takes.
-pub const PEER_SOLVERS: [&str; 5] = ["ours", "tethers", "self", "rapier", "sticks"];
+pub const PEER_SOLVERS: [&str; 6] = ["ours", "tethers", "lines", "self", "rapier", "sticks"];
 
 impl Peer {
     /// The solver's name in [`PEER_SOLVERS`].
@@ -108,6 +114,7 @@ impl Peer {
                 self_collision: true,
                 ..
             } => "self",
+            Peer::Ours { lines: true, .. } => "lines",
             Peer::Ours { tethers: false, .. } => "ours",
             Peer::Ours { tethers: true, .. } => "tethers",
             Peer::Rapier { .. } => "rapier",
@@ -121,9 +128,10 @@ impl Peer {
             Peer::Ours {
                 self_collision: true,
                 ..
-            } => "bevy_cloth XPBD + tethers + self-collision",
-            Peer::Ours { tethers: false, .. } => "bevy_cloth XPBD",
-            Peer::Ours { tethers: true, .. } => "bevy_cloth XPBD + tethers",
+            } => "bevy_cloth XPBD lines + tethers + self-collision",
+            Peer::Ours { lines: true, .. } => "bevy_cloth XPBD lines + tethers",
+            Peer::Ours { tethers: false, .. } => "bevy_cloth XPBD sweep",
+            Peer::Ours { tethers: true, .. } => "bevy_cloth XPBD sweep + tethers",
             Peer::Rapier { .. } => "rapier-cloth-core 0.3",
             Peer::Sticks { .. } => "Verlet + sticks",
         }
@@ -144,11 +152,13 @@ impl Peer {
 /// The default sweep: each solver from cheap and loose to dear and tight.
 pub fn default_peers() -> Vec<Peer> {
     let mut peers = Vec::new();
+    // The sweep (the solver before lines), alone and with tethers.
     for substeps in [5, 10, 20, 40, 80] {
         peers.push(Peer::Ours {
             substeps,
             tethers: false,
             self_collision: false,
+            lines: false,
         });
     }
     for substeps in [1, 2, 5, 10, 20, 40, 80] {
@@ -156,15 +166,25 @@ pub fn default_peers() -> Vec<Peer> {
             substeps,
             tethers: true,
             self_collision: false,
+            lines: false,
         });
     }
-    // What self-collision costs: the tethered configurations a game would pick, again
-    // with it on.
-    for substeps in [5, 10, 20] {
+    // The default: lines and tethers.
+    for substeps in [1, 2, 3, 4, 5, 10, 20, 40] {
+        peers.push(Peer::Ours {
+            substeps,
+            tethers: true,
+            self_collision: false,
+            lines: true,
+        });
+    }
+    // What self-collision costs: the configurations a game would pick, again with it on.
+    for substeps in [2, 5, 10] {
         peers.push(Peer::Ours {
             substeps,
             tethers: true,
             self_collision: true,
+            lines: true,
         });
     }
     for (steps, iterations) in [(1, 2), (1, 4), (1, 8), (1, 16), (2, 8), (4, 8)] {
@@ -289,8 +309,9 @@ pub fn measure(side: usize, hang: Hang, peer: Peer, frames: usize) -> Result<Pee
             substeps,
             tethers,
             self_collision,
+            lines,
         } => {
-            let mut params = ours_params(substeps, tethers);
+            let mut params = ours_params(substeps, tethers, lines);
             params.self_collision.enabled = self_collision;
             Box::new(Ours::new(side, hang, &params)?)
         }
@@ -387,11 +408,17 @@ fn gravity() -> Vec3 {
 // ----- ours -----------------------------------------------------------------------------
 
 /// Our parameters for the bench: XPBD at `substeps`, structural and shear inextensible,
-/// bend at the default stiffness, the bench's mass and damping.
-pub fn ours_params(substeps: u32, tethers: bool) -> ClothParams {
+/// bend at the default stiffness, the bench's mass and damping; the stretch solved along
+/// lines or swept.
+pub fn ours_params(substeps: u32, tethers: bool, lines: bool) -> ClothParams {
     let mut params = ClothParams {
         model: Model::Xpbd(XpbdParams {
             tethers,
+            solve: if lines {
+                XpbdSolve::Lines
+            } else {
+                XpbdSolve::Sweep
+            },
             ..XpbdParams::default()
         }),
         node_mass: NODE_MASS,

@@ -243,11 +243,19 @@ fn the_peer_bench_times_every_solver_and_never_a_failed_run() {
             substeps: 5,
             tethers: true,
             self_collision: false,
+            lines: false,
+        },
+        Peer::Ours {
+            substeps: 5,
+            tethers: true,
+            self_collision: false,
+            lines: true,
         },
         Peer::Ours {
             substeps: 5,
             tethers: true,
             self_collision: true,
+            lines: true,
         },
         Peer::Rapier {
             steps: 1,

@@ -1,6 +1,7 @@
 //! Stage 2 of a substep, the integrators the models share: Störmer–Verlet and
 //! semi-implicit (symplectic) Euler, piece by piece over the compute pool.
 
+use super::chains::compensated_add;
 use super::parallel;
 use super::state::ParticlePiece;
 use super::{ClothSolver, Particles};
@@ -14,7 +15,9 @@ impl ClothSolver {
         let h = self.clock.h;
         match self.params.integrator {
             Integrator::Verlet => verlet(&mut self.particles, h, drag),
-            Integrator::SemiImplicitEuler => symplectic_euler(&mut self.particles, h, drag),
+            Integrator::SemiImplicitEuler => {
+                symplectic_euler::<false>(&mut self.particles, h, drag)
+            }
         }
     }
 
@@ -88,14 +91,17 @@ pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
 }
 
 /// One symplectic Euler substep of every free particle, in pieces over the compute pool,
-/// with implicit drag.
-pub(crate) fn symplectic_euler(p: &mut Particles, h: f32, drag: f32) {
+/// with implicit drag. `COMPENSATED`: the position's step `h v` is added with what
+/// rounding lost kept in the residue (as Verlet's), so a step far below a float spacing
+/// of the position still moves it over many substeps.
+pub(crate) fn symplectic_euler<const COMPENSATED: bool>(p: &mut Particles, h: f32, drag: f32) {
     let n = p.len();
     // Seed 000 eq. 21–22: the new velocity first, then the position from it.
     let kernel = |ParticlePiece {
                       position,
                       previous,
                       velocity,
+                      residue,
                       force,
                       inv_mass,
                       lump,
@@ -103,14 +109,18 @@ pub(crate) fn symplectic_euler(p: &mut Particles, h: f32, drag: f32) {
                   }| {
         let n = position.len();
         let (x, previous, v) = (&mut position[..n], &mut previous[..n], &mut velocity[..n]);
-        let (f, w, lump) = (&force[..n], &inv_mass[..n], &lump[..n]);
+        let (f, w, lump, residue) = (&force[..n], &inv_mass[..n], &lump[..n], &mut residue[..n]);
         for i in 0..n {
             if w[i] == 0.0 {
                 continue;
             }
             v[i] = (v[i] + f[i] * (w[i] * h)) * drag_factor(h, drag, lump[i], w[i]);
             previous[i] = x[i];
-            x[i] += v[i] * h;
+            if COMPENSATED {
+                compensated_add(&mut x[i], &mut residue[i], v[i] * h);
+            } else {
+                x[i] += v[i] * h;
+            }
         }
     };
     parallel::for_each(n, p.pieces(), kernel);
@@ -147,7 +157,7 @@ mod tests {
         assert_eq!(p.position[1], Vec3::ONE);
 
         start(&mut p);
-        symplectic_euler(&mut p, h, 0.0);
+        symplectic_euler::<false>(&mut p, h, 0.0);
         let v = Vec3::new(1.0, -1.0, 0.0) + a * h;
         assert!(p.velocity[0].distance(v) < 1e-6);
         assert!(p.position[0].distance(Vec3::new(1.0, 2.0, 3.0) + v * h) < 1e-6);

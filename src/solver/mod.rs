@@ -8,6 +8,7 @@
 
 mod bending;
 mod build;
+mod chains;
 mod clock;
 mod collide;
 mod contact;

@@ -25,6 +25,7 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
+use super::chains::Chains;
 use super::parallel::{self, PIECE};
 use super::tethers::Tethers;
 use super::{Particles, SpringKind, Springs};
@@ -63,6 +64,9 @@ pub(super) struct Constraints {
     predicted: Vec<Vec3>,
     /// Long-range attachments to the pins (`tethers.rs`), projected after the colours.
     pub tethers: Tethers,
+    /// The structural constraints as chains, solved exactly along each
+    /// (`chains.rs`; [`XpbdSolve::Lines`](crate::params::XpbdSolve::Lines)).
+    pub chains: Chains,
 }
 
 /// What one family's constraints take in a substep.
@@ -134,6 +138,7 @@ impl Constraints {
             colours,
             predicted: Vec::with_capacity(n),
             tethers: Tethers::default(),
+            chains: Chains::default(),
         };
         debug_assert!(constraints.colours_are_disjoint(n));
         constraints

@@ -6,9 +6,11 @@
 //! change from the prediction over `h`.
 
 use super::ModelSteps;
-use crate::params::{Environment, XpbdParams};
+use crate::params::{Environment, XpbdParams, XpbdSolve};
+use crate::solver::chains::Chains;
 use crate::solver::integrate::symplectic_euler;
-use crate::solver::{ClothSolver, ModelState, SpringKind, family_stiffness, xpbd};
+use crate::solver::lattice::Stencil;
+use crate::solver::{ClothSolver, ModelState, Particles, SpringKind, family_stiffness, xpbd};
 
 impl ModelSteps for XpbdParams {
     /// A cloth's springs never change (they only tear): the constraints are built once
@@ -18,17 +20,22 @@ impl ModelSteps for XpbdParams {
             let n = cloth.particles.len();
             // A grid is projected on its stencil: no constraint lists.
             let general = cloth.structure.stencil.is_none();
-            let constraints = xpbd::Constraints::new(&cloth.structure.springs, n, general);
+            let springs = &cloth.structure.springs;
+            let mut constraints = xpbd::Constraints::new(springs, n, general);
+            constraints.chains = Chains::new(springs, &cloth.structure.local_rest);
             cloth.model = ModelState::Xpbd(Box::new(constraints));
         }
     }
 
     /// This step's seam lengths, torn springs and pins.
     fn prepare(&self, cloth: &mut ClothSolver, _dt: f32) {
-        if let ModelState::Xpbd(constraints) = &mut cloth.model
-            && cloth.structure.stencil.is_none()
-        {
-            constraints.sync(&cloth.structure.springs);
+        if let ModelState::Xpbd(constraints) = &mut cloth.model {
+            if cloth.structure.stencil.is_none() {
+                constraints.sync(&cloth.structure.springs);
+            }
+            if self.solve == XpbdSolve::Lines {
+                constraints.chains.sync(&cloth.structure.springs);
+            }
         }
         refresh_tethers(cloth, self);
     }
@@ -38,9 +45,14 @@ impl ModelSteps for XpbdParams {
         cloth.external_forces(env);
     }
 
-    /// The prediction `v += h f/m`, `x += h v`, whatever the integrator setting.
+    /// The prediction `v += h f/m`, `x += h v`, whatever the integrator setting; with
+    /// lines, the position's step compensated (`chains.rs`).
     fn integrate(&self, cloth: &mut ClothSolver) {
-        symplectic_euler(&mut cloth.particles, cloth.clock.h, cloth.params.drag);
+        let (p, h, drag) = (&mut cloth.particles, cloth.clock.h, cloth.params.drag);
+        match self.solve {
+            XpbdSolve::Lines => symplectic_euler::<true>(p, h, drag),
+            XpbdSolve::Sweep => symplectic_euler::<false>(p, h, drag),
+        }
     }
 
     /// Every spring's constraint projected once, the strain limit with the structural and
@@ -57,9 +69,25 @@ impl ModelSteps for XpbdParams {
             let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
             xpbd::Family::new(k, springs.damping, h, limit.filter(|_| limited))
         });
-        match &mut cloth.structure.stencil {
-            Some(stencil) => stencil.project_xpbd(&mut cloth.particles, &families, h),
-            None => constraints.project(&mut cloth.particles, &families, h),
+        let (stencil, p) = (&mut cloth.structure.stencil, &mut cloth.particles);
+        if self.solve == XpbdSolve::Sweep {
+            sweep_families(stencil, constraints, p, &families, h);
+        } else {
+            // The other families swept, then the structural one along its lines (one
+            // Newton step of each line's lengths), then a sweep of the seams and the
+            // structural constraints again, each projected on its own nonlinear length
+            // with its strain limit (the T-shirt's armpits, where seams meet, stretched
+            // to 8.5% without it and 5.2% with it; seams swept only before the lines
+            // stayed 3.5 mm open).
+            let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
+            let mut before = families;
+            before[structural].on = false;
+            sweep_families(stencil, constraints, p, &before, h);
+            constraints.chains.solve(p, families[structural], h);
+            let mut after = [xpbd::Family::default(); 5];
+            after[seam] = families[seam];
+            after[structural] = families[structural];
+            sweep_families(stencil, constraints, p, &after, h);
         }
         if let Some(fabric) = cloth.params.fabric {
             let hinges = &cloth.structure.hinges;
@@ -71,6 +99,23 @@ impl ModelSteps for XpbdParams {
 
     fn end(&self, cloth: &mut ClothSolver) {
         cloth.tear_overstretched();
+    }
+}
+
+/// One sweep of `families` (those on): on the grid's stencil, or colour by colour.
+fn sweep_families(
+    stencil: &mut Option<Stencil>,
+    constraints: &mut xpbd::Constraints,
+    p: &mut Particles,
+    families: &[xpbd::Family; 5],
+    h: f32,
+) {
+    if !families.iter().any(|f| f.on) {
+        return;
+    }
+    match stencil {
+        Some(stencil) => stencil.project_xpbd(p, families, h),
+        None => constraints.project(p, families, h),
     }
 }
 

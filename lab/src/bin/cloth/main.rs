@@ -267,7 +267,7 @@ struct PeersArgs {
     /// Frames of 1/60 s per run (the first 5 are not timed).
     #[arg(long, default_value_t = 60, value_parser = steps)]
     frames: usize,
-    /// The solvers, comma separated: ours, tethers, self (tethers + self-collision), rapier, sticks (all when absent).
+    /// The solvers, comma separated: ours (XPBD swept), tethers (swept + tethers), lines (lines + tethers, the default), self (lines + tethers + self-collision), rapier, sticks (all when absent).
     #[arg(long, value_delimiter = ',', value_parser = peer_solver)]
     solvers: Vec<&'static str>,
     /// Keeps our kernels on one thread (the peers always run on one).
