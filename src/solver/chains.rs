@@ -339,43 +339,41 @@ impl ChainSet {
         let slots = particle.len();
         let positions = (&p.position[..], &p.previous[..], &p.inv_mass[..]);
         let (tiles, particle, rest, live) = (&tiles[..], &particle[..], &rest[..], &live[..]);
-        let mut work = Vec::new();
-        {
-            // Each piece's scratch, cut from the set's.
-            let Scratch {
-                x: [x0, x1, x2],
-                prev: [p0, p1, p2],
-                w,
-                n: [n0, n1, n2],
-                cp,
-                dp,
-            } = scratch;
-            let mut rest_of = (
-                [&mut x0[..], &mut x1[..], &mut x2[..]],
-                [&mut p0[..], &mut p1[..], &mut p2[..]],
-                &mut w[..],
-                [&mut n0[..], &mut n1[..], &mut n2[..]],
-                &mut cp[..],
-                &mut dp[..],
-            );
-            let mut at = 0;
-            for piece in pieces.iter() {
-                let end = tiles.get(piece.end).map_or(slots, |t| t.0);
-                let size = end - at;
-                let (x, prev, w, n, cp, dp) = rest_of;
-                let ((x, x_rest), (prev, prev_rest), (n, n_rest)) =
-                    (cut3(x, size), cut3(prev, size), cut3(n, size));
-                let (w, w_rest) = w.split_at_mut(size);
-                let (cp, cp_rest) = cp.split_at_mut(size);
-                let (dp, dp_rest) = dp.split_at_mut(size);
-                work.push((piece.clone(), at, x, prev, w, n, cp, dp));
-                rest_of = (x_rest, prev_rest, w_rest, n_rest, cp_rest, dp_rest);
-                at = end;
-            }
-        }
+        // Each piece's scratch, cut from the set's as the pieces are handed out (no
+        // allocation).
+        let Scratch {
+            x: [x0, x1, x2],
+            prev: [p0, p1, p2],
+            w,
+            n: [n0, n1, n2],
+            cp,
+            dp,
+        } = scratch;
+        let whole = (
+            [&mut x0[..], &mut x1[..], &mut x2[..]],
+            [&mut p0[..], &mut p1[..], &mut p2[..]],
+            &mut w[..],
+            [&mut n0[..], &mut n1[..], &mut n2[..]],
+            &mut cp[..],
+            &mut dp[..],
+        );
+        let work = pieces.iter().scan((whole, 0), |(rest_of, at), piece| {
+            let end = tiles.get(piece.end).map_or(slots, |t| t.0);
+            let size = end - *at;
+            let (x, prev, w, n, cp, dp) = std::mem::take(rest_of);
+            let ((x, x_rest), (prev, prev_rest), (n, n_rest)) =
+                (cut3(x, size), cut3(prev, size), cut3(n, size));
+            let (w, w_rest) = w.split_at_mut(size);
+            let (cp, cp_rest) = cp.split_at_mut(size);
+            let (dp, dp_rest) = dp.split_at_mut(size);
+            let item = (piece.clone(), *at, x, prev, w, n, cp, dp);
+            *rest_of = (x_rest, prev_rest, w_rest, n_rest, cp_rest, dp_rest);
+            *at = end;
+            Some(item)
+        });
         parallel::for_each(
             slots,
-            work.into_iter(),
+            work,
             |(piece, at, mut x, mut prev, w, mut n, cp, dp)| {
                 // Gather the piece's particles into its slots.
                 for (s, &i) in particle[at..at + w.len()].iter().enumerate() {
@@ -415,7 +413,7 @@ impl ChainSet {
             },
         );
         // Each particle takes its slot's move (`x` now holds the moves).
-        let moves = &scratch.x;
+        let moves = [&x0[..], &x1[..], &x2[..]];
         let n = p.len();
         let pieces = p
             .position
@@ -480,86 +478,105 @@ struct Tile<'a> {
 }
 
 /// The Thomas algorithm on a tile's chains (see the module doc); leaves each slot's move
-/// in `x`.
+/// in `x`. Every loop runs over the lanes of local arrays, without branches, so it
+/// vectorises; what one constraint hands the next (its direction, `1/m`, its right-hand
+/// side) is carried in locals.
 #[inline(always)]
 fn solve_tile<const DAMPED: bool>(t: Tile<'_>, f: Family) {
     let m = t.w.len();
+    let [x0, x1, x2] = t.x;
     if m < 2 {
-        for lane in t.x {
+        for lane in [x0, x1, x2] {
             lane.iter_mut().for_each(|l| *l = [0.0; LANES]);
         }
         return;
     }
-    let [x0, x1, x2] = t.x;
     let [n0, n1, n2] = t.n;
     let (cp, dp) = (t.cp, t.dp);
-    let (w, rest, live) = (t.w, t.rest, t.live);
+    let (w, rest, live) = (&t.w[..m], &t.rest[..m], &t.live[..m]);
+    let prev = t.prev;
     let g = 1.0 + f.damping;
+    let zero = [0.0f32; LANES];
     // Forward elimination, constraint by constraint down the chains.
+    let mut xa = [x0[0], x1[0], x2[0]];
+    let mut pa = if DAMPED {
+        [prev[0][0], prev[1][0], prev[2][0]]
+    } else {
+        [zero; 3]
+    };
+    let (mut n_before, mut inv_before, mut d_before) = ([zero; 3], zero, zero);
     for k in 0..m - 1 {
+        let xb = [x0[k + 1], x1[k + 1], x2[k + 1]];
+        let pb = if DAMPED {
+            [prev[0][k + 1], prev[1][k + 1], prev[2][k + 1]]
+        } else {
+            [zero; 3]
+        };
+        let (wa, wb, r, alive) = (w[k], w[k + 1], rest[k], live[k]);
+        let (mut nk, mut inv_m, mut dk, mut c_before) = ([zero; 3], zero, zero, zero);
         for j in 0..LANES {
             let d = [
-                x0[k + 1][j] - x0[k][j],
-                x1[k + 1][j] - x1[k][j],
-                x2[k + 1][j] - x2[k][j],
+                xb[0][j] - xa[0][j],
+                xb[1][j] - xa[1][j],
+                xb[2][j] - xa[2][j],
             ];
             let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            let wsum = w[k][j] + w[k + 1][j];
-            let on = live[k][j] > 0.0 && wsum > 0.0 && len > f32::EPSILON * rest[k][j];
-            let inv = if on { 1.0 / len } else { 0.0 };
-            let nk = [d[0] * inv, d[1] * inv, d[2] * inv];
-            let mut rhs = if on { rest[k][j] - len } else { 0.0 };
+            let wsum = wa[j] + wb[j];
+            let on = alive[j] > 0.0 && wsum > 0.0 && len > f32::EPSILON * r[j];
+            let inv = if on {
+                1.0 / len.max(f32::MIN_POSITIVE)
+            } else {
+                0.0
+            };
+            let n = [d[0] * inv, d[1] * inv, d[2] * inv];
+            let mut rhs = if on { r[j] - len } else { 0.0 };
             if DAMPED {
-                let rel = [
-                    (x0[k + 1][j] - t.prev[0][k + 1][j]) - (x0[k][j] - t.prev[0][k][j]),
-                    (x1[k + 1][j] - t.prev[1][k + 1][j]) - (x1[k][j] - t.prev[1][k][j]),
-                    (x2[k + 1][j] - t.prev[2][k + 1][j]) - (x2[k][j] - t.prev[2][k][j]),
-                ];
-                rhs -= f.damping * (nk[0] * rel[0] + nk[1] * rel[1] + nk[2] * rel[2]);
+                let rel = [0, 1, 2].map(|c| (xb[c][j] - pb[c][j]) - (xa[c][j] - pa[c][j]));
+                rhs -= f.damping * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]);
             }
             let diag = if on { g * wsum + f.compliance } else { 1.0 };
-            let (off, c_prev, d_prev) = if k > 0 {
-                let dot = n0[k - 1][j] * nk[0] + n1[k - 1][j] * nk[1] + n2[k - 1][j] * nk[2];
-                let off = -g * w[k][j] * dot;
-                // The previous row's upper diagonal is this off-diagonal.
-                cp[k - 1][j] *= off;
-                (off, cp[k - 1][j], dp[k - 1][j])
-            } else {
-                (0.0, 0.0, 0.0)
-            };
-            let inv_m = 1.0 / (diag - off * c_prev);
-            dp[k][j] = (rhs - off * d_prev) * inv_m;
-            cp[k][j] = inv_m;
-            (n0[k][j], n1[k][j], n2[k][j]) = (nk[0], nk[1], nk[2]);
+            let dot = n_before[0][j] * n[0] + n_before[1][j] * n[1] + n_before[2][j] * n[2];
+            let off = -g * wa[j] * dot;
+            // The previous constraint's upper diagonal is this off-diagonal.
+            c_before[j] = off * inv_before[j];
+            inv_m[j] = 1.0 / (diag - off * c_before[j]);
+            dk[j] = (rhs - off * d_before[j]) * inv_m[j];
+            (nk[0][j], nk[1][j], nk[2][j]) = (n[0], n[1], n[2]);
         }
+        if k > 0 {
+            cp[k - 1] = c_before;
+        }
+        (n0[k], n1[k], n2[k], dp[k]) = (nk[0], nk[1], nk[2], dk);
+        (n_before, inv_before, d_before, xa, pa) = (nk, inv_m, dk, xb, pb);
     }
     // Back substitution: Δλ into dp.
-    for k in (0..m.saturating_sub(2)).rev() {
+    let mut after = dp[m - 2];
+    for k in (0..m - 2).rev() {
+        let (c, mut d) = (cp[k], dp[k]);
         for j in 0..LANES {
-            dp[k][j] -= cp[k][j] * dp[k + 1][j];
+            d[j] -= c[j] * after[j];
         }
+        dp[k] = d;
+        after = d;
     }
     // Each particle's move: w_k (n_{k−1} Δλ_{k−1} − n_k Δλ_k).
+    let mut before = [zero; 3];
     for k in 0..m {
-        for j in 0..LANES {
-            let (before, after) = if k > 0 {
-                (
-                    [n0[k - 1][j], n1[k - 1][j], n2[k - 1][j]].map(|c| c * dp[k - 1][j]),
-                    [0.0; 3],
-                )
-            } else {
-                ([0.0; 3], [0.0; 3])
-            };
-            let after = if k + 1 < m {
-                [n0[k][j], n1[k][j], n2[k][j]].map(|c| c * dp[k][j])
-            } else {
-                after
-            };
-            let wk = w[k][j];
-            x0[k][j] = wk * (before[0] - after[0]);
-            x1[k][j] = wk * (before[1] - after[1]);
-            x2[k][j] = wk * (before[2] - after[2]);
+        let here = if k + 1 < m {
+            let (l, n) = (dp[k], [n0[k], n1[k], n2[k]]);
+            n.map(|n| std::array::from_fn(|j| n[j] * l[j]))
+        } else {
+            [zero; 3]
+        };
+        let wk = w[k];
+        for (c, x) in [&mut *x0, &mut *x1, &mut *x2].into_iter().enumerate() {
+            let mut out = zero;
+            for j in 0..LANES {
+                out[j] = wk[j] * (before[c][j] - here[c][j]);
+            }
+            x[k] = out;
         }
+        before = here;
     }
 }
 

@@ -74,11 +74,12 @@ impl ModelSteps for XpbdParams {
             sweep_families(stencil, constraints, p, &families, h);
         } else {
             // The other families swept, then the structural one along its lines (one
-            // Newton step of each line's lengths), then a sweep of the seams and the
-            // structural constraints again, each projected on its own nonlinear length
-            // with its strain limit (the T-shirt's armpits, where seams meet, stretched
-            // to 8.5% without it and 5.2% with it; seams swept only before the lines
-            // stayed 3.5 mm open).
+            // Newton step of each line's lengths), then a sweep of the seams again (they
+            // pull against it: swept only before the lines, a seam of the T-shirt stayed
+            // 3.5 mm open) and of what bounds the structural length: an inextensible
+            // family projected on its own nonlinear lengths (the T-shirt's armpits, where
+            // seams meet, stretched to 8.5% without it and 5.2% with it), or a compliant
+            // family's strain limit.
             let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
             let mut before = families;
             before[structural].on = false;
@@ -86,7 +87,19 @@ impl ModelSteps for XpbdParams {
             constraints.chains.solve(p, families[structural], h);
             let mut after = [xpbd::Family::default(); 5];
             after[seam] = families[seam];
-            after[structural] = families[structural];
+            let f = families[structural];
+            if f.on && f.compliance == 0.0 {
+                // Inextensible: a second, nonlinear projection is one more iteration.
+                after[structural] = f;
+            } else if f.on && f.max_stretch.is_finite() {
+                // Compliant: projected again it would be twice as stiff; only its limit.
+                after[structural] = xpbd::Family {
+                    on: true,
+                    compliance: f32::INFINITY,
+                    damping: 0.0,
+                    max_stretch: f.max_stretch,
+                };
+            }
             sweep_families(stencil, constraints, p, &after, h);
         }
         if let Some(fabric) = cloth.params.fabric {
