@@ -232,13 +232,9 @@ fn path_cover(springs: &Springs, rest: &[Vec3]) -> Vec<(Vec<u32>, Vec<u32>)> {
     };
     for s in structural.clone() {
         let s = s as u32;
-        for k in 0..2 {
+        let ends = [springs.a[s as usize], springs.b[s as usize]];
+        for (k, from) in ends.into_iter().enumerate() {
             if !seen[s as usize] && link[s as usize][k] == NONE {
-                let from = if k == 0 {
-                    springs.a[s as usize]
-                } else {
-                    springs.b[s as usize]
-                };
                 paths.push(walk(s, from, &mut seen));
             }
         }
@@ -611,11 +607,12 @@ mod tests {
         for c in 0..m {
             let pivot = (c..m).max_by(|&i, &j| a[i][c].abs().total_cmp(&a[j][c].abs()));
             a.swap(c, pivot.unwrap());
-            for r in 0..m {
+            let pivot_row = a[c].clone();
+            for (r, row) in a.iter_mut().enumerate() {
                 if r != c {
-                    let factor = a[r][c] / a[c][c];
-                    for k in c..=m {
-                        a[r][k] -= factor * a[c][k];
+                    let factor = row[c] / pivot_row[c];
+                    for (x, p) in row[c..].iter_mut().zip(&pivot_row[c..]) {
+                        *x -= factor * p;
                     }
                 }
             }
