@@ -53,41 +53,42 @@ pub(super) struct Chains {
     sets: Vec<ChainSet>,
 }
 
-/// Chains that share no particle, tiled.
+/// Chains that share no particle, tiled: a tile is [`LANES`] chains side by side, one
+/// [`Row`] per particle along them (padded to the tile's longest chain), so slot
+/// `row · LANES + j` is that row's particle on chain `j`.
 #[derive(Clone, Debug)]
 struct ChainSet {
-    /// Each tile: its first slot and its particles per chain; slot `start + k·LANES + j`
-    /// is the `k`-th particle of the tile's `j`-th chain.
+    /// Each tile: its first row and its rows (particles per chain).
     tiles: Vec<(usize, usize)>,
+    rows: Vec<Row>,
     /// Each slot's particle (`NONE` for padding).
     particle: Vec<u32>,
     /// Each slot's constraint to the next slot of its chain (`NONE` for none).
     spring: Vec<u32>,
     /// Each particle's slot in this set (`NONE` when no chain of the set reaches it).
     slot_of: Vec<u32>,
-    /// Each slot's constraint's rest length and whether it acts (1) or tore (0); synced
-    /// once a step.
-    rest: Vec<f32>,
-    live: Vec<f32>,
     /// The tiles in pieces of about [`PIECE`] slots, for the compute pool.
     pieces: Vec<Range<usize>>,
-    /// The solve's scratch, one value per slot.
-    scratch: Scratch,
 }
 
-#[derive(Clone, Debug, Default)]
-struct Scratch {
+/// One particle along each of a tile's chains, and the constraint to the next: what the
+/// solve reads and writes at one step down the chains, together.
+#[derive(Clone, Copy, Debug, Default)]
+struct Row {
     /// Positions in, moves out.
-    x: [Vec<f32>; 3],
+    x: [Lane; 3],
     /// Positions at the substep's start (read when damped).
-    prev: [Vec<f32>; 3],
+    prev: [Lane; 3],
     /// Inverse masses.
-    w: Vec<f32>,
-    /// Each constraint's direction.
-    n: [Vec<f32>; 3],
-    /// Thomas's modified upper diagonal, and its right-hand side (then `Δλ`).
-    cp: Vec<f32>,
-    dp: Vec<f32>,
+    w: Lane,
+    /// The constraint to the next row: its rest length and 1 while it acts (0 torn or
+    /// none), synced once a step; its direction, Thomas's modified upper diagonal and
+    /// right-hand side (then `Δλ`), per solve.
+    rest: Lane,
+    live: Lane,
+    n: [Lane; 3],
+    cp: Lane,
+    dp: Lane,
 }
 
 impl Chains {
@@ -95,7 +96,7 @@ impl Chains {
     /// read from `rest`.
     pub fn new(springs: &Springs, rest: &[Vec3]) -> Self {
         let n = rest.len();
-        let paths = path_cover(springs, rest);
+        let paths = walk_paths(springs, &straight_links(springs, rest));
         // Colour the paths, longest first, into sets that share no particle.
         let mut order: Vec<usize> = (0..paths.len()).collect();
         order.sort_by_key(|&p| (std::cmp::Reverse(paths[p].0.len()), p));
@@ -142,8 +143,9 @@ impl Chains {
     /// Takes the springs' rest lengths (seams' change) and alive flags.
     pub fn sync(&mut self, springs: &Springs) {
         for set in &mut self.sets {
-            for ((rest, live), &k) in set.rest.iter_mut().zip(&mut set.live).zip(&set.spring) {
-                (*rest, *live) = match k {
+            for (slot, &k) in set.spring.iter().enumerate() {
+                let row = &mut set.rows[slot / LANES];
+                (row.rest[slot % LANES], row.live[slot % LANES]) = match k {
                     NONE => (0.0, 0.0),
                     k => (
                         springs.rest_length[k as usize],
@@ -162,41 +164,32 @@ impl Chains {
             return;
         }
         for set in &mut self.sets {
-            set.solve(p, f, h);
+            set.solve_tiles(p, f);
+            set.add_moves(p, h);
         }
     }
 }
 
-/// Structural edges paired through each particle and linked into paths: each path's
-/// particles in order, and its springs between them.
-fn path_cover(springs: &Springs, rest: &[Vec3]) -> Vec<(Vec<u32>, Vec<u32>)> {
-    let n = rest.len();
+/// For each structural spring, the spring continuing it straight through its end `a`
+/// (index 0) and `b` (1), or `NONE`: every pair of edges through a particle within
+/// [`STRAIGHT`] of straight, straightest first, each edge's end taking the first pair
+/// offered (in the rest shape).
+fn straight_links(springs: &Springs, rest: &[Vec3]) -> Vec<[u32; 2]> {
     let structural = springs.ranges[SpringKind::Structural as usize].clone();
-    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); n];
-    for s in structural.clone() {
+    let mut incident: Vec<Vec<u32>> = vec![Vec::new(); rest.len()];
+    for s in structural {
         incident[springs.a[s] as usize].push(s as u32);
         incident[springs.b[s] as usize].push(s as u32);
     }
-    let other = |s: u32, v: u32| {
-        let s = s as usize;
-        if springs.a[s] == v {
-            springs.b[s]
-        } else {
-            springs.a[s]
-        }
-    };
-    // Every pair of edges through a particle that continue each other, straightest
-    // first; each edge's end takes the first pair offered.
     let mut pairs: Vec<(f32, u32, u32, u32)> = Vec::new();
     for (v, edges) in incident.iter().enumerate() {
-        let v = v as u32;
+        let away =
+            |e: u32| (rest[other_end(springs, e, v as u32) as usize] - rest[v]).normalize_or_zero();
         for (i, &e1) in edges.iter().enumerate() {
             for &e2 in &edges[i + 1..] {
-                let u1 = (rest[other(e1, v) as usize] - rest[v as usize]).normalize_or_zero();
-                let u2 = (rest[other(e2, v) as usize] - rest[v as usize]).normalize_or_zero();
-                let straight = -u1.dot(u2);
+                let straight = -away(e1).dot(away(e2));
                 if straight > STRAIGHT {
-                    pairs.push((straight, v, e1, e2));
+                    pairs.push((straight, v as u32, e1, e2));
                 }
             }
         }
@@ -205,43 +198,65 @@ fn path_cover(springs: &Springs, rest: &[Vec3]) -> Vec<(Vec<u32>, Vec<u32>)> {
         b.0.total_cmp(&a.0)
             .then((a.1, a.2, a.3).cmp(&(b.1, b.2, b.3)))
     });
-    // link[s][end]: the edge continuing `s` through its end `a` (0) or `b` (1).
     let mut link = vec![[NONE; 2]; springs.len()];
-    let end = |s: u32, v: u32| usize::from(springs.a[s as usize] != v);
     for &(_, v, e1, e2) in &pairs {
-        let (k1, k2) = (end(e1, v), end(e2, v));
+        let (k1, k2) = (end_at(springs, e1, v), end_at(springs, e2, v));
         if link[e1 as usize][k1] == NONE && link[e2 as usize][k2] == NONE {
             link[e1 as usize][k1] = e2;
             link[e2 as usize][k2] = e1;
         }
     }
-    // Walk the paths from their free ends, then what is left (closed loops), cut once.
+    link
+}
+
+/// The particle of spring `s` that is not `v`.
+fn other_end(springs: &Springs, s: u32, v: u32) -> u32 {
+    let s = s as usize;
+    if springs.a[s] == v {
+        springs.b[s]
+    } else {
+        springs.a[s]
+    }
+}
+
+/// Which end of spring `s` particle `v` is: 0 for `a`, 1 for `b`.
+fn end_at(springs: &Springs, s: u32, v: u32) -> usize {
+    usize::from(springs.a[s as usize] != v)
+}
+
+/// The paths `link` makes of the structural springs: each path's particles in order and
+/// its springs between them. Walked from their free ends, then what is left (closed
+/// loops), cut once.
+fn walk_paths(springs: &Springs, link: &[[u32; 2]]) -> Vec<(Vec<u32>, Vec<u32>)> {
+    let structural = springs.ranges[SpringKind::Structural as usize].clone();
     let mut seen = vec![false; springs.len()];
-    let mut paths = Vec::new();
-    let walk = |start: u32, from: u32, seen: &mut Vec<bool>| {
+    let mut walk = |start: u32, from: u32| {
         let (mut particles, mut edges) = (vec![from], Vec::new());
         let (mut s, mut v) = (start, from);
         while s != NONE && !seen[s as usize] {
             seen[s as usize] = true;
             edges.push(s);
-            v = other(s, v);
+            v = other_end(springs, s, v);
             particles.push(v);
-            s = link[s as usize][end(s, v)];
+            s = link[s as usize][end_at(springs, s, v)];
         }
         (particles, edges)
     };
+    let mut paths = Vec::new();
     for s in structural.clone() {
-        let s = s as u32;
-        let ends = [springs.a[s as usize], springs.b[s as usize]];
-        for (k, from) in ends.into_iter().enumerate() {
-            if !seen[s as usize] && link[s as usize][k] == NONE {
-                paths.push(walk(s, from, &mut seen));
+        for (k, from) in [springs.a[s], springs.b[s]].into_iter().enumerate() {
+            if link[s][k] == NONE {
+                let path = walk(s as u32, from);
+                if !path.1.is_empty() {
+                    paths.push(path);
+                }
             }
         }
     }
     for s in structural {
-        if !seen[s] {
-            paths.push(walk(s as u32, springs.a[s], &mut seen));
+        let path = walk(s as u32, springs.a[s]);
+        if !path.1.is_empty() {
+            paths.push(path);
         }
     }
     paths
@@ -255,7 +270,7 @@ impl ChainSet {
         for tile in paths.chunks(LANES) {
             let len = tile.iter().map(|p| p.0.len()).max().unwrap_or(0);
             let start = particle.len();
-            tiles.push((start, len));
+            tiles.push((start / LANES, len));
             particle.resize(start + len * LANES, NONE);
             spring.resize(start + len * LANES, NONE);
             for (j, (particles, springs)) in tile.iter().enumerate() {
@@ -274,11 +289,12 @@ impl ChainSet {
             }
         }
         // Pieces of whole tiles, about PIECE slots each.
+        let rows = particle.len() / LANES;
         let mut pieces = Vec::new();
         let mut from = 0;
         for t in 0..tiles.len() {
-            let end = tiles.get(t + 1).map_or(particle.len(), |tile| tile.0);
-            if end - tiles[from].0 >= PIECE {
+            let end = tiles.get(t + 1).map_or(rows, |tile| tile.0);
+            if (end - tiles[from].0) * LANES >= PIECE {
                 pieces.push(from..t + 1);
                 from = t + 1;
             }
@@ -286,24 +302,13 @@ impl ChainSet {
         if from < tiles.len() {
             pieces.push(from..tiles.len());
         }
-        let slots = particle.len();
-        let lanes = || [vec![0.0; slots], vec![0.0; slots], vec![0.0; slots]];
         Self {
             tiles,
-            rest: vec![0.0; slots],
-            live: vec![0.0; slots],
+            rows: vec![Row::default(); rows],
             particle,
             spring,
             slot_of,
             pieces,
-            scratch: Scratch {
-                x: lanes(),
-                prev: lanes(),
-                w: vec![0.0; slots],
-                n: lanes(),
-                cp: vec![0.0; slots],
-                dp: vec![0.0; slots],
-            },
         }
     }
 
@@ -320,110 +325,57 @@ impl ChainSet {
         sum / count.max(1) as f64
     }
 
-    fn solve(&mut self, p: &mut Particles, f: Family, h: f32) {
+    /// Each piece's tiles, on the compute pool: their particles gathered into the rows,
+    /// then solved ([`solve_tile`]), leaving each slot's move in its row's `x`.
+    fn solve_tiles(&mut self, p: &Particles, f: Family) {
         let damped = f.damping > 0.0;
         let Self {
             tiles,
+            rows,
             particle,
-            rest,
-            live,
             pieces,
-            scratch,
-            slot_of,
             ..
         } = self;
-        let slots = particle.len();
-        let positions = (&p.position[..], &p.previous[..], &p.inv_mass[..]);
-        let (tiles, particle, rest, live) = (&tiles[..], &particle[..], &rest[..], &live[..]);
-        // Each piece's scratch, cut from the set's as the pieces are handed out (no
-        // allocation).
-        let Scratch {
-            x: [x0, x1, x2],
-            prev: [p0, p1, p2],
-            w,
-            n: [n0, n1, n2],
-            cp,
-            dp,
-        } = scratch;
-        let whole = (
-            [&mut x0[..], &mut x1[..], &mut x2[..]],
-            [&mut p0[..], &mut p1[..], &mut p2[..]],
-            &mut w[..],
-            [&mut n0[..], &mut n1[..], &mut n2[..]],
-            &mut cp[..],
-            &mut dp[..],
-        );
-        let work = pieces.iter().scan((whole, 0), |(rest_of, at), piece| {
-            let end = tiles.get(piece.end).map_or(slots, |t| t.0);
-            let size = end - *at;
-            let (x, prev, w, n, cp, dp) = std::mem::take(rest_of);
-            let ((x, x_rest), (prev, prev_rest), (n, n_rest)) =
-                (cut3(x, size), cut3(prev, size), cut3(n, size));
-            let (w, w_rest) = w.split_at_mut(size);
-            let (cp, cp_rest) = cp.split_at_mut(size);
-            let (dp, dp_rest) = dp.split_at_mut(size);
-            let item = (piece.clone(), *at, x, prev, w, n, cp, dp);
-            *rest_of = (x_rest, prev_rest, w_rest, n_rest, cp_rest, dp_rest);
-            *at = end;
-            Some(item)
+        let (tiles, particle, slots) = (&tiles[..], &particle[..], particle.len());
+        // Each piece's rows cut from the set's as the pieces are handed out.
+        let mut left = &mut rows[..];
+        let work = pieces.iter().map(|piece| {
+            let first = tiles[piece.start].0;
+            let end = tiles.get(piece.end).map_or(slots / LANES, |t| t.0);
+            let (mine, others) = std::mem::take(&mut left).split_at_mut(end - first);
+            left = others;
+            (piece.clone(), first, mine)
         });
-        parallel::for_each(
-            slots,
-            work,
-            |(piece, at, mut x, mut prev, w, mut n, cp, dp)| {
-                // Gather the piece's particles into its slots.
-                for (s, &i) in particle[at..at + w.len()].iter().enumerate() {
-                    let (position, previous, inv_mass) = positions;
-                    let (xi, pi, wi) = match i {
-                        NONE => (Vec3::ZERO, Vec3::ZERO, 0.0),
-                        i => (
-                            position[i as usize],
-                            previous[i as usize],
-                            inv_mass[i as usize],
-                        ),
-                    };
-                    (x[0][s], x[1][s], x[2][s], w[s]) = (xi.x, xi.y, xi.z, wi);
-                    if damped {
-                        (prev[0][s], prev[1][s], prev[2][s]) = (pi.x, pi.y, pi.z);
-                    }
+        parallel::for_each(slots, work, |(piece, first, rows)| {
+            gather(rows, &particle[first * LANES..], p, damped);
+            for &(start, len) in &tiles[piece] {
+                let tile = &mut rows[start - first..start - first + len];
+                if damped {
+                    solve_tile::<true>(tile, f);
+                } else {
+                    solve_tile::<false>(tile, f);
                 }
-                for &(start, len) in &tiles[piece] {
-                    let local = start - at..start - at + len * LANES;
-                    let global = start..start + len * LANES;
-                    let tile = Tile {
-                        x: x.each_mut().map(|l| lanes_mut(&mut l[local.clone()])),
-                        prev: prev.each_mut().map(|l| lanes(&l[local.clone()])),
-                        w: lanes(&w[local.clone()]),
-                        n: n.each_mut().map(|l| lanes_mut(&mut l[local.clone()])),
-                        cp: lanes_mut(&mut cp[local.clone()]),
-                        dp: lanes_mut(&mut dp[local.clone()]),
-                        rest: lanes(&rest[global.clone()]),
-                        live: lanes(&live[global]),
-                    };
-                    if damped {
-                        solve_tile::<true>(tile, f);
-                    } else {
-                        solve_tile::<false>(tile, f);
-                    }
-                }
-            },
-        );
-        // Each particle takes its slot's move (`x` now holds the moves).
-        let moves = [&x0[..], &x1[..], &x2[..]];
-        let n = p.len();
+            }
+        });
+    }
+
+    /// Each particle takes its slot's move: to its velocity over `h`, and to its
+    /// position with the rounding kept in its residue.
+    fn add_moves(&self, p: &mut Particles, h: f32) {
+        let rows = &self.rows;
         let pieces = p
             .position
             .chunks_mut(PIECE)
             .zip(p.velocity.chunks_mut(PIECE))
             .zip(p.residue.chunks_mut(PIECE))
-            .zip(slot_of.chunks(PIECE));
-        parallel::for_each(n, pieces, |(((x, v), r), slot_of)| {
+            .zip(self.slot_of.chunks(PIECE));
+        parallel::for_each(self.slot_of.len(), pieces, |(((x, v), r), slot_of)| {
             for (((x, v), r), &s) in x.iter_mut().zip(v).zip(r).zip(slot_of) {
                 if s == NONE {
                     continue;
                 }
-                let s = s as usize;
-                let delta = Vec3::new(moves[0][s], moves[1][s], moves[2][s]);
+                let (row, j) = (&rows[s as usize / LANES].x, s as usize % LANES);
+                let delta = Vec3::new(row[0][j], row[1][j], row[2][j]);
                 *v += delta / h;
                 compensated_add(x, r, delta);
             }
@@ -431,16 +383,25 @@ impl ChainSet {
     }
 }
 
-/// Three lanes split at `size`.
-#[allow(clippy::type_complexity)]
-fn cut3(l: [&mut [f32]; 3], size: usize) -> ([&mut [f32]; 3], [&mut [f32]; 3]) {
-    let [a, b, c] = l;
-    let ((a, a2), (b, b2), (c, c2)) = (
-        a.split_at_mut(size),
-        b.split_at_mut(size),
-        c.split_at_mut(size),
-    );
-    ([a, b, c], [a2, b2, c2])
+/// The particles of `particle` (slot by slot from the first of `rows`) into `rows`:
+/// positions, inverse masses, and the substep's start when `damped`; padding at rest
+/// with no mass to move.
+fn gather(rows: &mut [Row], particle: &[u32], p: &Particles, damped: bool) {
+    for (row, particle) in rows.iter_mut().zip(particle.chunks(LANES)) {
+        for (j, &i) in particle.iter().enumerate() {
+            let (x, prev, w) = match i {
+                NONE => (Vec3::ZERO, Vec3::ZERO, 0.0),
+                i => {
+                    let i = i as usize;
+                    (p.position[i], p.previous[i], p.inv_mass[i])
+                }
+            };
+            (row.x[0][j], row.x[1][j], row.x[2][j], row.w[j]) = (x.x, x.y, x.z, w);
+            if damped {
+                (row.prev[0][j], row.prev[1][j], row.prev[2][j]) = (prev.x, prev.y, prev.z);
+            }
+        }
+    }
 }
 
 /// `x + r += delta`, keeping in `r` what rounding `x` lost (Kahan's compensated sum;
@@ -453,124 +414,107 @@ pub(super) fn compensated_add(x: &mut Vec3, r: &mut Vec3, delta: Vec3) {
     *x = s;
 }
 
-fn lanes(l: &[f32]) -> &[Lane] {
-    l.as_chunks::<LANES>().0
-}
-
-fn lanes_mut(l: &mut [f32]) -> &mut [Lane] {
-    l.as_chunks_mut::<LANES>().0
-}
-
-/// One tile's slots as lanes (`len` rows of [`LANES`]).
-struct Tile<'a> {
-    x: [&'a mut [Lane]; 3],
-    prev: [&'a [Lane]; 3],
-    w: &'a [Lane],
-    n: [&'a mut [Lane]; 3],
-    cp: &'a mut [Lane],
-    dp: &'a mut [Lane],
-    rest: &'a [Lane],
-    live: &'a [Lane],
-}
-
-/// The Thomas algorithm on a tile's chains (see the module doc); leaves each slot's move
-/// in `x`. Every loop runs over the lanes of local arrays, without branches, so it
-/// vectorises; what one constraint hands the next (its direction, `1/m`, its right-hand
-/// side) is carried in locals.
+/// The Thomas algorithm on a tile's chains (see the module doc), leaving each row's
+/// move in its `x`. Every loop runs over the lanes of local arrays, without branches,
+/// so it vectorises.
 #[inline(always)]
-fn solve_tile<const DAMPED: bool>(t: Tile<'_>, f: Family) {
-    let m = t.w.len();
-    let [x0, x1, x2] = t.x;
-    if m < 2 {
-        for lane in [x0, x1, x2] {
-            lane.iter_mut().for_each(|l| *l = [0.0; LANES]);
-        }
+fn solve_tile<const DAMPED: bool>(rows: &mut [Row], f: Family) {
+    if rows.len() < 2 {
+        rows.iter_mut().for_each(|row| row.x = [ZERO; 3]);
         return;
     }
-    let [n0, n1, n2] = t.n;
-    let (cp, dp) = (t.cp, t.dp);
-    let (w, rest, live) = (&t.w[..m], &t.rest[..m], &t.live[..m]);
-    let prev = t.prev;
+    eliminate::<DAMPED>(rows, f);
+    substitute(rows);
+    moves(rows);
+}
+
+const ZERO: Lane = [0.0; LANES];
+
+/// Forward elimination, constraint by constraint down the chains: each row's direction,
+/// modified upper diagonal (of the row before, once this one's off-diagonal is known)
+/// and right-hand side. What a constraint hands the next is carried in locals.
+#[inline(always)]
+fn eliminate<const DAMPED: bool>(rows: &mut [Row], f: Family) {
     let g = 1.0 + f.damping;
-    let zero = [0.0f32; LANES];
-    // Forward elimination, constraint by constraint down the chains.
-    let mut xa = [x0[0], x1[0], x2[0]];
-    let mut pa = if DAMPED {
-        [prev[0][0], prev[1][0], prev[2][0]]
-    } else {
-        [zero; 3]
-    };
-    let (mut n_before, mut inv_before, mut d_before) = ([zero; 3], zero, zero);
-    for k in 0..m - 1 {
-        let xb = [x0[k + 1], x1[k + 1], x2[k + 1]];
-        let pb = if DAMPED {
-            [prev[0][k + 1], prev[1][k + 1], prev[2][k + 1]]
-        } else {
-            [zero; 3]
-        };
-        let (wa, wb, r, alive) = (w[k], w[k + 1], rest[k], live[k]);
-        let (mut nk, mut inv_m, mut dk, mut c_before) = ([zero; 3], zero, zero, zero);
+    let (mut n_before, mut inv_before, mut d_before) = ([ZERO; 3], ZERO, ZERO);
+    let mut xa = rows[0].x;
+    let mut pa = if DAMPED { rows[0].prev } else { [ZERO; 3] };
+    for k in 0..rows.len() - 1 {
+        let (wa, rest, live) = (rows[k].w, rows[k].rest, rows[k].live);
+        let (xb, wb) = (rows[k + 1].x, rows[k + 1].w);
+        let pb = if DAMPED { rows[k + 1].prev } else { [ZERO; 3] };
+        let (mut n, mut inv_m, mut d, mut c_before) = ([ZERO; 3], ZERO, ZERO, ZERO);
         for j in 0..LANES {
-            let d = [
+            let dx = [
                 xb[0][j] - xa[0][j],
                 xb[1][j] - xa[1][j],
                 xb[2][j] - xa[2][j],
             ];
-            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            let len = (dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]).sqrt();
             let wsum = wa[j] + wb[j];
-            let on = alive[j] > 0.0 && wsum > 0.0 && len > f32::EPSILON * r[j];
+            let on = live[j] > 0.0 && wsum > 0.0 && len > f32::EPSILON * rest[j];
             let inv = if on {
                 1.0 / len.max(f32::MIN_POSITIVE)
             } else {
                 0.0
             };
-            let n = [d[0] * inv, d[1] * inv, d[2] * inv];
-            let mut rhs = if on { r[j] - len } else { 0.0 };
+            let nj = [dx[0] * inv, dx[1] * inv, dx[2] * inv];
+            let mut rhs = if on { rest[j] - len } else { 0.0 };
             if DAMPED {
-                let rel = [0, 1, 2].map(|c| (xb[c][j] - pb[c][j]) - (xa[c][j] - pa[c][j]));
-                rhs -= f.damping * (n[0] * rel[0] + n[1] * rel[1] + n[2] * rel[2]);
+                let rel = [
+                    (xb[0][j] - pb[0][j]) - (xa[0][j] - pa[0][j]),
+                    (xb[1][j] - pb[1][j]) - (xa[1][j] - pa[1][j]),
+                    (xb[2][j] - pb[2][j]) - (xa[2][j] - pa[2][j]),
+                ];
+                rhs -= f.damping * (nj[0] * rel[0] + nj[1] * rel[1] + nj[2] * rel[2]);
             }
             let diag = if on { g * wsum + f.compliance } else { 1.0 };
-            let dot = n_before[0][j] * n[0] + n_before[1][j] * n[1] + n_before[2][j] * n[2];
+            let dot = n_before[0][j] * nj[0] + n_before[1][j] * nj[1] + n_before[2][j] * nj[2];
             let off = -g * wa[j] * dot;
-            // The previous constraint's upper diagonal is this off-diagonal.
             c_before[j] = off * inv_before[j];
             inv_m[j] = 1.0 / (diag - off * c_before[j]);
-            dk[j] = (rhs - off * d_before[j]) * inv_m[j];
-            (nk[0][j], nk[1][j], nk[2][j]) = (n[0], n[1], n[2]);
+            d[j] = (rhs - off * d_before[j]) * inv_m[j];
+            (n[0][j], n[1][j], n[2][j]) = (nj[0], nj[1], nj[2]);
         }
         if k > 0 {
-            cp[k - 1] = c_before;
+            rows[k - 1].cp = c_before;
         }
-        (n0[k], n1[k], n2[k], dp[k]) = (nk[0], nk[1], nk[2], dk);
-        (n_before, inv_before, d_before, xa, pa) = (nk, inv_m, dk, xb, pb);
+        (rows[k].n, rows[k].dp) = (n, d);
+        (n_before, inv_before, d_before, xa, pa) = (n, inv_m, d, xb, pb);
     }
-    // Back substitution: Δλ into dp.
-    let mut after = dp[m - 2];
-    for k in (0..m - 2).rev() {
-        let (c, mut d) = (cp[k], dp[k]);
-        for j in 0..LANES {
-            d[j] -= c[j] * after[j];
+}
+
+/// Back substitution: each constraint's `Δλ` into its row's `dp`.
+#[inline(always)]
+fn substitute(rows: &mut [Row]) {
+    let m = rows.len();
+    let mut after = rows[m - 2].dp;
+    for row in rows[..m - 2].iter_mut().rev() {
+        for ((d, c), a) in row.dp.iter_mut().zip(&row.cp).zip(&after) {
+            *d -= c * a;
         }
-        dp[k] = d;
-        after = d;
+        after = row.dp;
     }
-    // Each particle's move: w_k (n_{k−1} Δλ_{k−1} − n_k Δλ_k).
-    let mut before = [zero; 3];
-    for k in 0..m {
-        let here = if k + 1 < m {
-            let (l, n) = (dp[k], [n0[k], n1[k], n2[k]]);
-            n.map(|n| std::array::from_fn(|j| n[j] * l[j]))
-        } else {
-            [zero; 3]
-        };
-        let wk = w[k];
-        for (c, x) in [&mut *x0, &mut *x1, &mut *x2].into_iter().enumerate() {
-            let mut out = zero;
-            for j in 0..LANES {
-                out[j] = wk[j] * (before[c][j] - here[c][j]);
+}
+
+/// Each particle's move, `w_k (n_{k−1} Δλ_{k−1} − n_k Δλ_k)`, into its row's `x`.
+#[inline(always)]
+fn moves(rows: &mut [Row]) {
+    let m = rows.len();
+    let mut before = [ZERO; 3];
+    for (k, row) in rows.iter_mut().enumerate() {
+        let mut here = [ZERO; 3];
+        if k + 1 < m {
+            for (h, n) in here.iter_mut().zip(&row.n) {
+                for ((h, n), l) in h.iter_mut().zip(n).zip(&row.dp) {
+                    *h = n * l;
+                }
             }
-            x[k] = out;
+        }
+        for ((x, b), h) in row.x.iter_mut().zip(&before).zip(&here) {
+            for (((x, w), b), h) in x.iter_mut().zip(&row.w).zip(b).zip(h) {
+                *x = w * (b - h);
+            }
         }
         before = here;
     }
@@ -647,53 +591,22 @@ mod tests {
 
     fn tile_solve(x: &[Vec3], w: &[f32], rest: &[f32], family: Family) -> Vec<Vec3> {
         // One chain in lane 3 of a tile, the other lanes padding.
-        let m = x.len();
-        let j = 3;
-        let lane = |f: &dyn Fn(usize) -> f32| {
-            let mut l = vec![0.0f32; m * LANES];
-            for k in 0..m {
-                l[k * LANES + j] = f(k);
-            }
-            l
-        };
-        let mut xs = [lane(&|k| x[k].x), lane(&|k| x[k].y), lane(&|k| x[k].z)];
-        let prev = [lane(&|_| 0.0), lane(&|_| 0.0), lane(&|_| 0.0)];
-        let ws = lane(&|k| w[k]);
-        let rs = lane(&|k| rest.get(k).copied().unwrap_or(0.0));
-        let live = lane(&|k| f32::from(u8::from(k + 1 < m)));
-        let mut n = [
-            vec![0.0; m * LANES],
-            vec![0.0; m * LANES],
-            vec![0.0; m * LANES],
-        ];
-        let (mut cp, mut dp) = (vec![0.0; m * LANES], vec![0.0; m * LANES]);
-        let [n0, n1, n2] = &mut n;
-        let [x0, x1, x2] = &mut xs;
-        solve_tile::<false>(
-            Tile {
-                x: [lanes_mut(x0), lanes_mut(x1), lanes_mut(x2)],
-                prev: prev.each_ref().map(|l| lanes(l)),
-                w: lanes(&ws),
-                n: [lanes_mut(n0), lanes_mut(n1), lanes_mut(n2)],
-                cp: lanes_mut(&mut cp),
-                dp: lanes_mut(&mut dp),
-                rest: lanes(&rs),
-                live: lanes(&live),
-            },
-            family,
-        );
-        // The padding lanes do not move.
-        for (k, v) in xs[0].iter().enumerate() {
-            assert!(k % LANES == j || *v == 0.0, "padding moved");
+        let (m, j) = (x.len(), 3);
+        let mut rows = vec![Row::default(); m];
+        for (k, row) in rows.iter_mut().enumerate() {
+            (row.x[0][j], row.x[1][j], row.x[2][j]) = (x[k].x, x[k].y, x[k].z);
+            row.w[j] = w[k];
+            row.rest[j] = rest.get(k).copied().unwrap_or(0.0);
+            row.live[j] = f32::from(u8::from(k + 1 < m));
         }
-        (0..m)
-            .map(|k| {
-                Vec3::new(
-                    xs[0][k * LANES + j],
-                    xs[1][k * LANES + j],
-                    xs[2][k * LANES + j],
-                )
-            })
+        solve_tile::<false>(&mut rows, family);
+        for row in &rows {
+            for (lane, c) in row.x.iter().flatten().enumerate() {
+                assert!(lane % LANES == j || *c == 0.0, "padding moved");
+            }
+        }
+        rows.iter()
+            .map(|row| Vec3::new(row.x[0][j], row.x[1][j], row.x[2][j]))
             .collect()
     }
 
