@@ -208,23 +208,18 @@ fn tethers_hold_a_hanging_inextensible_chain_to_its_length_at_one_substep() {
         let bottom = cloth.positions()[40].y;
         (worst, bottom)
     };
-    let (alone, alone_bottom) = settle(&ClothParams {
+    // Without tethers, at one substep: swept, and solved along its line (one exact solve
+    // a substep, which needs no tethers).
+    let untethered = |solve| ClothParams {
         model: Model::Xpbd(XpbdParams {
             tethers: false,
-            solve: XpbdSolve::Sweep,
+            solve,
             ..XpbdParams::default()
         }),
         ..tethered(1)
-    });
-    // Solved along its line, the chain needs no tethers: one exact solve a substep.
-    let (line, _) = settle(&ClothParams {
-        model: Model::Xpbd(XpbdParams {
-            tethers: false,
-            solve: XpbdSolve::Lines,
-            ..XpbdParams::default()
-        }),
-        ..tethered(1)
-    });
+    };
+    let (alone, alone_bottom) = settle(&untethered(XpbdSolve::Sweep));
+    let (line, _) = settle(&untethered(XpbdSolve::Lines));
     assert!(line < 1e-5, "the line alone leaves a link strain of {line}");
     let (with, bottom) = settle(&tethered(1));
     println!(

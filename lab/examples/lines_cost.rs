@@ -6,11 +6,9 @@
 //! constraints. Add `ONE=1` for one thread.
 //!
 //! `cargo run -p bevy_cloth_lab --example lines_cost`
-use bevy::math::{Affine3A, Quat, Vec3};
-use bevy_cloth::params::{Environment, Model, SpringFamily, XpbdSolve};
-use bevy_cloth::prelude::*;
+use bevy_cloth::params::{Environment, SpringFamily, XpbdSolve};
 use bevy_cloth::solver::ClothSolver;
-use bevy_cloth_lab::peers::{FRAME, SPACING, ours_params};
+use bevy_cloth_lab::peers::{FRAME, Hang, ours, ours_params};
 
 fn main() {
     let side: usize = std::env::var("SIDE").map_or(64, |s| s.parse().expect("SIDE"));
@@ -21,19 +19,7 @@ fn main() {
         params.springs.shear = SpringFamily::off(f32::INFINITY);
         params.springs.bend = SpringFamily::off(0.0);
         params.springs.bend_diagonal = SpringFamily::off(0.0);
-        if let Model::Xpbd(xpbd) = &mut params.model {
-            xpbd.solve = solve;
-        }
-        let shape = ClothShape::Grid {
-            width: side as u32,
-            height: side as u32,
-            spacing: SPACING,
-        };
-        let half = (side - 1) as f32 * SPACING * 0.5;
-        let level = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
-        let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
-        let pins = ClothPins::Indices((0..side as u32).collect());
-        shape.build_solver(&pins, &params, frame).expect("builds")
+        ours(side, Hang::Swing, &params).expect("builds")
     };
     let mut cloths = [build(XpbdSolve::Lines), build(XpbdSolve::Sweep)];
     let mut env = Environment::default();

@@ -3,10 +3,8 @@
 //! (64) particles a side and `SUBSTEPS` (5).
 //!
 //! `cargo run -p bevy_cloth_lab --example self_cost`
-use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::params::{Environment, SelfCollision};
-use bevy_cloth::prelude::*;
-use bevy_cloth_lab::peers::{FRAME, SPACING, ours_params};
+use bevy_cloth_lab::peers::{FRAME, Hang, ours, ours_params};
 use std::time::Duration;
 
 fn main() {
@@ -14,20 +12,11 @@ fn main() {
     let substeps: u32 = std::env::var("SUBSTEPS").map_or(5, |s| s.parse().expect("SUBSTEPS"));
     bevy_cloth::solver::set_parallel(std::env::var("ONE").is_err());
     for on in [false, true] {
-        let mut params = ours_params(substeps, true, true);
+        let mut params = ours_params(substeps, true, false);
         if on {
             params.self_collision = SelfCollision::on();
         }
-        let shape = ClothShape::Grid {
-            width: side as u32,
-            height: side as u32,
-            spacing: SPACING,
-        };
-        let half = (side - 1) as f32 * SPACING * 0.5;
-        let level = Quat::from_rotation_x(std::f32::consts::FRAC_PI_2);
-        let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
-        let pins = ClothPins::Indices((0..side as u32).collect());
-        let mut cloth = shape.build_solver(&pins, &params, frame).expect("builds");
+        let mut cloth = ours(side, Hang::Swing, &params).expect("builds");
         let mut env = Environment::default();
         env.wind.strength = 0.0;
         let mut rows: Vec<[Duration; 4]> = Vec::new();

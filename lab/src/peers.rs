@@ -440,28 +440,36 @@ struct Ours {
 
 impl Ours {
     fn new(side: usize, hang: Hang, params: &ClothParams) -> Result<Self, String> {
-        let shape = ClothShape::Grid {
-            width: side as u32,
-            height: side as u32,
-            spacing: SPACING,
-        };
-        // The grid hangs down −y from the middle of its top edge: moved to the bench's
-        // origin, and turned level (rows along +z) for the swing.
-        let half = (side - 1) as f32 * SPACING * 0.5;
-        let level = match hang {
-            Hang::Swing => Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
-            _ => Quat::IDENTITY,
-        };
-        let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
-        let pins = ClothPins::Indices(hang.pins(side));
-        let cloth = shape
-            .build_solver(&pins, params, frame)
-            .map_err(|e: ClothError| e.to_string())?;
+        let cloth = ours(side, hang, params).map_err(|e: ClothError| e.to_string())?;
         let mut env = Environment::default();
         env.wind.strength = 0.0;
         env.gravity = gravity();
         Ok(Self { cloth, env })
     }
+}
+
+/// Our cloth of the bench: the `side × side` grid at [`SPACING`], hung by `hang` (its top
+/// row's middle at the bench's origin, turned level for the swing), with `params`.
+pub fn ours(
+    side: usize,
+    hang: Hang,
+    params: &ClothParams,
+) -> Result<bevy_cloth::solver::ClothSolver, ClothError> {
+    let shape = ClothShape::Grid {
+        width: side as u32,
+        height: side as u32,
+        spacing: SPACING,
+    };
+    // The grid hangs down −y from the middle of its top edge: moved to the bench's
+    // origin, and turned level (rows along +z) for the swing.
+    let half = (side - 1) as f32 * SPACING * 0.5;
+    let level = match hang {
+        Hang::Swing => Quat::from_rotation_x(std::f32::consts::FRAC_PI_2),
+        _ => Quat::IDENTITY,
+    };
+    let frame = Affine3A::from_rotation_translation(level, Vec3::new(half, 0.0, 0.0));
+    let pins = ClothPins::Indices(hang.pins(side));
+    shape.build_solver(&pins, params, frame)
 }
 
 impl Frames for Ours {
