@@ -30,7 +30,7 @@ use crate::{Cloth, ClothCollider, ClothEnvironment, ClothLod, ClothStats};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ClothScene {
-    /// Fixed timestep in s (seed 000 §5: 16 ms).
+    /// Fixed timestep in s (Sladović 2014 §5: 16 ms).
     #[serde(default = "default_timestep")]
     pub timestep: f32,
     /// Gravity and wind.

@@ -1,12 +1,13 @@
-//! The seed's keyboard controls for the simulation (seed 000 §3.1 and Privitak, seed 002
-//! §2.1), as an opt-in plugin for demos and tools: a game keeps its keys unless it adds it.
+//! The source works' keyboard controls for the simulation (Sladović 2014 §3.1 and its
+//! appendix; Maslova §2.1), as an opt-in plugin for demos and tools: a game keeps its keys
+//! unless it adds it.
 //!
 //! | key | action |
 //! | --- | --- |
 //! | O / P | lower / raise the wind strength |
 //! | keypad 4 / 6 | turn the wind left / right (about the vertical) |
 //! | keypad 8 / 2 | tilt the wind up / down |
-//! | G | gravity on / off (seed 000's `toggleGravity`) |
+//! | G | gravity on / off (Sladović 2014's `toggleGravity`) |
 //! | Space | pause / resume |
 //! | N | one step while paused |
 //! | R | reset every cloth (undoes grabs and cuts) |

@@ -8,7 +8,7 @@ use crate::params::{Model, PatchParams};
 
 /// Level of detail: the cloth's model follows its size on screen. At level 0
 /// the cloth runs its own model; below each threshold it switches to the patch model with
-/// parts of 2×2, 4×4 and 8×8 particles (seed 000 §3.4: cheaper the larger the parts),
+/// parts of 2×2, 4×4 and 8×8 particles (Sladović 2014 §3.4: cheaper the larger the parts),
 /// which adopts the running state (no jump), and back as the cloth grows on screen. The
 /// size is the cloth's bounding sphere projected by the active camera, as a fraction of
 /// the view's height. Grid cloths only (the patch model needs a grid): on others it

@@ -1,7 +1,7 @@
 //! Kinematic drivers: what moves particles by prescription rather than by force. Pins
 //! follow the cloth's frame and a grabbed particle follows its tool, both over the
 //! substeps of a step; seams shorten from their starting gap to their rest length over
-//! the sewing time (seed 002 §1.4); motion constraints keep particles within a distance
+//! the sewing time (Maslova §1.4); motion constraints keep particles within a distance
 //! of targets that move (NvCloth's motion constraints, Unreal's painted max distance: a
 //! skirt on a walking body).
 

@@ -1,5 +1,5 @@
 //! Stage 1 of a substep, the forces the models share: gravity, wind and drag on every
-//! particle, and Hooke springs (seed 002 eq. 1.4) with damping along them.
+//! particle, and Hooke springs (Maslova eq. 1.4) with damping along them.
 
 use bevy::math::Vec3;
 
@@ -9,8 +9,8 @@ use super::{ClothSolver, Particles, SpringKind, Springs};
 use crate::params::{Air, Environment};
 
 impl ClothSolver {
-    /// Sets every particle's force to gravity (seed 002 eq. 1.6) and wind. The linear drag
-    /// `−c v` (seed 000 eq. 31) is not a force here: the integrators take it implicitly
+    /// Sets every particle's force to gravity (Maslova eq. 1.6) and wind. The linear drag
+    /// `−c v` (Sladović 2014 eq. 31) is not a force here: the integrators take it implicitly
     /// (`integrate.rs`), stable at any drag, mass and step. While its seams are being sewn, a garment is held as a
     /// tailor holds it: gravity and wind act once the seams are closed (otherwise the
     /// pieces would fall past the body in the time it takes to sew them).
@@ -131,10 +131,10 @@ impl ClothSolver {
     }
 }
 
-/// Hooke springs `F = k (|l| − l0) l/|l|` (seed 002 eq. 1.4) plus damping along the
+/// Hooke springs `F = k (|l| − l0) l/|l|` (Maslova eq. 1.4) plus damping along the
 /// spring, over the springs `range` of `s`, each scaled by `scale(spring)`. Each spring
 /// pushes its ends with equal and opposite forces; dividing by each end's mass in
-/// `integrate` shares the motion by inverse mass, as seed 000 eq. 2 asks.
+/// `integrate` shares the motion by inverse mass, as Sladović 2014 eq. 2 asks.
 #[inline(always)]
 pub(super) fn spring_forces(
     s: &Springs,

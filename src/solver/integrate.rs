@@ -42,7 +42,7 @@ impl ClothSolver {
 /// The factor implicit linear drag scales a substep's new velocity by: `v' = (v + h a) /
 /// (1 + h c/m)`, the backward-Euler step of `m dv/dt = F − c v`. It lies in (0, 1] for
 /// any drag, mass and step (explicit `v' = v + h (a − c v/m)` diverges once `h c/m > 2`:
-/// at seed 002's lightest material, 0.001 g, with 0.005 N·s/m drag, from h = 0.4 ms).
+/// at Maslova's lightest material, 0.001 g, with 0.005 N·s/m drag, from h = 0.4 ms).
 #[inline]
 fn drag_factor(h: f32, drag: f32, lump: f32, inv_mass: f32) -> f32 {
     1.0 / (1.0 + h * drag * lump * inv_mass)
@@ -52,7 +52,7 @@ fn drag_factor(h: f32, drag: f32, lump: f32, inv_mass: f32) -> f32 {
 /// implicit drag.
 pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
     let (n, h2) = (p.len(), h * h);
-    // Seed 002 eq. 1.12 prints `+ a Δt²/2`; substituting eq. 1.10 into 1.9
+    // Maslova eq. 1.12 prints `+ a Δt²/2`; substituting eq. 1.10 into 1.9
     // drops the `x_{n−1}` Taylor term, and the correct Störmer–Verlet step is
     // `x' = 2x − x_prev + a Δt²` (with the ½, free fall would reach only g t²/4).
     // Written as `x' = x + ((x − x_prev) + a Δt²)` with compensated summation:
@@ -96,7 +96,7 @@ pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
 /// of the position still moves it over many substeps.
 pub(crate) fn symplectic_euler<const COMPENSATED: bool>(p: &mut Particles, h: f32, drag: f32) {
     let n = p.len();
-    // Seed 000 eq. 21–22: the new velocity first, then the position from it.
+    // Sladović 2014 eq. 21–22: the new velocity first, then the position from it.
     let kernel = |ParticlePiece {
                       position,
                       previous,
@@ -133,8 +133,8 @@ mod tests {
     use super::*;
 
     /// One particle under a constant force: Verlet's step is `x' = 2x − x_prev + a h²`
-    /// (seed 002 eq. 1.9–1.10, corrected, see [`verlet`]) with `v = (x' − x)/h`;
-    /// symplectic Euler's `v' = v + a h`, `x' = x + v' h` (seed 000 eq. 21–22). A pinned
+    /// (Maslova eq. 1.9–1.10, corrected, see [`verlet`]) with `v = (x' − x)/h`;
+    /// symplectic Euler's `v' = v + a h`, `x' = x + v' h` (Sladović 2014 eq. 21–22). A pinned
     /// particle (`1/m = 0`) stays.
     #[test]
     fn one_particle_steps_as_the_integrators_formulas() {

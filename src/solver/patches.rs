@@ -1,4 +1,4 @@
-//! The hybrid patch model (seed 000 §3.4): the grid is split into parts of w×h particles;
+//! The hybrid patch model (Sladović 2014 §3.4): the grid is split into parts of w×h particles;
 //! the parts' centres of mass form a mass-spring lattice (a [`ClothSolver`] of its own, each
 //! node a lump of its particles) that feels gravity, wind, drag and the part springs; the
 //! particles follow targets interpolated between neighbouring part centres.
@@ -470,7 +470,7 @@ impl Patches {
         self.layout.len()
     }
 
-    /// Targets of every particle from the part centres (seed 000 §3.4, Slika 7–9), given
+    /// Targets of every particle from the part centres (Sladović 2014 §3.4, fig. 7–9), given
     /// the particles' current positions `x` (used only when the cloth is one part wide or
     /// high). Allocates nothing.
     pub fn compute_targets(&mut self, x: &[Vec3], patch: &PatchParams) {
@@ -505,7 +505,7 @@ impl Patches {
         }
         let size = |p: Part, horizontal: bool| if horizontal { p.width } else { p.height } as f32;
         // Neighbour centres and their rest distances in particle spacings; a missing
-        // neighbour is a "ghost" mirrored through this centre (Slika 9).
+        // neighbour is a "ghost" mirrored through this centre (fig. 9).
         let neighbour = |dx: i32, dy: i32| -> Option<(Vec3, f32)> {
             let (qx, qy) = (px as i32 + dx, py as i32 + dy);
             if qx < 0 || qy < 0 || qx >= nx as i32 || qy >= ny as i32 {
@@ -536,7 +536,7 @@ impl Patches {
         };
         let ((l, dl), (r, dr)) = axis(neighbour(-1, 0), neighbour(1, 0), true);
         let ((t, dt), (b, db)) = axis(neighbour(0, -1), neighbour(0, 1), false);
-        // Seed 000's pseudocode, generalised to unequal neighbours (edge parts):
+        // Sladović 2014's pseudocode, generalised to unequal neighbours (edge parts):
         // horizontal = (right − left) / (2w), vertical = (bottom − top) / (2h),
         // start = (top + left)/2 shifted by half a step; target = start + j·v + i·h.
         let horizontal = (r - l) / (dl + dr);

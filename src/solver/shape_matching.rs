@@ -1,4 +1,4 @@
-//! Meshless shape matching (seed 000 §2.3, §3.3; Müller et al. 2005): each cluster of
+//! Meshless shape matching (Sladović 2014 §2.3, §3.3; Müller et al. 2005): each cluster of
 //! particles finds the rigid motion that best maps its rest shape onto its current shape;
 //! the moved rest positions are the particles' goals.
 
@@ -10,7 +10,7 @@ use crate::params::{RotationMethod, ShapeMatchingParams};
 #[derive(Clone, Debug)]
 struct Cluster {
     particles: Vec<u32>,
-    /// `q_i = x_i0 − x_cm0` (seed 000 eq. 5, 12), in the same order as `particles`.
+    /// `q_i = x_i0 − x_cm0` (Sladović 2014 eq. 5, 12), in the same order as `particles`.
     rest_offsets: Vec<Vec3>,
     /// `(Σ m q qᵀ)⁻¹`, regularised for a flat rest shape (for β blending).
     a_qq_inv: Mat3,
@@ -88,7 +88,7 @@ impl ShapeMatching {
         self.clusters.len()
     }
 
-    /// Goals `g_i = G (x_i0 − x_cm0) + x_cm` (seed 000 eq. 12) from the current positions,
+    /// Goals `g_i = G (x_i0 − x_cm0) + x_cm` (Sladović 2014 eq. 12) from the current positions,
     /// with `G = R` or Müller's `β A + (1 − β) R`. Allocates nothing.
     ///
     /// Each cluster weighs its particles by `m_i / n_i` (n_i: the clusters holding the
@@ -104,7 +104,7 @@ impl ShapeMatching {
         let inv_count = &self.inv_cluster_count;
         let weight = |i: u32| mass[i as usize] * inv_count[i as usize];
         for c in &mut self.clusters {
-            let com = centre_of_mass(&c.particles, x, weight); // seed 000 eq. 4
+            let com = centre_of_mass(&c.particles, x, weight); // Sladović 2014 eq. 4
             let mut a_pq = Mat3::ZERO;
             for (&i, q) in c.particles.iter().zip(&c.rest_offsets) {
                 a_pq += outer((x[i as usize] - com) * weight(i), *q);
@@ -179,7 +179,7 @@ fn regularised_inverse(a_qq: Mat3) -> Mat3 {
     if inv.is_finite() { inv } else { Mat3::ZERO }
 }
 
-/// Seed 000 eq. 6–9: per particle, the rotation of the rest offset onto the current
+/// Sladović 2014 eq. 6–9: per particle, the rotation of the rest offset onto the current
 /// offset; the quaternions summed component-wise and normalised once, so every particle
 /// weighs the same whatever its place in the order. Each quaternion is flipped into the
 /// hemisphere of the cluster's previous rotation first (q and −q are the same rotation;
@@ -202,7 +202,7 @@ fn average_rotation(c: &Cluster, x: &[Vec3], com: Vec3) -> Quat {
     }
 }
 
-/// The rotation part of `A` (seed 000 eq. 15–16) by the iterative method of Müller,
+/// The rotation part of `A` (Sladović 2014 eq. 15–16) by the iterative method of Müller,
 /// Bender, Chentanez and Macklin (2016), "A robust method to extract the rotational part
 /// of deformations": maximise tr(Rᵀ A) by rotating `R` about `ω = Σ r_i × a_i / |Σ r_i·a_i|`.
 /// Works for rank-deficient `A` (flat or straight shapes), never yields a reflection or a
