@@ -240,9 +240,16 @@ impl ClothSolver {
             }
         };
         let (structural, shear) = fabric.grid_springs();
+        // Along lines the structural family is solved exactly, with no softening (a soft
+        // grid settles at its static stretch at 20 substeps, `tests/xpbd.rs`): only the
+        // swept shear family bounds the substeps.
+        let springs_k = match xpbd.solve {
+            XpbdSolve::Lines => shear,
+            XpbdSolve::Sweep => structural.max(shear),
+        };
         let strain = self.structural_strain().max(0.0);
         // `h² · 2 w k · ε ≤ max_stretch_error` and `h² · hinges ≤ FABRIC_SOFTENING`.
-        let springs = 2.0 * w * structural.max(shear) * strain / xpbd.max_stretch_error;
+        let springs = 2.0 * w * springs_k * strain / xpbd.max_stretch_error;
         let most = springs.max(hinges / FABRIC_SOFTENING);
         let n = (dt * most.sqrt()).ceil();
         if n.is_finite() { (n as u32).max(1) } else { 1 }
