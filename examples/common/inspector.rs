@@ -7,7 +7,7 @@ use bevy::prelude::*;
 use bevy_cloth::StatSample;
 use bevy_cloth::params::{
     Air, Environment, GoalUpdate, Integrator, Model, ModelKind, PatchTargets, RotationMethod,
-    ShapeMatchingParams, SpringFamily, SpringParams, Substeps, WindField,
+    ShapeMatchingParams, SpringFamily, SpringParams, Substeps, WindField, XpbdSolve,
 };
 use bevy_cloth::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
@@ -423,6 +423,14 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
                 );
                 ui.checkbox(&mut xpbd.tethers, "tethers to the pins")
                     .on_hover_text("Long-range attachments: no particle farther from its nearest pin than the cloth between them allows (acts when the structural springs are inextensible or strain limited)");
+                let mut lines = xpbd.solve == XpbdSolve::Lines;
+                if ui
+                    .checkbox(&mut lines, "stretch solved along lines")
+                    .on_hover_text("Each row and column of structural springs solved exactly every substep (few substeps hold a moving cloth's length); off: each spring once in a sweep")
+                    .changed()
+                {
+                    xpbd.solve = if lines { XpbdSolve::Lines } else { XpbdSolve::Sweep };
+                }
                 true
             } else {
                 false
