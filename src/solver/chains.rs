@@ -33,6 +33,7 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
+use super::integrate::compensated_add;
 use super::parallel::{self, PIECE};
 use super::xpbd::Family;
 use super::{Particles, SpringKind, Springs};
@@ -402,16 +403,6 @@ fn gather(rows: &mut [Row], particle: &[u32], p: &Particles, damped: bool) {
             }
         }
     }
-}
-
-/// `x + r += delta`, keeping in `r` what rounding `x` lost (Kahan's compensated sum;
-/// Fast2Sum, exact while `|x| ≥ |delta + r|`).
-#[inline(always)]
-pub(super) fn compensated_add(x: &mut Vec3, r: &mut Vec3, delta: Vec3) {
-    let t = delta + *r;
-    let s = *x + t;
-    *r = t - (s - *x);
-    *x = s;
 }
 
 /// The Thomas algorithm on a tile's chains (see the module doc), leaving each row's

@@ -1,7 +1,8 @@
 //! Stage 2 of a substep, the integrators the models share: Störmer–Verlet and
 //! semi-implicit (symplectic) Euler, piece by piece over the compute pool.
 
-use super::chains::compensated_add;
+use bevy::math::Vec3;
+
 use super::parallel;
 use super::state::ParticlePiece;
 use super::{ClothSolver, Particles};
@@ -88,6 +89,16 @@ pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
         }
     };
     parallel::for_each(n, p.pieces(), kernel);
+}
+
+/// `x + r += delta`, keeping in `r` what rounding `x` lost (Kahan's compensated sum;
+/// Fast2Sum, exact while `|x| ≥ |delta + r|`).
+#[inline(always)]
+pub(super) fn compensated_add(x: &mut Vec3, r: &mut Vec3, delta: Vec3) {
+    let t = delta + *r;
+    let s = *x + t;
+    *r = t - (s - *x);
+    *x = s;
 }
 
 /// One symplectic Euler substep of every free particle, in pieces over the compute pool,
