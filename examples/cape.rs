@@ -1,4 +1,4 @@
-//! A cape on a running character (issue 18), with avian3d's physics: the character is an
+//! A cape on a running character, with avian3d's physics: the character is an
 //! avian capsule body that runs on a ground among obstacles (avian keeps it out of them);
 //! the cape is attached by its top edge round the character's shoulders
 //! (`ClothAttachment::at`, points of the body's frame) and collides with the character's
@@ -34,8 +34,11 @@ const LOOP_RADIUS: f32 = 3.2;
 const ARENA: f32 = 10.0;
 /// Seconds without input before the character runs its loop again.
 const SCRIPT_AFTER: f32 = 2.0;
-/// The camera looks from this angle (radians) round from straight behind the character.
+/// The camera looks from this angle (radians) round from straight behind the character,
+/// and this far (radians) down on it: high enough to look over the boxes (a camera 7°
+/// above the character lost it behind a pillar between them).
 const CAMERA_YAW: f32 = 0.6;
+const CAMERA_PITCH: f32 = 0.35;
 /// The cape: particles across and down, and their spacing (m).
 const CAPE_WIDTH: u32 = 14;
 const CAPE_HEIGHT: u32 = 17;
@@ -71,7 +74,7 @@ fn setup(
     mut materials: ResMut<Assets<StandardMaterial>>,
     mut environment: ResMut<ClothEnvironment>,
 ) {
-    // A light gusty breeze (seed 002's trigonometric field) that makes the cape ripple.
+    // A light gusty breeze (Maslova's trigonometric field) that makes the cape ripple.
     environment.wind = Wind {
         direction: Vec3::new(0.4, 0.0, 1.0),
         strength: 0.0025,
@@ -146,7 +149,8 @@ fn setup(
             Name::new("wall"),
         ));
     }
-    for at in [Vec3::new(1.6, 0.9, -1.4), Vec3::new(-2.0, 0.9, 4.5)] {
+    // One pillar inside the loop, one outside beyond where the following camera goes.
+    for at in [Vec3::new(1.6, 0.9, -1.4), Vec3::new(-2.0, 0.9, 8.5)] {
         commands.spawn((
             RigidBody::Static,
             Collider::cylinder(0.25, 1.8),
@@ -283,7 +287,7 @@ fn run(
 }
 
 /// Keeps the orbit camera on the character; while it runs its loop, the camera also
-/// swings round to look at it from behind and to one side.
+/// swings round to look at it from behind, to one side and from above.
 fn follow(runners: Query<(&Transform, &Runner)>, mut cameras: Query<&mut PanOrbitCamera>) {
     let Ok((transform, runner)) = runners.single() else {
         return;
@@ -292,6 +296,7 @@ fn follow(runners: Query<(&Transform, &Runner)>, mut cameras: Query<&mut PanOrbi
         camera.target_focus = transform.translation + Vec3::Y * 0.3;
         if runner.idle >= SCRIPT_AFTER {
             camera.target_yaw = runner.heading + CAMERA_YAW;
+            camera.target_pitch = CAMERA_PITCH;
         }
     }
 }
