@@ -1,4 +1,4 @@
-//! Seed 000's shape-matching model (§2.3, §3.3): a stiff playing card hanging from one
+//! Sladović's (2014) shape-matching model (§2.3, §3.3): a stiff playing card hanging from one
 //! corner, swinging and spinning in the wind, beside the same card as a mass-spring cloth.
 //! Same camera, keys, mouse tools, inspector and screenshot mode as the curtain.
 //!

@@ -1,4 +1,4 @@
-//! The curtain of seed 000 §3.2: a cloth hanging from its two top corners, swaying under
+//! The curtain of Sladović 2014 §3.2: a cloth hanging from its two top corners, swaying under
 //! gravity and wind. Orbit camera (left-drag away from the cloth rotates, middle-drag pans,
 //! wheel zooms), the seed's keys, mouse tools (left-drag on the cloth grabs, right-drag
 //! cuts) and an egui inspector for every parameter.

@@ -1,4 +1,4 @@
-//! A textured flag on a moving pole (issue 18): the flag's edge is attached to the pole
+//! A textured flag on a moving pole: the flag's edge is attached to the pole
 //! entity (`ClothAttachments`), so it follows the pole as it is carried round a circle and
 //! turned; the pole is a capsule collider the flag wraps against; the flag's material is
 //! your own — here a texture made in code, through the mesh's UVs (u along the width, v

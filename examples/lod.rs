@@ -1,4 +1,4 @@
-//! Level of detail (issue 16): four curtains at 0, 5, 11 and 25 m from the first, each
+//! Level of detail: four curtains at 0, 5, 11 and 25 m from the first, each
 //! with `ClothLod`: the near one runs its own model (mass-spring), the farther ones the
 //! patch model with larger parts as they shrink on the screen; zoom or orbit and watch
 //! the levels change in the inspector (each cloth's level, size on screen and step time).

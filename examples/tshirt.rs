@@ -1,4 +1,4 @@
-//! Seed 002's T-shirt: two 0/1 pattern pieces (`assets/patterns/`) sewn together by seam
+//! Maslova's T-shirt: two 0/1 pattern pieces (`assets/patterns/`) sewn together by seam
 //! springs around a mannequin of capsules and spheres, settling onto it and fluttering in
 //! the wind. The inspector edits node mass, stiffness, seams, the front and back colours,
 //! the diffuse and specular coefficients and the light; the same camera, keys, tools and

@@ -1,7 +1,7 @@
 //! # bevy_cloth
 //!
 //! Cloth simulation for Bevy on the CPU: the mass-spring model of the 2014 thesis
-//! "Model elastične tkanine" (seed 000) and the BMSTU T-shirt course work (seed 002),
+//! "Model elastične tkanine" (Sladović 2014) and the BMSTU T-shirt course work (Maslova),
 //! with a measured solver that runs the same way in a game, a test and a benchmark.
 //!
 //! Add [`ClothPlugin`] and spawn a [`Cloth`]:

@@ -34,7 +34,7 @@ pub const MAX_WORK_PER_STEP: u64 = 1 << 26;
 /// seam, took its 500 sweeps every substep: the T-shirt inside a capsule of radius 100 km
 /// cost 503 ms a step at 36 substeps, 91 ms with this budget (`cloth run`, the median of
 /// 50 steps, which now warn). Steps that converge are not cut: the T-shirt scene's own
-/// (3.1 ms) and seed 002's corners on it (`tests/garment.rs`; 0.001 g at 100 and 25,000
+/// (3.1 ms) and Maslova's corners on it (`tests/garment.rs`; 0.001 g at 100 and 25,000
 /// N/m: 39 and 369 ms at 454 and 4,040 substeps, the same strain as without the budget).
 /// At 32 sweeps a substep the 1 g, 100 N/m corner (12 substeps) ran out of it.
 pub fn limiter_budget(substeps: u32) -> u32 {
@@ -63,13 +63,13 @@ pub const MAX_GRAVITY: f32 = 1_000.0;
 /// Wind strength, N per particle (a 0.5 g particle then accelerates at 2·10⁶ m/s²).
 pub const MAX_WIND: f32 = 1_000.0;
 
-/// A particle's mass, kg: seed 002's range is 1e-6 to 1e-3; past these, forces and
+/// A particle's mass, kg: Maslova's range is 1e-6 to 1e-3; past these, forces and
 /// accelerations leave `f32`'s range within a few steps.
 pub const MIN_NODE_MASS: f32 = 1e-9;
 /// See [`MIN_NODE_MASS`].
 pub const MAX_NODE_MASS: f32 = 1e3;
 
-/// A spring family's (or a pull's) stiffness, N/m (seed 002's stiffest is 25,000; XPBD
+/// A spring family's (or a pull's) stiffness, N/m (Maslova's stiffest is 25,000; XPBD
 /// also takes `inf`).
 pub const MAX_STIFFNESS: f32 = 1e9;
 

@@ -31,13 +31,13 @@ pub mod vec3_serde {
     }
 }
 
-/// One family of springs (seed 000 §2.2, Slika 1): whether it exists and how stiff it is.
+/// One family of springs (Sladović 2014 §2.2, fig. 1): whether it exists and how stiff it is.
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SpringFamily {
-    /// Switch the whole family off (seed 000 §4, Slika 18–20 show cloth without each family).
+    /// Switch the whole family off (Sladović 2014 §4, figs. 18–20 show cloth without each family).
     pub enabled: bool,
-    /// Hooke constant `k` in N/m (seed 002 eq. 1.4).
+    /// Hooke constant `k` in N/m (Maslova eq. 1.4).
     pub stiffness: f32,
 }
 
@@ -83,11 +83,11 @@ pub struct SpringParams {
     pub shear: SpringFamily,
     /// Every second particle (i±2, j±2), rest length = 2·spacing.
     pub bend: SpringFamily,
-    /// Every second particle diagonally, rest length = 2√2·spacing (seed 000 §2.2, optional).
+    /// Every second particle diagonally, rest length = 2√2·spacing (Sladović 2014 §2.2, optional).
     pub bend_diagonal: SpringFamily,
     /// Damping along each spring in N·s/m: `F = c ((v_b − v_a)·d̂) d̂`.
     pub damping: f32,
-    /// Seam springs joining garment pieces (seed 002 §1.4).
+    /// Seam springs joining garment pieces (Maslova §1.4).
     pub seam: SpringFamily,
     /// The length a seam spring is sewn to, m (0: the two edges meet).
     pub seam_rest_length: f32,
@@ -99,7 +99,7 @@ pub struct SpringParams {
 }
 
 impl Default for SpringParams {
-    /// Seed 000 §4's structural:shear:bend ratio of 2:1:1, at a stiffness soft enough that
+    /// Sladović 2014 §4's structural:shear:bend ratio of 2:1:1, at a stiffness soft enough that
     /// a 0.5 g-per-node cloth drapes and folds under its own weight; the strain limiter
     /// (Provot 1995) keeps the stretch below 10%. Stiffer springs make a board-like sheet
     /// that will not buckle, and cost more substeps.
@@ -137,10 +137,10 @@ impl SpringParams {
 /// where Euler's velocity stays exact (`cloth accuracy` uses Euler for its reference).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum Integrator {
-    /// Position Verlet, seed 002 eq. 1.12: `x' = 2x − x_prev + a h²`.
+    /// Position Verlet, Maslova eq. 1.12: `x' = 2x − x_prev + a h²`.
     #[default]
     Verlet,
-    /// Semi-implicit (symplectic) Euler, seed 000 eq. 21–22: `v' = v + a h`, `x' = x + v' h`.
+    /// Semi-implicit (symplectic) Euler, Sladović 2014 eq. 21–22: `v' = v + a h`, `x' = x + v' h`.
     SemiImplicitEuler,
 }
 
@@ -168,20 +168,20 @@ impl Default for Substeps {
     }
 }
 
-/// Seed 000 §4: exponents of the pull toward a goal stay within [0.5, 3].
+/// Sladović 2014 §4: exponents of the pull toward a goal stay within [0.5, 3].
 fn check_exponent(exponent: f32) -> Result<(), ClothError> {
     check(
         "model.exponent",
         exponent,
         (0.5..=3.0).contains(&exponent),
-        "an exponent in [0.5, 3] (seed 000 §4)",
+        "an exponent in [0.5, 3] (Sladović 2014 §4)",
     )
 }
 
 /// How shape matching finds the rotation of a cluster.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum RotationMethod {
-    /// Seed 000 eq. 6–9: the rotation of each particle's rest offset onto its current
+    /// Sladović 2014 eq. 6–9: the rotation of each particle's rest offset onto its current
     /// offset as a quaternion, averaged component-wise and normalised once (the thesis's
     /// faster variant). Fast; an approximation that is exact for rotations about the
     /// cloth's normal and degrades for large rotations about in-plane axes (see the
@@ -189,7 +189,7 @@ pub enum RotationMethod {
     /// every particle, weighs the last particle ½, the one before ¼, …: its rotation
     /// depends on the particles' order, so it is not offered.
     QuaternionAverage,
-    /// Seed 000 eq. 14–16: the rotation part of `A_pq = Σ m p qᵀ`, found by the iterative
+    /// Sladović 2014 eq. 14–16: the rotation part of `A_pq = Σ m p qᵀ`, found by the iterative
     /// method of Müller et al. 2016 (robust for the rank-2 `A_pq` of a flat cloth and
     /// rank-1 of a strip; never a reflection; warm-started from the last step).
     #[default]
@@ -200,7 +200,7 @@ pub enum RotationMethod {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum GoalUpdate {
     /// A force `α (|d|/L)^(p−1) d` toward the goal (`d = g − x`, L = the cloth's
-    /// spacing), as seed 000 §4 describes: exponent p in [0.5, 3], stiffness α in N/m,
+    /// spacing), as Sladović 2014 §4 describes: exponent p in [0.5, 3], stiffness α in N/m,
     /// integrated with the other forces.
     #[default]
     Force,
@@ -209,7 +209,7 @@ pub enum GoalUpdate {
     Velocity,
 }
 
-/// Parameters of the meshless shape-matching model (seed 000 §2.3, §3.3; Müller 2005).
+/// Parameters of the meshless shape-matching model (Sladović 2014 §2.3, §3.3; Müller 2005).
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ShapeMatchingParams {
@@ -219,9 +219,9 @@ pub struct ShapeMatchingParams {
     pub update: GoalUpdate,
     /// Stiffness α: N/m for `Force`, a fraction 0–1 per substep for `Velocity`.
     pub stiffness: f32,
-    /// Exponent p of the force law (seed 000 §4: 0.5–3); 1 is a linear spring.
+    /// Exponent p of the force law (Sladović 2014 §4: 0.5–3); 1 is a linear spring.
     pub exponent: f32,
-    /// Damping of each particle's velocity, N·s/m (seed 000 §4's particle damping).
+    /// Damping of each particle's velocity, N·s/m (Sladović 2014 §4's particle damping).
     pub damping: f32,
     /// Müller's β: goals from `β A + (1 − β) R`, letting the card shear and stretch a
     /// little (an extension beyond the thesis). 0 = rigid goals.
@@ -288,9 +288,9 @@ impl ShapeMatchingParams {
 /// How the patch model places particle targets between part centres.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum PatchTargets {
-    /// Seed 000 §3.4's pseudocode: an affine map per part from its four neighbours.
+    /// Sladović 2014 §3.4's pseudocode: an affine map per part from its four neighbours.
     /// Neighbouring parts disagree along their border when the lattice bends (the
-    /// thesis's visible borders, Slika 22). (`Seed` in older scene files.)
+    /// thesis's visible borders, fig. 22). (`Seed` in older scene files.)
     #[serde(alias = "Seed")]
     PerPart,
     /// Bilinear interpolation between the four part centres around each particle
@@ -301,7 +301,7 @@ pub enum PatchTargets {
     Bilinear,
 }
 
-/// Parameters of the hybrid patch model (seed 000 §3.4).
+/// Parameters of the hybrid patch model (Sladović 2014 §3.4).
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PatchParams {
@@ -311,9 +311,9 @@ pub struct PatchParams {
     pub part_height: u32,
     /// Stiffness α of the pull toward the targets, N/m (as shape matching's force).
     pub stiffness: f32,
-    /// Exponent p of the pull (seed 000 §4: 0.5–3).
+    /// Exponent p of the pull (Sladović 2014 §4: 0.5–3).
     pub exponent: f32,
-    /// Particle damping as a fraction of critical damping `2√(α m)` (seed 000 §4 keeps
+    /// Particle damping as a fraction of critical damping `2√(α m)` (Sladović 2014 §4 keeps
     /// particle damping separate from part damping).
     pub particle_damping_ratio: f32,
     /// Extra damping of the part centres, N·s/m per particle (added to the drag).
@@ -323,7 +323,7 @@ pub struct PatchParams {
     /// [`PatchTargets::PerPart`]: the bilinear targets ignore it (a per-part shift would
     /// break their continuity across part borders).
     pub center_correction: bool,
-    /// "Tiles" (Slika 12): particles sit exactly on their targets, no oscillation. The
+    /// "Tiles" (fig. 12): particles sit exactly on their targets, no oscillation. The
     /// pull is then neither computed nor integrated, and only the part lattice sets the
     /// substeps: the cheap end of the model.
     pub tiles: bool,
@@ -463,14 +463,14 @@ impl XpbdParams {
 /// Which cloth model moves the particles.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Reflect, Serialize, Deserialize)]
 pub enum Model {
-    /// Springs between particles (seed 000 §2.2, §3.2; seed 002).
+    /// Springs between particles (Sladović 2014 §2.2, §3.2; Maslova).
     #[default]
     MassSpring,
     /// Each particle pulled toward a goal from the best rigid fit of the rest shape
-    /// (seed 000 §2.3, §3.3). No springs act, so nothing tears.
+    /// (Sladović 2014 §2.3, §3.3). No springs act, so nothing tears.
     ShapeMatching(ShapeMatchingParams),
     /// Parts of w×h particles whose centres form a mass-spring lattice; particles follow
-    /// targets interpolated between neighbouring centres (seed 000 §3.4). Grids only.
+    /// targets interpolated between neighbouring centres (Sladović 2014 §3.4). Grids only.
     Patches(PatchParams),
     /// The springs as compliant distance constraints, solved once per small substep
     /// (XPBD): stable at any stiffness and substep count. Not in the seeds.
@@ -560,11 +560,11 @@ impl std::str::FromStr for ModelKind {
 pub struct ClothParams {
     /// The cloth model; spring parameters are used by the mass-spring and XPBD models.
     pub model: Model,
-    /// Mass of one particle in kg (seed 002 §1.4: 0.001–1 g, i.e. 1e-6–1e-3 kg).
+    /// Mass of one particle in kg (Maslova §1.4: 0.001–1 g, i.e. 1e-6–1e-3 kg).
     pub node_mass: f32,
     /// Spring families and spring damping.
     pub springs: SpringParams,
-    /// Linear air drag per particle in N·s/m: `F = −c v` (seed 000 eq. 31, seed 002 eq. 1.5).
+    /// Linear air drag per particle in N·s/m: `F = −c v` (Sladović 2014 eq. 31, Maslova eq. 1.5).
     pub drag: f32,
     /// The time integrator.
     pub integrator: Integrator,
@@ -580,7 +580,7 @@ pub struct ClothParams {
     /// once a sweep finds no spring longer than `(1 + limit + tolerance)·l0`. `None`:
     /// exactly `strain_limit_iterations` sweeps (a game's fixed cost).
     pub strain_limit_tolerance: Option<f32>,
-    /// A spring longer than `tear_ratio · rest_length` breaks (seed 000 §3.2). `None`: never.
+    /// A spring longer than `tear_ratio · rest_length` breaks (Sladović 2014 §3.2). `None`: never.
     pub tear_ratio: Option<f32>,
     /// Particles of the cloth kept apart from one another, so folds do not pass through
     /// themselves (XPBD and mass-spring). Off by default.
@@ -849,10 +849,10 @@ impl ClothParams {
 /// The spatial pattern of the wind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Reflect, Serialize, Deserialize)]
 pub enum WindField {
-    /// The same force on every particle: `F = strength · d̂` (seed 000 §3.2).
+    /// The same force on every particle: `F = strength · d̂` (Sladović 2014 §3.2).
     #[default]
     Constant,
-    /// Seed 002 listing 3.3: gusts from trigonometric functions of position and time.
+    /// Maslova listing 3.3: gusts from trigonometric functions of position and time.
     /// With `d̂ = +z` and strength 0.1 this is the listing's
     /// `(0.1 sin(10t), ·, 0.1 |sin(z + 10t)|)`; the listing's middle (y) line is missing
     /// from the seed text, so the vertical component here is 0.
@@ -930,7 +930,7 @@ impl WindAt {
         let d = self.direction;
         match self.field {
             WindField::Constant => d * self.strength,
-            // Seed 002 listing 3.3, rotated so that the listing's +z is `d`.
+            // Maslova listing 3.3, rotated so that the listing's +z is `d`.
             WindField::Trigonometric => {
                 let along = (position.dot(d) + self.phase).sin().abs();
                 self.strength * (along * d + self.across * self.side)
@@ -961,7 +961,7 @@ pub struct Air {
     /// The air's velocity far from the cloth, m/s (its pattern in space and time: `field`).
     #[serde(with = "vec3_serde")]
     pub velocity: Vec3,
-    /// Its spatial and temporal pattern ([`WindField`]: constant, or seed 002's gusts).
+    /// Its spatial and temporal pattern ([`WindField`]: constant, or Maslova's gusts).
     pub field: WindField,
     /// Its density, kg/m³ (1.2 at sea level and 20 °C).
     pub density: f32,
@@ -985,7 +985,7 @@ impl Default for Air {
 
 impl Air {
     /// The air's velocity at `position` at simulated time `time`: `velocity`, or with
-    /// seed 002's gusts their pattern at the speed of `velocity`.
+    /// Maslova's gusts their pattern at the speed of `velocity`.
     pub fn velocity_at(&self, position: Vec3, time: f32) -> Vec3 {
         self.at_time(time).force_at(position)
     }
@@ -1030,10 +1030,10 @@ impl Air {
 #[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct Environment {
-    /// Acceleration of gravity in m/s² (seed 002 eq. 1.6).
+    /// Acceleration of gravity in m/s² (Maslova eq. 1.6).
     #[serde(with = "vec3_serde")]
     pub gravity: Vec3,
-    /// Switch gravity off without forgetting its value (seed 000's G key).
+    /// Switch gravity off without forgetting its value (Sladović's (2014) G key).
     pub gravity_enabled: bool,
     /// The wind as a force per particle (the seeds' scenes).
     pub wind: Wind,
@@ -1090,8 +1090,9 @@ impl Environment {
 }
 
 /// Refuses `params` on a cloth of `particles` when a step's fixed work is over
-/// [`MAX_WORK_PER_STEP`](crate::limits::MAX_WORK_PER_STEP) (particles × fixed substeps) or [`MAX_SWEEP_WORK_PER_STEP`](crate::limits::MAX_SWEEP_WORK_PER_STEP)
-/// (× fixed limiter sweeps). Automatic substeps are capped at the budget instead (see
+/// [`MAX_WORK_PER_STEP`](crate::limits::MAX_WORK_PER_STEP) (particles × fixed substeps) or
+/// [`MAX_SWEEP_WORK_PER_STEP`](crate::limits::MAX_SWEEP_WORK_PER_STEP) (× fixed limiter
+/// sweeps). Automatic substeps are capped at the budget instead (see
 /// [`auto_substeps_cap`](crate::limits::auto_substeps_cap)).
 pub fn check_work(particles: usize, params: &ClothParams) -> Result<(), ClothError> {
     let n = particles as u64;

@@ -187,7 +187,7 @@ fn the_same_air_moves_the_same_fabric_the_same_at_two_resolutions() {
 
 #[test]
 fn the_lightest_seed_material_in_the_curtains_air_keeps_its_strain_limit() {
-    // Seed 002's lightest node (0.001 g) on the curtain (40 × 32 at 5 cm, XPBD at its
+    // Maslova's lightest node (0.001 g) on the curtain (40 × 32 at 5 cm, XPBD at its
     // automatic substeps, strain limit 10%) in air at 1 m/s: on a 5 cm cell facing it,
     // ½ ρ C_d A v² = 1.8 mN, the force of the curtain's per-particle wind (1.5 mN), which
     // drove it to 157% strain. The air's force does not grow as the particles get lighter.

@@ -1,4 +1,4 @@
-//! Fuzzing (issue 17): random and mutated scene, garment and pattern text and `--set`
+//! Fuzzing: random and mutated scene, garment and pattern text and `--set`
 //! pairs through the loaders and a few steps, and random edits of a running cloth through
 //! reflection in a headless App, as the inspector makes them. Each case must end in a
 //! clean error or a finite result; a panic fails the test. A seeded generator on stable

@@ -1,4 +1,4 @@
-//! Pattern files, seams, colliders and the T-shirt on its mannequin (seed 002 §1.4).
+//! Pattern files, seams, colliders and the T-shirt on its mannequin (Maslova §1.4).
 
 use std::path::Path;
 
@@ -574,7 +574,7 @@ fn the_xpbd_tshirt_at_twenty_substeps_is_sewn_shut_outside_the_mannequin() {
 
 #[test]
 fn the_seed_material_range_stays_stable_on_the_mannequin() {
-    // Seed 002 §1.4: node mass 0.001–1 g, stiffness 100–25,000 N/m. Automatic substeps
+    // Maslova §1.4: node mass 0.001–1 g, stiffness 100–25,000 N/m. Automatic substeps
     // keep every corner of that range stable for half a second after sewing (an explicit
     // instability doubles within a few substeps, so it shows well within that; the
     // stiffest, lightest corner needs thousands of substeps per step). XPBD keeps each

@@ -1,4 +1,4 @@
-//! Level of detail (issue 16): a grid cloth's model follows its size on the camera's
+//! Level of detail: a grid cloth's model follows its size on the camera's
 //! view, with a band against flicker, and switches without a jump.
 
 use bevy::camera::{Camera, PerspectiveProjection, Projection};

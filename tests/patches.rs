@@ -1,4 +1,4 @@
-//! The hybrid patch model (seed 000 §3.4): reduction to mass-spring, targets at rest and
+//! The hybrid patch model (Sladović 2014 §3.4): reduction to mass-spring, targets at rest and
 //! under rigid motion (ghost centres at the edges), tiles, and a hanging curtain.
 
 use bevy::math::{Affine3A, Quat, Vec3};
@@ -232,7 +232,7 @@ fn a_curtain_of_four_by_four_parts_hangs() {
     // both sags depend on the limiter's sweeps per step, which the automatic substeps set
     // (mass-spring 0.195 m, 4×4 parts 0.137 and 0.136 m with the power iteration's
     // substeps, the scene's 7 sweeps and the limiter's velocity from its summed
-    // corrections; 0.169 and 0.150 m at issue 12's 8 substeps and 4 sweeps).
+    // corrections; 0.169 and 0.150 m at the earlier default of 8 substeps and 4 sweeps).
     let (_, sag_ms, _, _) = hang_curtain(Model::MassSpring);
     // The default, continuous targets: within the 20% of believable cloth everywhere.
     let (_, sag, p95, max) = hang_curtain(patches(PatchTargets::Bilinear));
@@ -254,7 +254,7 @@ fn a_curtain_of_four_by_four_parts_hangs() {
         max * 100.0
     );
     // The seed's per-part targets: neighbouring parts disagree on their common border when
-    // the lattice bends (Slika 22's visible borders), so the largest strain sits there.
+    // the lattice bends (fig. 22's visible borders), so the largest strain sits there.
     let (_, sag, p95, max) = hang_curtain(patches(PatchTargets::PerPart));
     assert!(
         (sag / sag_ms - 1.0).abs() < 0.35,

@@ -1,7 +1,7 @@
-//! The render test: each example (curtain, card, T-shirt, fold's stack scene, flag, character; the cape with `--features
-//! avian`) under Xvfb with Mesa's software Vulkan, two screenshots, and checks from the
-//! pixels that the cloth is drawn where the camera looks and that it moved between them.
-//! Catches a black window, a mesh that is not updated and a frozen simulation.
+//! The render test: each example (curtain, card, T-shirt, fold's stack scene, flag, character;
+//! the cape with `--features avian`) under Xvfb with Mesa's software Vulkan, two screenshots,
+//! and checks from the pixels that the cloth is drawn where the camera looks and that it moved
+//! between them. Catches a black window, a mesh that is not updated and a frozen simulation.
 //!
 //! Needs `Xvfb` and a Vulkan driver (`apt-get install xvfb mesa-vulkan-drivers`; `.ci/run`
 //! installs them). Without Xvfb the test says so and passes, except under CI (`CI` set),
@@ -228,7 +228,7 @@ const GUSTS: &[&str] = &[
 #[test]
 fn flag_renders_and_moves() {
     // The textured flag on its pole, carried round a circle: its coloured bands are the
-    // cloth's pixels, and it moves with the pole (issue 18's attachment and texture).
+    // cloth's pixels, and it moves with the pole (the attachment and the texture).
     renders_and_moves("flag", &[], (40, 120), 0.005..0.4);
 }
 

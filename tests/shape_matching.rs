@@ -1,4 +1,4 @@
-//! Shape matching (seed 000 §2.3, §3.3): goals against rigid motions known exactly,
+//! Shape matching (Sladović 2014 §2.3, §3.3): goals against rigid motions known exactly,
 //! degenerate shapes, return to rest, the two rotation methods, the force exponent.
 
 use bevy::math::{Affine3A, Quat, Vec3};
@@ -337,7 +337,7 @@ fn halving_time(exponent: f32, offset: f32) -> f32 {
 
 #[test]
 fn larger_exponents_return_faster_from_far_and_slower_from_near() {
-    // L = spacing = 9 mm: "far" is 3 L, "near" is L/5 (seed 000 §4).
+    // L = spacing = 9 mm: "far" is 3 L, "near" is L/5 (Sladović 2014 §4).
     let (far, near) = (0.027, 0.0018);
     let (p1_far, p2_far) = (halving_time(1.0, far), halving_time(2.0, far));
     let (p1_near, p2_near) = (halving_time(1.0, near), halving_time(2.0, near));

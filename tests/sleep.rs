@@ -1,4 +1,4 @@
-//! Sleeping (issue 16): a still cloth falls asleep, costs no step, and wakes within one
+//! Sleeping: a still cloth falls asleep, costs no step, and wakes within one
 //! step on each thing that can move it, without a jump. Headless App, manual 16 ms time.
 
 use bevy::prelude::*;

@@ -353,7 +353,7 @@ fn tears_past_its_ratio_and_not_below(model: Model) {
     );
 }
 
-/// Seed 002's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
+/// Maslova's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
 fn seed_002_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
     let params = ClothParams {
         node_mass: 1e-6,
@@ -365,7 +365,7 @@ fn seed_002_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
 }
 
 /// A `size × size` grid (5 cm spacing) pinned by its top corners, tilted 1.2 rad from
-/// hanging so it swings, in seed 002's gusty wind of `wind` N a particle.
+/// hanging so it swings, in Maslova's gusty wind of `wind` N a particle.
 fn tilted_in_gusts(size: u32, params: &ClothParams, wind: f32) -> (ClothSolver, Environment) {
     let cloth = ClothShape::Grid {
         width: size,
@@ -1229,7 +1229,7 @@ fn the_step_report_counts_substeps_times_stages_and_measures_xpbd_strain() {
 
 #[test]
 fn the_lightest_seed_material_with_drag_is_stable_at_one_substep() {
-    // Seed 002's lightest node, 0.001 g, with 0.005 N·s/m of drag: h c/m = 80 at one
+    // Maslova's lightest node, 0.001 g, with 0.005 N·s/m of drag: h c/m = 80 at one
     // 16 ms substep, where explicit drag (`v += h (a − c v/m)`) multiplies the velocity
     // by −79 a step. Implicit drag is stable at any h c/m and only takes energy away.
     // Mass-spring without springs (its springs at this mass need thousands of substeps

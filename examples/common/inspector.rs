@@ -1,5 +1,5 @@
-//! The egui side panel: every model parameter live (seed 000 §4), the environment, the
-//! look (seed 002 §1.4: colour, diffuse and specular coefficients 0–1; light), live
+//! The egui side panel: every model parameter live (Sladović 2014 §4), the environment, the
+//! look (Maslova §1.4: colour, diffuse and specular coefficients 0–1; light), live
 //! statistics with a plot, and a button for bevy-inspector-egui's world inspector.
 //! Every widget has a range and clamps what is typed into it.
 
@@ -13,12 +13,12 @@ use bevy_cloth::prelude::*;
 use bevy_egui::{EguiContexts, EguiPrimaryContextPass, egui};
 use bevy_inspector_egui::quick::WorldInspectorPlugin;
 
-/// Colour and seed 002's reflection coefficients of a cloth.
+/// Colour and Maslova's reflection coefficients of a cloth.
 #[derive(Component, Clone, Debug, PartialEq)]
 pub struct ClothLook {
     /// Base colour, linear RGB.
     pub color: [f32; 3],
-    /// Colours of a garment's pieces (seed 002 Fig. 4.2–4.3: front and back may differ),
+    /// Colours of a garment's pieces (Maslova Fig. 4.2–4.3: front and back may differ),
     /// drawn as vertex colours; empty for one colour.
     pub piece_colors: Vec<[f32; 3]>,
     /// Diffuse coefficient k_d, 0–1.
@@ -43,10 +43,10 @@ impl ClothLook {
         self.piece_colors.get(k).copied().unwrap_or(self.color)
     }
 
-    /// Seed 002's Phong coefficients on a PBR material: the diffuse coefficient scales the
+    /// Maslova's Phong coefficients on a PBR material: the diffuse coefficient scales the
     /// albedo; the specular coefficient raises the reflectance (F0) and lowers the
     /// roughness, so the highlight grows stronger and tighter. Double-sided: back faces
-    /// are lit with their own normals (seed 000 §3.5), not as a mirror of the front.
+    /// are lit with their own normals (Sladović 2014 §3.5), not as a mirror of the front.
     pub fn material(&self) -> StandardMaterial {
         // With piece colours the mesh's vertex colours carry the hue (Bevy multiplies
         // them with the base colour).
@@ -664,7 +664,7 @@ fn environment_controls(ui: &mut egui::Ui, env: &mut Environment) {
     }
     let mut trig = w.field == WindField::Trigonometric;
     if ui
-        .checkbox(&mut trig, "gusts (seed 002 trigonometric field)")
+        .checkbox(&mut trig, "gusts (Maslova's trigonometric field)")
         .changed()
     {
         w.field = if trig {

@@ -1,4 +1,4 @@
-//! The camera keys of seed 000 §3.1 (W/A/S/D/Q/E rotate, keypad +/− zoom) on the orbit
+//! The camera keys of Sladović 2014 §3.1 (W/A/S/D/Q/E rotate, keypad +/− zoom) on the orbit
 //! camera, and the mouse tools: left-drag grabs the particle under the cursor and pulls
 //! it, right-drag cuts the springs the stroke crosses. The orbit camera keeps left-drag
 //! (away from the cloth) for orbiting; panning moves to the middle button.
@@ -45,7 +45,7 @@ fn camera_keys(
         camera.target_yaw += rate * (held(KeyCode::KeyA) - held(KeyCode::KeyD));
         let roll = rate * (held(KeyCode::KeyE) - held(KeyCode::KeyQ));
         if roll != 0.0 {
-            // Seed 000 rotates about the view's z axis too: roll the camera's frame.
+            // Sladović 2014 rotates about the view's z axis too: roll the camera's frame.
             let r = Quat::from_rotation_z(roll);
             camera.axis = camera.axis.map(|a| r * a);
             camera.force_update = true;

@@ -1,4 +1,4 @@
-//! Regression benches: one 16 ms step of each model of seed 000's Slika 23 on the
+//! Regression benches: one 16 ms step of each model of Sladović's (2014) fig. 23 on the
 //! timing table's curtain (top row pinned, gravity, the default wind) at 4,096 and
 //! 65,536 particles. `cargo bench --bench step`; the tables and charts are made by
 //! `cargo run --bin cloth -- bench`.
@@ -16,7 +16,7 @@ fn step(c: &mut Criterion) {
             group.sample_size(10);
         }
         for model in SEED_MODELS {
-            let mut cloth = bench_cloth(model, count).expect("a Slika 23 model");
+            let mut cloth = bench_cloth(model, count).expect("a fig. 23 model");
             // Past the first steps, whose substep count and caches settle.
             for _ in 0..3 {
                 cloth.step(0.016, &env);

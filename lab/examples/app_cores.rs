@@ -1,4 +1,4 @@
-//! What the second core buys the full app: seed 002's frame experiment (the whole Bevy app
+//! What the second core buys the full app: Maslova's frame experiment (the whole Bevy app
 //! without a window, `ClothPlugin`, mesh write-back) at 65,536 mass-spring particles, with
 //! the cloth's kernels on one thread and on the compute pool, alternately, twice.
 //!

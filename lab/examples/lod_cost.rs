@@ -1,4 +1,4 @@
-//! What level of detail saves (issue 16): the `lod` example's curtain (48×40 particles,
+//! What level of detail saves: the `lod` example's curtain (48×40 particles,
 //! 4 cm apart, top row pinned, the scene's wind) with `ClothLod`, a camera at each
 //! distance in turn, in the whole app without a window: its level, its size on the view
 //! and the median wall-clock ms of its step over 60 steps after 60 to settle; five

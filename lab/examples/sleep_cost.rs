@@ -1,4 +1,4 @@
-//! What a sleeping cloth costs (issue 16): the whole app without a window (as seed 002's
+//! What a sleeping cloth costs: the whole app without a window (as Maslova's
 //! frame experiment, `fps.rs`) with a 16,384-particle curtain awake and asleep, and with
 //! no cloth, frame after frame in turn so a slow moment of the machine falls on all three.
 //! The cloth's cost is its app's frame time less the empty app's; the ratio is asleep

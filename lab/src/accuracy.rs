@@ -1,5 +1,5 @@
 //! Speed against accuracy: every model and its main knobs against a converged
-//! mass-spring reference of the same scene (issue 7).
+//! mass-spring reference of the same scene.
 //!
 //! The reference is the scene's cloth as a mass-spring cloth at the same resolution, with
 //! the substep divided by [`REFERENCE_FACTOR`] (100): 100 times the automatic substeps
@@ -379,7 +379,8 @@ pub struct Row {
     pub max_strain: f32,
     /// Final total energy minus the reference's, over `M g D` (mass, gravity, diagonal);
     /// the same quantity for every model: the particles' kinetic, gravitational and
-    /// spring energy at the scene's spring parameters ([`bevy_cloth::solver::ClothSolver::energy`]).
+    /// spring energy at the scene's spring parameters
+    /// ([`bevy_cloth::solver::ClothSolver::energy`]).
     pub energy_drift: Option<f64>,
     /// When the run failed, s.
     pub failed_at: Option<f32>,

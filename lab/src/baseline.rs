@@ -29,7 +29,7 @@ pub struct BareGrid {
 
 impl BareGrid {
     /// `count` particles (as the bench's curtain, [`grid_for`]), `spacing` m apart, of
-    /// `mass` kg, springs of `k` N/m (structural; shear and bend at half, seed 000's 2:1:1).
+    /// `mass` kg, springs of `k` N/m (structural; shear and bend at half, Sladović's (2014) 2:1:1).
     pub fn new(count: usize, spacing: f32, mass: f32, k: f32) -> Self {
         let (width, height) = grid_for(count);
         let (width, height) = (width as usize, height as usize);

@@ -1,4 +1,4 @@
-//! `cloth choose` (issue 16): the accuracy study ([`crate::accuracy`]) on the user's own
+//! `cloth choose`: the accuracy study ([`crate::accuracy`]) on the user's own
 //! scene, and the configuration it asks for: the cheapest whose error against the
 //! converged reference is within a budget, or the most accurate whose cost per step is
 //! within a budget. The answer comes as `--set` overrides and as an edited copy of the

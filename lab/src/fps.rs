@@ -1,4 +1,4 @@
-//! Seed 002's experiment (table 4.1): frames per second against the number of masses,
+//! Maslova's experiment (table 4.1): frames per second against the number of masses,
 //! here with the whole Bevy app and no window: `MinimalPlugins`, assets, `ClothPlugin`
 //! stepping on `FixedUpdate` and writing the mesh back every frame. Time is advanced by
 //! exactly one 16 ms fixed step per frame, so a frame's wall-clock time is what one
@@ -14,7 +14,7 @@ use bevy_cloth::error::ClothError;
 use bevy_cloth::headless::headless_app;
 use bevy_cloth::prelude::{Cloth, ClothSimulation};
 
-/// Seed 002's table 4.1: masses and the frames per second it reported.
+/// Maslova's table 4.1: masses and the frames per second it reported.
 pub const SEED_002_FPS: [(usize, f64); 10] = [
     (100, 60.0),
     (300, 50.0),
@@ -36,7 +36,7 @@ pub const APP_COUNTS: [usize; 12] = [
 /// One row of the experiment.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct AppFrame {
-    /// Slika 23's model name (see [`crate::seed_model_params`]).
+    /// fig. 23's model name (see [`crate::seed_model_params`]).
     pub model: String,
     /// Masses (particles).
     pub particles: usize,
@@ -48,7 +48,7 @@ pub struct AppFrame {
     /// The first frame (1-based) after which the cloth was not stable; `None`: stable
     /// for all [`BENCH_CHECK_STEPS`] frames.
     pub failed_at_frame: Option<usize>,
-    /// Seed 002's frames per second at this count, when it has one.
+    /// Maslova's frames per second at this count, when it has one.
     pub seed_fps: Option<f64>,
 }
 

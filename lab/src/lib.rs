@@ -1,5 +1,5 @@
 //! The lab: bevy_cloth's measuring instruments, not published and not a dependency of
-//! any game. Seed 000's timing table (Slika 23, here), seed 002's frame rates with the
+//! any game. Sladović's (2014) timing table (fig. 23, here), Maslova's frame rates with the
 //! full app ([`fps`]), speed against accuracy ([`accuracy`]) and where each method fails
 //! ([`stability`]); the `cloth` command line drives them and draws the charts. Every
 //! instrument steps the same [`solver::ClothSolver`] a game runs.
@@ -29,20 +29,20 @@ use bevy_cloth::solver;
 pub use bevy_cloth::headless::SceneRun;
 pub use bevy_cloth::stats::median;
 
-/// The models of seed 000's timing table (Slika 23): 1 mass-spring, 2 shape matching,
+/// The models of Sladović's (2014) timing table (fig. 23): 1 mass-spring, 2 shape matching,
 /// 3a–3c patches of 2×2, 4×4 and 8×8 particles.
 pub const SEED_MODELS: [&str; 5] = ["1", "2", "3a", "3b", "3c"];
 
-/// The timing table's models: seed 000's, then `x`, XPBD (issue 15; not in the seeds), at
-/// its automatic substeps (its stretch-error target, 1%).
+/// The timing table's models: Sladović's (2014), then `x`, XPBD (Macklin et al. 2016; not
+/// in the two source works), at its automatic substeps (its stretch-error target, 1%).
 pub const BENCH_MODELS: [&str; 6] = ["1", "2", "3a", "3b", "3c", "x"];
 
-/// Particle counts of Slika 23.
+/// Particle counts of fig. 23.
 pub const SEED_COUNTS: [usize; 11] = [
     64, 128, 256, 512, 1024, 2048, 4096, 8192, 16384, 32768, 65536,
 ];
 
-/// Slika 23's ms per 16 ms step, by model (rows as in [`SEED_MODELS`]) and count.
+/// fig. 23's ms per 16 ms step, by model (rows as in [`SEED_MODELS`]) and count.
 pub const SEED_MS: [[f64; 11]; 5] = [
     [
         0.0, 1.0, 2.0, 4.0, 9.0, 18.0, 26.0, 60.0, 79.0, 257.0, 592.0,
@@ -61,7 +61,7 @@ pub const SEED_MS: [[f64; 11]; 5] = [
 /// passes 100% strain within 0.2 s, and a time for that is not a result.
 pub const SHAPE_MATCHING_STIFFNESS_FACTOR: f32 = 64.0;
 
-/// The parameters of a Slika 23 model (or `x`, XPBD: see [`BENCH_MODELS`]) on the
+/// The parameters of a fig. 23 model (or `x`, XPBD: see [`BENCH_MODELS`]) on the
 /// default cloth.
 pub fn seed_model_params(model: &str) -> Option<ClothParams> {
     let patches = |size| {
@@ -102,7 +102,7 @@ pub fn grid_for(count: usize) -> (u32, u32) {
 /// One cell of the timing table.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct BenchCell {
-    /// Slika 23's model name.
+    /// fig. 23's model name.
     pub model: String,
     /// Particles.
     pub particles: usize,
@@ -133,9 +133,9 @@ impl BenchCell {
 }
 
 /// The curtain of the timing table: a grid of `count` particles (a power of two), 5 cm
-/// apart, hung from its whole top row (a curtain on a rod), with Slika 23's `model`.
+/// apart, hung from its whole top row (a curtain on a rod), with fig. 23's `model`.
 ///
-/// Not from its two top corners, as the curtain scene (seed 000 Slika 5): the default
+/// Not from its two top corners, as the curtain scene (Sladović 2014 fig. 5): the default
 /// 20 N/m material cannot carry a curtain of 128×128 or more from two points, and every
 /// model passed 100% strain within half a second there (mass-spring at step 30), so the
 /// table would time cloths that tear. From the top row a 256×256 curtain holds at 13%.
@@ -239,7 +239,7 @@ pub fn bench_cell(
 }
 
 /// What a mass-spring substep of the timing table's curtain costs, part by part, and
-/// what the second core buys: the numbers issue 14's speed targets are stated in.
+/// what the second core buys: the numbers our speed targets are stated in.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct KernelCosts {
     /// Particles.

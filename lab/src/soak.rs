@@ -1,4 +1,4 @@
-//! The soak (issue 17): a scene's cloth driven for minutes by everything a game and its
+//! The soak: a scene's cloth driven for minutes by everything a game and its
 //! player can do to it — gusty wind, grabs and drags, cuts, tearing, parameter edits (valid
 //! ones, and invalid ones that must be refused), model switches and resets — with every
 //! step checked for non-finite state and the process's resident memory sampled for growth.

@@ -1,4 +1,4 @@
-//! Where each method fails: a grid over stiffness, node mass and timestep (issue 7), and
+//! Where each method fails: a grid over stiffness, node mass and timestep, and
 //! the measured stability threshold of a single spring and of the full lattice against
 //! the explicit bound `ω_max·h = 2`.
 //!
@@ -35,9 +35,9 @@ use bevy_cloth::params::{
 };
 use bevy_cloth::solver;
 
-/// Spring (and pull) stiffnesses of the grid, N/m (seed 002 §1.4's range).
+/// Spring (and pull) stiffnesses of the grid, N/m (Maslova §1.4's range).
 pub const STIFFNESS: [f32; 6] = [100.0, 300.0, 1_000.0, 3_000.0, 10_000.0, 25_000.0];
-/// Node masses of the grid, kg (seed 002: 0.001–1 g).
+/// Node masses of the grid, kg (Maslova: 0.001–1 g).
 pub const MASS: [f32; 4] = [1e-6, 1e-5, 1e-4, 1e-3];
 /// Timesteps of the grid, s.
 pub const TIMESTEP: [f32; 6] = [0.001, 0.002, 0.004, 0.008, 0.016, 0.033];

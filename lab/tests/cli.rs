@@ -393,10 +393,10 @@ fn choose_picks_the_most_accurate_within_a_cost_and_refuses_an_impossible_goal()
 /// must say.
 type BadInput = (Vec<(&'static str, String)>, Vec<&'static str>, &'static str);
 
-/// The inputs that took the program down before issue 17, each in a temporary directory
-/// (`{dir}` in a file stands for it, `{curtain}` in the command line for the shipped
-/// curtain).
-fn issue_17_inputs() -> Vec<BadInput> {
+/// The inputs that took the program down before they were refused at the door, each in
+/// a temporary directory (`{dir}` in a file stands for it, `{curtain}` in the command line for
+/// the shipped curtain).
+fn once_fatal_inputs() -> Vec<BadInput> {
     let curtain = std::fs::read_to_string(concat!(
         env!("CARGO_MANIFEST_DIR"),
         "/../assets/scenes/curtain.ron"
@@ -525,7 +525,7 @@ fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
     // refused before anything of the asked size is allocated or looped over.
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let curtain = format!("{root}/assets/scenes/curtain.ron");
-    for (k, (files, args, needle)) in issue_17_inputs().into_iter().enumerate() {
+    for (k, (files, args, needle)) in once_fatal_inputs().into_iter().enumerate() {
         let dir = temp(&format!("issue17_{k}"));
         std::fs::create_dir_all(&dir).unwrap();
         let dir_text = dir.display().to_string();

@@ -46,7 +46,7 @@ fn the_lattice_fails_where_its_largest_frequency_says() {
     let factor = |t: &stability::Threshold| t.omega_max / (t.stiffness / t.mass).sqrt();
     assert!((factor(&t) - factor(&other)).abs() < 0.01 * factor(&t));
     assert!((factor(&t) - stability::lattice_factor()).abs() < 0.01 * factor(&t));
-    // Seed 002's stiffest, lightest material: the automatic substep lies inside the
+    // Maslova's stiffest, lightest material: the automatic substep lies inside the
     // measured threshold, and not wastefully far inside (Gershgorin overestimates ω_max
     // by ~1.8×, the safety factor is 0.8).
     let x = stability::lattice(25_000.0, 1e-6, Integrator::Verlet).unwrap();

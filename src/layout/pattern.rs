@@ -1,4 +1,4 @@
-//! Garment pieces as 0/1 pattern files (seed 002 §1.4): "the shape of a piece is given by a
+//! Garment pieces as 0/1 pattern files (Maslova §1.4): "the shape of a piece is given by a
 //! matrix in which 1 means a mass is present and 0 that it is absent".
 //!
 //! ```text

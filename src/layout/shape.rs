@@ -13,7 +13,7 @@ use crate::solver::{self, Layout, MAX_PARTICLES, topology};
 pub enum ClothShape {
     /// A `width × height` grid hanging in the local XY plane: particle `(i, j)` starts at
     /// `(i·spacing − (width−1)·spacing/2, −j·spacing, 0)`, so the local origin is the middle
-    /// of the top edge (where a curtain rod would be). Seed 000 §3.2's construction.
+    /// of the top edge (where a curtain rod would be). Sladović 2014 §3.2's construction.
     Grid {
         /// Particles across (i).
         width: u32,
@@ -26,7 +26,7 @@ pub enum ClothShape {
     /// particle, each edge a structural spring, and the two far corners of each pair of
     /// triangles sharing an edge a bend spring.
     Mesh,
-    /// A garment: 0/1 pattern pieces stitched by seams (seed 002 §1.4), from a garment file
+    /// A garment: 0/1 pattern pieces stitched by seams (Maslova §1.4), from a garment file
     /// (see [`crate::layout::garment`]); the local origin is the garment file's origin.
     Garment {
         /// The garment file, relative to the `assets` folder (or absolute).
@@ -47,10 +47,11 @@ impl Default for ClothShape {
 }
 
 impl ClothShape {
-    /// The layout of a grid (seed 000 §3.2's construction): particle `(i, j)` at
+    /// The layout of a grid (Sladović 2014 §3.2's construction): particle `(i, j)` at
     /// `(i·spacing − (width−1)·spacing/2, −j·spacing, 0)`, structural, shear and bend
     /// springs, two triangles per cell. A mesh or a garment is laid out from its data
-    /// ([`Layout::from_mesh`], [`crate::layout::garment::GarmentLayout::into_layout`]): an error here.
+    /// ([`Layout::from_mesh`], [`crate::layout::garment::GarmentLayout::into_layout`]): an
+    /// error here.
     pub fn layout(&self) -> Result<Layout, ClothError> {
         self.validate()?;
         match *self {
@@ -146,7 +147,7 @@ pub enum ClothPins {
     None,
     /// The whole top row of a grid (j = 0).
     TopRow,
-    /// The two top corners of a grid (seed 000 Slika 5).
+    /// The two top corners of a grid (Sladović 2014 fig. 5).
     #[default]
     TopCorners,
     /// Particles by index: `j·width + i` for a grid; for a cloth made of a mesh, the

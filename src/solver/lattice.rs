@@ -499,7 +499,7 @@ fn chunks6<'a>(
 
 impl Projection {
     /// Shortens the spring from `a` to `b` (indices in `g`) to `(1 + limit)·rest` when it
-    /// is longer, each end moved by its share of inverse mass (seed 000 eq. 2); nothing
+    /// is longer, each end moved by its share of inverse mass (Sladović 2014 eq. 2); nothing
     /// when it is within, torn (`weight` 0) or held at both ends. Most springs are within,
     /// so the test comes first, on squared lengths. With `TRACK`, whether it was longer
     /// than `past·rest`.

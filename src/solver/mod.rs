@@ -4,7 +4,8 @@
 //! A step is a pipeline of stages (`steps/mod.rs` describes it; one file per model under
 //! `steps/`). A cloth's state is kept by concern: its particles ([`Particles`]), what it
 //! is made of (`structure.rs`), what holds it from outside (`drivers.rs`), what it touches
-//! (`contact.rs`), how it keeps out of itself (`self_contact.rs`), its clock (`clock.rs`) and the active model's own state.
+//! (`contact.rs`), how it keeps out of itself (`self_contact.rs`), its clock (`clock.rs`) and
+//! the active model's own state.
 
 mod bending;
 mod build;
@@ -218,7 +219,7 @@ fn check_model_fits(
 }
 
 /// The scale `(d/L)^(p−1)` of the pull `α (d/L)^(p−1) d` toward a goal or target used by
-/// shape matching and the patch model (seed 000 §4's exponent p), with `d/L` kept ≥ 0.05
+/// shape matching and the patch model (Sladović 2014 §4's exponent p), with `d/L` kept ≥ 0.05
 /// so that `p < 1` stays finite at the goal.
 #[inline]
 pub(crate) fn pull_scale(d: f32, length_scale: f32, exponent: f32) -> f32 {

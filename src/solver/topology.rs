@@ -5,7 +5,7 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
-/// The kind of a spring, which decides its stiffness (seed 000 §2.2, Slika 1).
+/// The kind of a spring, which decides its stiffness (Sladović 2014 §2.2, fig. 1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SpringKind {
     /// Horizontal and vertical neighbours: resist stretch and compression.
@@ -16,7 +16,7 @@ pub enum SpringKind {
     Bend = 2,
     /// Every second particle along diagonals: optional extra bending resistance.
     BendDiagonal = 3,
-    /// Joins two garment pieces along a seam (seed 002 §1.4); rest length from the
+    /// Joins two garment pieces along a seam (Maslova §1.4); rest length from the
     /// parameters, reached by sewing.
     Seam = 4,
 }
@@ -103,7 +103,7 @@ impl Springs {
     }
 }
 
-/// Spring pairs of a `width × height` grid, as in seed 000 §3.2's pseudocode, plus the
+/// Spring pairs of a `width × height` grid, as in Sladović 2014 §3.2's pseudocode, plus the
 /// optional diagonal bend springs. Particle `(i, j)` has index `j·width + i`.
 pub fn grid_spring_pairs(width: u32, height: u32) -> Vec<(SpringKind, u32, u32)> {
     let idx = |i: u32, j: u32| j * width + i;

@@ -1,4 +1,4 @@
-//! Garments: pattern pieces placed in space and stitched by seams (seed 002 §1.4: "the
+//! Garments: pattern pieces placed in space and stitched by seams (Maslova §1.4: "the
 //! parts are joined by extra springs between the particles along the seams").
 //!
 //! A garment file (RON) lists the pieces and the seams; everything about a garment is
@@ -8,8 +8,8 @@
 //!     spacing: 0.034,            // m between neighbouring nodes at resolution 1
 //!     pieces: [
 //!         (name: "front", pattern: "tshirt_front.txt", translation: (0.0, 0.0, 0.17)),
-//!         (name: "back", pattern: "tshirt_back.txt", translation: (0.0, 0.0, -0.17), yaw_degrees: 180.0),
-//!     ],
+//!         (name: "back", pattern: "tshirt_back.txt", translation: (0.0, 0.0, -0.17),
+//! yaw_degrees: 180.0),     ],
 //!     seams: [
 //!         // nodes (column, row) from `from` to `to` on each piece, joined in order
 //!         (name: "left side", a: (piece: "front", from: (6, 7), to: (6, 22)),
@@ -457,7 +457,7 @@ fn add_piece(
             }
         }
     }
-    // The grid's springs between present nodes (seed 000 §3.2); a bend spring also needs
+    // The grid's springs between present nodes (Sladović 2014 §3.2); a bend spring also needs
     // the node it bends over, so none bridges a notch.
     let present = |g: u32| index[g as usize] != u32::MAX;
     for (kind, a, b) in grid_spring_pairs(w, h) {

@@ -1,4 +1,4 @@
-//! The mass-spring model's step (seeds 000 §3.2 and 002 §1): spring and external forces,
+//! The mass-spring model's step (Sladović 2014 §3.2 and Maslova §1): spring and external forces,
 //! Verlet or semi-implicit Euler, Provot's strain limit, tearing.
 
 use super::{MassSpring, ModelSteps};
@@ -41,7 +41,7 @@ impl ModelSteps for MassSpring {
 
 impl ClothSolver {
     /// Provot (1995): springs longer than `(1 + limit)·l0` are shortened to that length,
-    /// each end moved by its share of inverse mass (seed 000 eq. 2); Gauss–Seidel sweeps
+    /// each end moved by its share of inverse mass (Sladović 2014 eq. 2); Gauss–Seidel sweeps
     /// over the structural and shear springs. Velocities take the same correction over `h`.
     /// With `strain_limit_tolerance`, sweeping stops once a sweep finds every spring
     /// within `(1 + limit + tolerance)·l0`.

@@ -2,7 +2,7 @@
 //! [`ClothSolver::substep`]s, then [`ClothSolver::end_step`]; [`ClothSolver::step`] runs
 //! the three and returns a [`StepReport`].
 //!
-//! Each substep runs five stages in order (seed 000 §3.2: every force from the old state
+//! Each substep runs five stages in order (Sladović 2014 §3.2: every force from the old state
 //! before any position changes):
 //! 1. [`ClothSolver::accumulate_forces`]: gravity, wind, drag and the model's forces
 //!    (springs, the goal or target pull);
@@ -271,8 +271,8 @@ impl ClothSolver {
     }
 
     /// Stage 1: clears and accumulates the forces on every free particle (gravity, seed
-    /// 002 eq. 1.6; wind; linear drag `−c v`, seed 000 eq. 31; the model's). Reads only
-    /// the old state, so the result does not depend on particle order (seed 000 §3.2).
+    /// 002 eq. 1.6; wind; linear drag `−c v`, Sladović 2014 eq. 31; the model's). Reads only
+    /// the old state, so the result does not depend on particle order (Sladović 2014 §3.2).
     /// Just after a model switch, the force that keeps the switch smooth (`switch.rs`).
     pub fn accumulate_forces(&mut self, env: &Environment) {
         let start = Instant::now();
@@ -324,7 +324,8 @@ impl ClothSolver {
     }
 
     /// Finishes a step. A step that left a position or velocity non-finite is undone (the
-    /// positions at the end of the last good step come back, at rest) and says so; otherwise springs stretched past the tear ratio break (seed 000 §3.2).
+    /// positions at the end of the last good step come back, at rest) and says so; otherwise
+    /// springs stretched past the tear ratio break (Sladović 2014 §3.2).
     pub fn end_step(&mut self) -> StepReport {
         let start = Instant::now();
         if self.report.substeps == 0 {

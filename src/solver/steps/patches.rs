@@ -1,4 +1,4 @@
-//! The hybrid patch model's step (seed 000 §4): a lattice of parts (a small mass-spring
+//! The hybrid patch model's step (Sladović 2014 §4): a lattice of parts (a small mass-spring
 //! cloth of its own, `patches.rs`) takes its whole substep first, held by the pins; each
 //! particle is then pulled toward its target on its part's frame, or (tiles) placed on
 //! it.
@@ -105,7 +105,7 @@ impl ModelSteps for PatchParams {
         cloth.integrate_particles(0.0);
     }
 
-    /// Tiles (Slika 12): every free particle on its target. Otherwise the targets move
+    /// Tiles (fig. 12): every free particle on its target. Otherwise the targets move
     /// with their parts, and a particle that is a part of its own is its part's centre.
     fn fit_targets(&self, cloth: &mut ClothSolver) {
         let Some(patches) = cloth.model.patches_mut() else {

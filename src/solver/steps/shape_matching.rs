@@ -1,4 +1,4 @@
-//! Meshless shape matching's step (Müller et al. 2005; seed 000 §3.3–§4): gravity, wind
+//! Meshless shape matching's step (Müller et al. 2005; Sladović 2014 §3.3–§4): gravity, wind
 //! and drag, integrated; each cluster's goal positions from the best rigid (or linear)
 //! fit of its rest shape; then either a force `α (|d|/L)^(p−1) d` toward the goals
 //! (the seed's force update) or the paper's velocity update, a fraction α of the way
@@ -71,7 +71,7 @@ impl ModelSteps for ShapeMatchingParams {
     }
 }
 
-/// The pull toward the goals (seed 000 §3.3, §4): particle damping `−c v`, and for the
+/// The pull toward the goals (Sladović 2014 §3.3, §4): particle damping `−c v`, and for the
 /// force update `α (|d|/L)^(p−1) d` with `d = g − x` from goals of the current
 /// positions.
 fn goal_forces(cloth: &mut ClothSolver, sm: &ShapeMatchingParams) {

@@ -163,8 +163,8 @@ fn err<E: std::fmt::Display>(e: E) -> String {
 // ----- bench --------------------------------------------------------------------------
 
 /// `docs/bench.png`: ms per step against particles, log-log, one line per model, seed
-/// 000's Slika 23 as hollow markers of the same colour; the full app's ms per frame and
-/// seed 002's (from its frames per second) in black.
+/// 000's fig. 23 as hollow markers of the same colour; the full app's ms per frame and
+/// Maslova's (from its frames per second) in black.
 pub fn bench(png: &Path, cells: &[BenchCell], app: &[AppFrame]) -> Result<()> {
     both(png, (1100, 750), &Bench { cells, app })
 }
@@ -239,7 +239,7 @@ impl Chart for Bench<'_> {
             let series = chart.draw_series(seed).map_err(err)?;
             if m == 0 {
                 series
-                    .label("seed 000 Slika 23 (hollow triangles, model colour)")
+                    .label("Sladović 2014 fig. 23 (hollow triangles, model colour)")
                     .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
             }
         }
@@ -273,7 +273,7 @@ impl Chart for Bench<'_> {
                     + Rectangle::new([(-5, -5), (5, 5)], BLACK.stroke_width(2))
             }))
             .map_err(err)?
-            .label("seed 002 table 4.1: 1000 / fps (hollow squares)")
+            .label("Maslova table 4.1: 1000 / fps (hollow squares)")
             .legend(|(x, y)| {
                 Rectangle::new([(x + 5, y - 5), (x + 15, y + 5)], BLACK.stroke_width(2))
             });

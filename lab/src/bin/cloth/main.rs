@@ -1,7 +1,7 @@
 //! `cloth`: the headless command line (`cloth --help`, `cloth <verb> --help`).
 //!
 //! `run` prints a JSON summary on stdout and dumps positions on request; `bench` prints
-//! seed 000's timing table (Slika 23) beside ours and, with `--app`, seed 002's frame
+//! Sladović's (2014) timing table (fig. 23) beside ours and, with `--app`, Maslova's frame
 //! rates beside the full app's; `accuracy` and `stability` print their tables. `--chart`
 //! draws the chart to a PNG and an SVG beside it. Bad input exits with code 2 and a
 //! one-line message naming the file, line and field; nothing panics on user input.
@@ -72,7 +72,7 @@ struct Cli {
 enum Verb {
     /// Runs a scene headless: a JSON summary on stdout, positions dumped on request.
     Run(RunArgs),
-    /// Seed 000's timing table (Slika 23) beside ours; with --app, seed 002's frame rates.
+    /// Sladović's (2014) timing table (fig. 23) beside ours; with --app, Maslova's frame rates.
     Bench(BenchArgs),
     /// Speed against accuracy, against a converged reference.
     Accuracy(AccuracyArgs),
@@ -220,13 +220,13 @@ struct BenchArgs {
     /// The largest particle count (at most 262,144).
     #[arg(long, default_value_t = 65_536, value_parser = particles)]
     max: usize,
-    /// Slika 23's models and `x` (XPBD), comma separated (all when absent).
+    /// fig. 23's models and `x` (XPBD), comma separated (all when absent).
     #[arg(long, value_delimiter = ',', value_parser = seed_model)]
     models: Vec<&'static str>,
     /// Timed steps per cell (5 from 16,384 particles up).
     #[arg(long, default_value_t = 15, value_parser = repeats)]
     repeats: usize,
-    /// Also runs seed 002's experiment with the full app.
+    /// Also runs Maslova's experiment with the full app.
     #[arg(long)]
     app: bool,
     /// The models of the full-app experiment (implies --app; all when absent).
@@ -788,7 +788,7 @@ fn bench(args: BenchArgs) -> Result<(), String> {
     }
     if !cells.is_empty() {
         println!(
-            "ms per 16 ms step: ours (median) / seed 000 Slika 23; substeps per step in brackets; \
+            "ms per 16 ms step: ours (median) / Sladović 2014 fig. 23; substeps per step in brackets; \
              `failed` where the cloth passed 100% strain or went non-finite (not timed)"
         );
         print!("{:>8}", "model");
@@ -811,7 +811,7 @@ fn bench(args: BenchArgs) -> Result<(), String> {
         });
         println!();
         println!(
-            "speed-up over seed 000 (its ms / ours; - where it printed 0 ms or our cloth failed)"
+            "speed-up over Sladović 2014 (its ms / ours; - where it printed 0 ms or our cloth failed)"
         );
         print_by_model(&cells, counts.len(), |cell| {
             match (cell.seed_ms, cell.ms_per_step) {
@@ -846,7 +846,7 @@ fn bench(args: BenchArgs) -> Result<(), String> {
     print_kernels(&kernels);
     if !frames.is_empty() {
         println!();
-        println!("| model | masses | ms per frame | fps | seed 002 fps |");
+        println!("| model | masses | ms per frame | fps | Maslova fps |");
         println!("|---|---:|---:|---:|---:|");
         for f in &frames {
             let seed = f.seed_fps.map_or("-".to_string(), |s| format!("{s:.0}"));
