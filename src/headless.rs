@@ -115,18 +115,18 @@ impl SceneRun {
                 let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
                 solver::collide_cloths(&mut all);
             }
-            // The cloths in contact with others step together, substep by substep; the
-            // rest alone (the plugin does the same).
-            let (mut touching, mut substeps) = (Vec::new(), Vec::new());
+            // The cloths in contact with others step together, substep by substep at one
+            // count; the rest alone (the plugin does the same).
+            let mut touching = Vec::new();
             for (_, cloth) in &mut self.cloths {
                 if cloth.touches_other_cloths() {
-                    substeps.push(cloth.begin_step(self.timestep));
                     touching.push(cloth);
                 } else {
                     cloth.step(self.timestep, &env);
                 }
             }
-            solver::substep_together(&mut touching, &substeps, &env);
+            solver::begin_together(&mut touching, self.timestep);
+            solver::substep_together(&mut touching, &env);
             for cloth in touching {
                 cloth.end_step();
             }

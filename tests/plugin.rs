@@ -1302,18 +1302,19 @@ fn the_mesh_is_drawn_between_the_last_two_steps() {
 /// Two cloths in contact (self-collision on, one laid 2 cm over the other on the ground)
 /// step together: on the plugin's task path (`solver::substep_together`) and on its
 /// stage-by-stage path (a game system between the stages, `solver::exchange_cloths`
-/// before the constraints) they end on the same bits, and they did touch.
+/// before the constraints) they end on the same bits, and they did touch. The lower one
+/// asks for 3 substeps, the upper for 5: in contact both take 5.
 #[test]
 fn cloths_in_contact_step_together_the_same_on_both_paths() {
     let run = |with_system: bool| {
         let mut app = app_counting_substeps(with_system);
         app.world_mut().spawn(ClothCollider::plane());
-        let cloths: Vec<Entity> = [0.1, 0.12]
+        let cloths: Vec<Entity> = [(0.1, 3), (0.12, 5)]
             .into_iter()
-            .map(|y| {
+            .map(|(y, substeps)| {
                 let (mut cloth, place) = common::lying_cloth(Vec3::new(0.0, y, 0.0));
                 cloth.params.self_collision.enabled = true;
-                cloth.params.substeps = Substeps::Fixed(5);
+                cloth.params.substeps = Substeps::Fixed(substeps);
                 app.world_mut()
                     .spawn((cloth, place, ClothSleep::never()))
                     .id()
@@ -1322,11 +1323,16 @@ fn cloths_in_contact_step_together_the_same_on_both_paths() {
         let mut touched = false;
         for _ in 0..40 {
             app.update();
-            touched |= cloths.iter().any(|&e| {
-                app.world()
-                    .get::<ClothSimulation>(e)
-                    .is_some_and(|s| s.solver.touches_other_cloths())
-            });
+            let solvers: Vec<_> = cloths
+                .iter()
+                .filter_map(|&e| app.world().get::<ClothSimulation>(e))
+                .map(|s| &s.solver)
+                .collect();
+            if solvers.iter().any(|s| s.touches_other_cloths()) {
+                touched = true;
+                let counts: Vec<u32> = solvers.iter().map(|s| s.last_report().substeps).collect();
+                assert_eq!(counts, [5, 5], "cloths in contact take one count");
+            }
         }
         let positions: Vec<Vec<Vec3>> = cloths
             .iter()

@@ -41,7 +41,8 @@ pub enum ClothSubstepSystems {
     Constrain,
 }
 
-/// The schedule run once per substep inside [`ClothSystems::Substeps`](crate::ClothSystems::Substeps).
+/// The schedule run once per substep inside
+/// [`ClothSystems::Substeps`](crate::ClothSystems::Substeps).
 #[derive(ScheduleLabel, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct ClothSubstep;
 
@@ -142,24 +143,48 @@ pub(crate) fn begin_steps(
             .collect();
         solver::collide_cloths(&mut solvers);
     }
+    // The cloths in contact with others begin together, at one substep count.
+    let mut touching = Vec::new();
     for (entity, mut sim, progress, sleep) in &mut cloths {
         let start = Instant::now();
         let awake = sleep.is_none_or(|s| !s.asleep);
         let steps = run && awake;
         // Where the step begins, kept only when the mesh is drawn between steps.
         sim.note_step(steps && interpolate);
+        if steps && sim.solver.touches_other_cloths() {
+            touching.push((entity, sim, progress));
+            continue;
+        }
         let substeps = if steps { sim.solver.begin_step(dt) } else { 0 };
-        let progress_now = StepProgress {
-            substeps,
-            elapsed: start.elapsed(),
-        };
-        match progress {
-            Some(mut p) => *p = progress_now,
-            None => {
-                commands.entity(entity).insert(progress_now);
-            }
+        set_progress(&mut commands, entity, progress, substeps, start.elapsed());
+        plan.count = plan.count.max(substeps);
+    }
+    if !touching.is_empty() {
+        let start = Instant::now();
+        let mut solvers: Vec<_> = touching.iter_mut().map(|(_, s, _)| &mut s.solver).collect();
+        let substeps = solver::begin_together(&mut solvers, dt);
+        let share = start.elapsed() / touching.len() as u32;
+        for (entity, _, progress) in touching {
+            set_progress(&mut commands, entity, progress, substeps, share);
         }
         plan.count = plan.count.max(substeps);
+    }
+}
+
+/// A cloth's progress at the start of its step: its substeps and the time begun.
+fn set_progress(
+    commands: &mut Commands,
+    entity: Entity,
+    progress: Option<Mut<StepProgress>>,
+    substeps: u32,
+    elapsed: std::time::Duration,
+) {
+    let now = StepProgress { substeps, elapsed };
+    match progress {
+        Some(mut p) => *p = now,
+        None => {
+            commands.entity(entity).insert(now);
+        }
     }
 }
 
@@ -218,14 +243,11 @@ pub(crate) fn run_substeps(
         if !touching.is_empty() {
             scope.spawn(async move {
                 let start = Instant::now();
-                let substeps: Vec<u32> = touching.iter().map(|(_, p)| p.substeps).collect();
                 let mut group: Vec<_> = touching.iter_mut().map(|(s, _)| &mut s.solver).collect();
-                solver::substep_together(&mut group, &substeps, &env);
-                // The group's time is shared among its cloths by their substeps.
-                let total: u32 = substeps.iter().sum::<u32>().max(1);
-                let elapsed = start.elapsed();
+                solver::substep_together(&mut group, &env);
+                // The group's time is shared evenly among its cloths (one substep count).
+                let share = start.elapsed() / touching.len() as u32;
                 for (_, progress) in &mut touching {
-                    let share = elapsed * progress.substeps / total;
                     progress.elapsed += share;
                 }
             });

@@ -39,7 +39,7 @@ pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
 pub use parallel::{for_each_indexed, pool as task_pool, set_parallel, threads};
-pub use self_contact::{collide_cloths, exchange_cloths, substep_together};
+pub use self_contact::{begin_together, collide_cloths, exchange_cloths, substep_together};
 pub use state::Particles;
 pub use steps::{StageTimes, StepReport};
 pub use substeps::unit_hash;

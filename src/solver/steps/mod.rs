@@ -206,6 +206,16 @@ impl ClothSolver {
     /// Prepares a step of `dt` seconds and returns the number of substeps it takes (0 for a
     /// `dt` that is not positive and finite: nothing happens then).
     pub fn begin_step(&mut self, dt: f32) -> u32 {
+        let n = self.plan_step(dt);
+        self.start_substeps(dt, n);
+        n
+    }
+
+    /// The first half of [`begin_step`](Self::begin_step): the step's sewing, model
+    /// state and substep choice; returns the substeps this cloth needs (0 for a `dt` that
+    /// is not positive and finite). Cloths in contact then start with the most any of
+    /// them needs (`begin_together`).
+    pub(crate) fn plan_step(&mut self, dt: f32) -> u32 {
         let start = Instant::now();
         self.report = StepReport::default();
         if !(dt > 0.0 && dt.is_finite()) {
@@ -222,6 +232,18 @@ impl ClothSolver {
         steps.build(self, auto && self.state_dependent_stiffness());
         steps.prepare(self, dt);
         let n = self.choose_substeps(dt);
+        self.report.time.begin = start.elapsed();
+        n
+    }
+
+    /// The second half of [`begin_step`](Self::begin_step): the clock, the model, the
+    /// drivers and the contacts set for `n` substeps of a `dt` step (nothing for `n` 0).
+    pub(crate) fn start_substeps(&mut self, dt: f32, n: u32) {
+        if n == 0 {
+            return;
+        }
+        let start = Instant::now();
+        let model = self.stepping;
         let on = matches!(model, Model::Xpbd(_) | Model::MassSpring);
         self.self_contact.prepare(
             &self.particles,
@@ -231,7 +253,7 @@ impl ClothSolver {
             dt,
         );
         let ratio = self.clock.begin(dt, n);
-        steps.begin(self, dt, ratio);
+        model_steps(&model).begin(self, dt, ratio);
         let p = &self.particles.position;
         self.drivers.begin_step(p, &self.structure.local_rest);
         self.structure.torn_this_step.clear();
@@ -240,8 +262,7 @@ impl ClothSolver {
             .fill(super::collide::ColliderImpulse::default());
         self.report.substeps = n;
         self.report.under_resolved = self.clock.under_resolved;
-        self.report.time.begin = start.elapsed();
-        n
+        self.report.time.begin += start.elapsed();
     }
 
     /// This step's substeps: the fixed count, or the automatic one (the stable bound,
