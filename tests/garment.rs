@@ -557,10 +557,14 @@ fn the_tshirt_is_sewn_shut_on_the_mannequin_after_five_seconds() {
 
 #[test]
 fn the_xpbd_tshirt_at_twenty_substeps_is_sewn_shut_outside_the_mannequin() {
-    // Issue 15: XPBD at 20 substeps per 16 ms with inextensible seams (`inf`): seams
-    // closed, no particle inside a collider, and the strain after five seconds (5.7%
-    // here: the armpits, where the side and under-sleeve seams meet; the mass-spring
-    // T-shirt ends at 7.0%, and XPBD at 80 substeps with a 5% limit at 5.1%).
+    // XPBD at 20 substeps per 16 ms with inextensible seams (`inf`): seams closed, no
+    // particle inside a collider, and the largest strain after five seconds (at the
+    // armpits, where the side and under-sleeve seams meet) within 1.6 points of the
+    // converged 7.07%: lines and sweep alike at 320 substeps, lines at 80 (`cloth run
+    // assets/scenes/tshirt.ron --steps 312 --model xpbd --set
+    // 'cloths[0].params.substeps=320' --set 'cloths[0].params.springs.seam.stiffness=inf'`).
+    // At 20 substeps lines leave 8.54%, the sweep 5.66%: each 1.5 points off, the sweep
+    // stiffer than the cloth, the lines softer.
     let (mut cloth, env, colliders) = tshirt_scene();
     let mut params = *cloth.params();
     params.model = Model::Xpbd(XpbdParams::default());
@@ -569,7 +573,8 @@ fn the_xpbd_tshirt_at_twenty_substeps_is_sewn_shut_outside_the_mannequin() {
     cloth.set_params(&params).unwrap();
     let (_, deepest) = sewn_tshirt(&mut cloth, &env, &colliders);
     assert!(deepest < 0.0, "a particle is {deepest} m inside a collider");
-    assert!(cloth.strain().max < 0.06, "strain {}", cloth.strain().max);
+    let strain = cloth.strain().max;
+    assert!((strain - 0.0707).abs() < 0.016, "strain {strain}");
 }
 
 #[test]
@@ -578,7 +583,7 @@ fn the_seed_material_range_stays_stable_on_the_mannequin() {
     // keep every corner of that range stable for half a second after sewing (an explicit
     // instability doubles within a few substeps, so it shows well within that; the
     // stiffest, lightest corner needs thousands of substeps per step). XPBD keeps each
-    // corner stable at a fixed 20 substeps (issue 15).
+    // corner stable at a fixed 20 substeps.
     let corners = [
         (0.001, 100.0),
         (0.001, 25_000.0),
