@@ -21,7 +21,6 @@ use thiserror::Error;
 use bevy::ecs::entity::Entity;
 use bevy::ecs::name::Name;
 use bevy::ecs::system::Commands;
-use bevy::time::{Fixed, Time};
 
 use crate::params::Environment;
 use crate::{Cloth, ClothCollider, ClothEnvironment, ClothLod, ClothStats};
@@ -182,8 +181,11 @@ pub struct SpawnedScene {
 impl ClothScene {
     /// Spawns the scene: each cloth (its [`Cloth`], `Name`, `Transform` and
     /// [`ClothStats`]) and each collider (its [`ClothCollider`], `Name`, `Transform`), and
-    /// sets the environment and the fixed timestep. How they look (materials, collider
-    /// meshes) is the app's to add to the returned entities.
+    /// sets the environment. How they look (materials, collider meshes) is the app's to
+    /// add to the returned entities, and so is the clock: the scene's `timestep` is what
+    /// it was made for, and `Time<Fixed>` stays the game's (set it from the scene with
+    /// [`ClothPlugin::with_timestep`](crate::ClothPlugin::with_timestep) or
+    /// `Time::<Fixed>::from_seconds`, as the examples do).
     pub fn spawn(&self, commands: &mut Commands) -> SpawnedScene {
         let colliders = self
             .colliders
@@ -199,7 +201,6 @@ impl ClothScene {
             })
             .collect();
         commands.insert_resource(ClothEnvironment(self.environment));
-        commands.insert_resource(Time::<Fixed>::from_seconds(self.timestep as f64));
         let cloths = self
             .cloths
             .iter()

@@ -194,6 +194,8 @@ pub fn spawn_scene(
     materials: &mut Assets<StandardMaterial>,
 ) {
     let spawned = scene.spawn(commands);
+    // The example runs at the scene's timestep (spawning a scene leaves the clock alone).
+    commands.insert_resource(Time::<Fixed>::from_seconds(f64::from(scene.timestep)));
     for (entry, entity) in scene.colliders.iter().zip(spawned.colliders) {
         if let Some([r, g, b]) = entry.color {
             let mesh = match entry.collider.shape {

@@ -2,7 +2,7 @@
 //! [`ClothSolver::substep`]s, then [`ClothSolver::end_step`]; [`ClothSolver::step`] runs
 //! the three and returns a [`StepReport`].
 //!
-//! Each substep runs five stages in order (Sladović 2014 §3.2: every force from the old state
+//! Each substep runs four stages in order (Sladović 2014 §3.2: every force from the old state
 //! before any position changes):
 //! 1. [`ClothSolver::accumulate_forces`]: gravity, wind, drag and the model's forces
 //!    (springs, the goal or target pull);
