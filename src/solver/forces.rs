@@ -37,7 +37,7 @@ impl ClothSolver {
             for i in 0..n {
                 f[i] = mass[i] * g;
                 if has_wind {
-                    f[i] += wind.force_at(x[i]) * lump[i];
+                    f[i] += wind.vector_at(x[i]) * lump[i];
                 }
             }
         };
@@ -72,7 +72,7 @@ impl ClothSolver {
             let (area, normal) = (0.5 * twice_area, cross / twice_area);
             let centre = (xa + xb + xc) / 3.0;
             let moving = (p.velocity[a] + p.velocity[b] + p.velocity[c]) / 3.0;
-            let w = flow.force_at(centre) - moving;
+            let w = flow.vector_at(centre) - moving;
             let wn = w.dot(normal);
             let across = w - wn * normal;
             let drag = half_rho * air.drag * area * wn * wn.abs() * normal;

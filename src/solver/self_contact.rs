@@ -804,7 +804,11 @@ fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
 /// 22), met at times that did not line up and jittered at 0.28 m/s when solved along
 /// lines (`assets/scenes/stack.ron`); at one count they come to rest.
 pub fn begin_together(cloths: &mut [&mut super::ClothSolver], dt: f32) -> u32 {
-    let n = cloths.iter_mut().map(|c| c.plan_step(dt)).max().unwrap_or(0);
+    let n = cloths
+        .iter_mut()
+        .map(|c| c.plan_step(dt))
+        .max()
+        .unwrap_or(0);
     for cloth in cloths {
         cloth.start_substeps(dt, n);
     }

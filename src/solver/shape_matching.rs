@@ -83,11 +83,6 @@ impl ShapeMatching {
         }
     }
 
-    /// Number of clusters.
-    pub fn cluster_count(&self) -> usize {
-        self.clusters.len()
-    }
-
     /// Goals `g_i = G (x_i0 − x_cm0) + x_cm` (Sladović 2014 eq. 12) from the current positions,
     /// with `G = R` or Müller's `β A + (1 − β) R`. Allocates nothing.
     ///
