@@ -115,19 +115,12 @@ impl SceneRun {
                 let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
                 solver::collide_cloths(&mut all);
             }
-            // The cloths in contact with others step together, substep by substep at one
-            // count; the rest alone (the plugin does the same).
-            let mut touching = Vec::new();
+            // As the plugin steps them: cloths in contact together, the rest side by side.
+            let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
+            solver::begin_cloths(&mut all, self.timestep);
+            let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| c).collect();
+            solver::run_cloths(&mut all, &env);
             for (_, cloth) in &mut self.cloths {
-                if cloth.touches_other_cloths() {
-                    touching.push(cloth);
-                } else {
-                    cloth.step(self.timestep, &env);
-                }
-            }
-            solver::begin_together(&mut touching, self.timestep);
-            solver::substep_together(&mut touching, &env);
-            for cloth in touching {
                 cloth.end_step();
             }
             times.push(start.elapsed().as_secs_f64() * 1e3);

@@ -2,8 +2,6 @@
 //! substeps (the [`ClothSubstep`] schedule, or one task per cloth when no game system
 //! sits between its stages), then ends each cloth's step and reports what happened.
 
-use std::time::Duration;
-
 use bevy::ecs::schedule::{ScheduleLabel, SingleThreadedExecutor};
 use bevy::platform::time::Instant;
 use bevy::prelude::*;
@@ -84,7 +82,6 @@ pub(crate) fn substep_schedule() -> Schedule {
 pub(crate) struct StepProgress {
     /// Substeps this cloth takes in this step (0: it does not step).
     pub(crate) substeps: u32,
-    elapsed: Duration,
 }
 
 /// A cloth paused because a step went non-finite runs again once it has been reset
@@ -143,48 +140,30 @@ pub(crate) fn begin_steps(
             .collect();
         solver::collide_cloths(&mut solvers);
     }
-    // The cloths in contact with others begin together, at one substep count.
-    let mut touching = Vec::new();
+    // Cloths in contact with others begin together at one substep count, the rest alone
+    // (`solver::begin_cloths`, as the headless runner does); a sleeping cloth not at all.
+    let mut all = Vec::new();
     for (entity, mut sim, progress, sleep) in &mut cloths {
-        let start = Instant::now();
-        let awake = sleep.is_none_or(|s| !s.asleep);
-        let steps = run && awake;
+        let steps = run && sleep.is_none_or(|s| !s.asleep);
         // Where the step begins, kept only when the mesh is drawn between steps.
         sim.note_step(steps && interpolate);
-        if steps && sim.solver.touches_other_cloths() {
-            touching.push((entity, sim, progress));
-            continue;
-        }
-        let substeps = if steps { sim.solver.begin_step(dt) } else { 0 };
-        set_progress(&mut commands, entity, progress, substeps, start.elapsed());
-        plan.count = plan.count.max(substeps);
+        all.push((entity, sim, progress, steps));
     }
-    if !touching.is_empty() {
-        let start = Instant::now();
-        let mut solvers: Vec<_> = touching.iter_mut().map(|(_, s, _)| &mut s.solver).collect();
-        let substeps = solver::begin_together(&mut solvers, dt);
-        let share = start.elapsed() / touching.len() as u32;
-        for (entity, _, progress) in touching {
-            set_progress(&mut commands, entity, progress, substeps, share);
+    let mut solvers: Vec<_> = all
+        .iter_mut()
+        .map(|(_, sim, _, steps)| (&mut sim.solver, *steps))
+        .collect();
+    solver::begin_cloths(&mut solvers, dt);
+    for (entity, sim, progress, steps) in all {
+        let substeps = if steps { sim.solver.substeps() } else { 0 };
+        let now = StepProgress { substeps };
+        match progress {
+            Some(mut p) => *p = now,
+            None => {
+                commands.entity(entity).insert(now);
+            }
         }
         plan.count = plan.count.max(substeps);
-    }
-}
-
-/// A cloth's progress at the start of its step: its substeps and the time begun.
-fn set_progress(
-    commands: &mut Commands,
-    entity: Entity,
-    progress: Option<Mut<StepProgress>>,
-    substeps: u32,
-    elapsed: std::time::Duration,
-) {
-    let now = StepProgress { substeps, elapsed };
-    match progress {
-        Some(mut p) => *p = now,
-        None => {
-            commands.entity(entity).insert(now);
-        }
     }
 }
 
@@ -219,57 +198,28 @@ pub(crate) fn run_substeps(
     }
     let env = **world.resource::<ClothEnvironment>();
     let cloths = cloths.get_or_insert_with(|| world.query_filtered());
-    // The solver's pool, not `Query::par_iter_mut`: on two cores Bevy gives its compute
-    // pool one thread, and `par_iter_mut` then runs on the calling thread alone; a scope
-    // has the calling thread work beside the pool's.
-    // Cloths in contact with other cloths step together in one task, substep by substep
-    // (`solver::substep_together`); every other cloth in its own.
-    let mut touching = Vec::new();
-    let active = cloths.iter_mut(world);
-    solver::task_pool().scope(|scope| {
-        for (mut sim, mut progress) in active {
-            if sim.solver.touches_other_cloths() {
-                touching.push((sim, progress));
-                continue;
-            }
-            scope.spawn(async move {
-                let start = Instant::now();
-                for _ in 0..progress.substeps {
-                    sim.solver.substep(&env);
-                }
-                progress.elapsed += start.elapsed();
-            });
-        }
-        if !touching.is_empty() {
-            scope.spawn(async move {
-                let start = Instant::now();
-                let mut group: Vec<_> = touching.iter_mut().map(|(s, _)| &mut s.solver).collect();
-                solver::substep_together(&mut group, &env);
-                // The group's time is shared evenly among its cloths (one substep count).
-                let share = start.elapsed() / touching.len() as u32;
-                for (_, progress) in &mut touching {
-                    progress.elapsed += share;
-                }
-            });
-        }
-    });
+    // The solver's pool (`solver::run_cloths`), not `Query::par_iter_mut`: on two cores
+    // Bevy gives its compute pool one thread, and `par_iter_mut` then runs on the calling
+    // thread alone; a scope has the calling thread work beside the pool's.
+    let mut active: Vec<_> = cloths.iter_mut(world).collect();
+    let mut solvers: Vec<_> = active.iter_mut().map(|(sim, _)| &mut sim.solver).collect();
+    solver::run_cloths(&mut solvers, &env);
 }
 
-/// A cloth that takes part in the step: its simulation and progress.
-type ActiveCloth = (&'static mut ClothSimulation, &'static mut StepProgress);
+/// A cloth that takes part in the step, and how many substeps it takes (each stage times
+/// itself into the cloth's report).
+type ActiveCloth = (&'static mut ClothSimulation, &'static StepProgress);
 
 /// Runs one solver phase on every cloth that takes part in the current substep, in
-/// parallel, adding the time it took to that cloth's step time.
+/// parallel.
 fn for_each_active(
     plan: &ClothSubstepPlan,
-    cloths: &mut Query<(&mut ClothSimulation, &mut StepProgress), Without<ClothInvalid>>,
+    cloths: &mut Query<(&mut ClothSimulation, &StepProgress), Without<ClothInvalid>>,
     phase: impl Fn(&mut solver::ClothSolver) + Sync + Send,
 ) {
-    cloths.par_iter_mut().for_each(|(mut sim, mut progress)| {
+    cloths.par_iter_mut().for_each(|(mut sim, progress)| {
         if plan.index < progress.substeps {
-            let start = Instant::now();
             phase(&mut sim.solver);
-            progress.elapsed += start.elapsed();
         }
     });
 }
@@ -326,9 +276,9 @@ pub(crate) fn finish_steps(
         if progress.substeps == 0 {
             continue;
         }
-        let start = Instant::now();
         let sim = &mut *sim;
         let report = sim.solver.end_step();
+        let start = Instant::now();
         if !report.finite {
             let error = ClothError::NonFinite {
                 time: sim.solver.time(),
@@ -362,7 +312,8 @@ pub(crate) fn finish_steps(
             }
             asleep
         });
-        sim.last_step_ms = (progress.elapsed + start.elapsed()).as_secs_f32() * 1e3;
+        // The solver's own time for the step (each stage times itself) and this system's.
+        sim.last_step_ms = (report.time.total() + start.elapsed()).as_secs_f32() * 1e3;
         sim.mesh_dirty = true;
         if let Some(mut stats) = stats {
             stats.record(&sim.solver, &env, sim.last_step_ms);

@@ -25,8 +25,8 @@
 //! Cloth–cloth contact is the same test between a cloth's particles and those of the
 //! other cloths near it ([`collide_cloths`]): once a step each cloth takes a copy of their
 //! particles (position, velocity, inverse mass) and lists the pairs that can meet in
-//! the step. Cloths with such a copy step together ([`begin_together`],
-//! [`substep_together`]): at one substep count, the most any of them needs, and
+//! the step. Cloths with such a copy step together (`many.rs`): at one substep count,
+//! the most any of them needs, and
 //! before each substep's constraints the copy is
 //! refreshed to where the others are then, so each keeps its `d` from where they were
 //! one substep ago. Each cloth moves only its own particle, by its share of the
@@ -778,7 +778,7 @@ pub fn exchange_cloths(cloths: &mut [&mut super::ClothSolver]) {
 
 /// Cloth `a`'s copy of the others' particles, refreshed from those of `cloths` (matched
 /// by the place [`collide_cloths`] gave each).
-fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
+pub(super) fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
     let mut others = std::mem::take(&mut cloths[a].self_contact.others);
     let mut from: Option<(u32, usize)> = None; // the last source found (they come in runs)
     for o in &mut others {
@@ -795,48 +795,4 @@ fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
         }
     }
     cloths[a].self_contact.others = others;
-}
-
-/// Begins a step of `dt` for cloths in contact with one another ([`collide_cloths`]): each
-/// plans its step, and all take the most substeps any of them needs, so that they meet
-/// substep by substep at the same times ([`substep_together`]). Returns that count.
-/// Three self-colliding cloths stacked on a cushion, each at its own count (64, 55 and
-/// 22), met at times that did not line up and jittered at 0.28 m/s when solved along
-/// lines (`assets/scenes/stack.ron`); at one count they come to rest.
-pub fn begin_together(cloths: &mut [&mut super::ClothSolver], dt: f32) -> u32 {
-    let n = cloths
-        .iter_mut()
-        .map(|c| c.plan_step(dt))
-        .max()
-        .unwrap_or(0);
-    for cloth in cloths {
-        cloth.start_substeps(dt, n);
-    }
-    n
-}
-
-/// Runs the substeps of cloths in contact with one another, begun together
-/// ([`begin_together`]): every substep, all take their forces, prediction and targets,
-/// then each one's copy of the others is refreshed, then each projects its constraints:
-/// the order the plugin's stage-by-stage path runs (the same bits). With the others one
-/// step old, as when each cloth takes its step alone, three cloths stacked on a cushion
-/// jittered by up to 1 m/s for as long as they lay there (`assets/scenes/stack.ron`); so,
-/// they come to rest. A cloth that was not begun (0 substeps) takes none.
-pub fn substep_together(cloths: &mut [&mut super::ClothSolver], env: &crate::params::Environment) {
-    let due = |c: &super::ClothSolver| c.report.taken < c.report.substeps;
-    while cloths.iter().any(|c| due(c)) {
-        for cloth in cloths.iter_mut().filter(|c| due(c)) {
-            cloth.accumulate_forces(env);
-            cloth.integrate();
-            cloth.fit_targets();
-        }
-        for c in 0..cloths.len() {
-            if due(cloths[c]) {
-                refresh(cloths, c);
-            }
-        }
-        for cloth in cloths.iter_mut().filter(|c| due(c)) {
-            cloth.constrain();
-        }
-    }
 }
