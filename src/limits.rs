@@ -82,6 +82,11 @@ pub const MAX_POSITION: f32 = 1e5;
 /// A grid's or a garment's spacing between neighbouring particles, m.
 pub const MAX_SPACING: f32 = 10.0;
 
+/// Self-collision's distance, m, at least: 0.1 mm, thinner than any fabric. Far below
+/// it, the contact grid over a cloth's box would need more cells than an `i32` counts
+/// (a distance of 1e-9 m once overflowed it).
+pub const MIN_SELF_COLLISION_DISTANCE: f32 = 1e-4;
+
 /// Cloths in one scene, and colliders.
 pub const MAX_SCENE_ITEMS: usize = 1 << 12;
 

@@ -299,8 +299,11 @@ impl ClothScene {
                 "keys start with timestep, environment., cloth. or cloths[N].".into(),
             ));
         }
-        self.validate("", Path::new(spec))
-            .map_err(|e| fail(e.to_string()))
+        // Said once: the field and what is wrong (not the override again as a file).
+        self.validate("", Path::new(spec)).map_err(|e| match e {
+            SceneError::Invalid { field, message, .. } => fail(format!("`{field}` {message}")),
+            other => fail(other.to_string()),
+        })
     }
 
     /// The first cloth or collider placed out of range (not finite, or farther than

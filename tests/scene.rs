@@ -222,6 +222,13 @@ fn xpbd_reads_from_scene_files_and_overrides_and_only_it_takes_an_infinite_stiff
         .apply_override("cloth.params.springs.structural.stiffness=inf")
         .unwrap_err();
     assert!(matches!(e, SceneError::Override { .. }), "{e}");
+    // The refusal names the override once, then the field and what is wrong.
+    let e = explicit
+        .apply_override("cloth.params.drag=-1")
+        .unwrap_err()
+        .to_string();
+    assert_eq!(e.matches("drag=-1").count(), 1, "{e}");
+    assert!(e.contains("`cloths[0].cloth.params.drag`"), "{e}");
 }
 
 #[test]

@@ -294,3 +294,18 @@ fn a_stack_of_cloths_comes_to_rest() {
     );
     assert!(worst < 0.2, "the stack jitters: {worst} m/s");
 }
+
+/// A self-collision distance below 0.1 mm is refused at the door, naming its field (1e-30
+/// m was accepted and overflowed the contact grid's cell count in the first step).
+#[test]
+fn a_vanishing_self_collision_distance_is_refused() {
+    let mut scene = scene("fold", true, "xpbd");
+    for d in [1e-30, 1e-9, 5e-5] {
+        scene.cloths[0].cloth.params.self_collision.distance = Some(d);
+        let error = SceneRun::new(&scene).err().expect("refused").to_string();
+        assert!(error.contains("self_collision.distance"), "{error}");
+    }
+    scene.cloths[0].cloth.params.self_collision.distance = Some(1e-3);
+    let mut run = SceneRun::new(&scene).expect("1 mm is a distance");
+    run.run(3, |_, _| {});
+}

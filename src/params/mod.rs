@@ -322,8 +322,10 @@ impl ClothParams {
             check(
                 "self_collision.distance",
                 d,
-                d > 0.0 && d <= crate::limits::MAX_SPACING,
-                "a distance > 0 and at most 10 m (limits::MAX_SPACING)",
+                (crate::limits::MIN_SELF_COLLISION_DISTANCE..=crate::limits::MAX_SPACING)
+                    .contains(&d),
+                "a distance from 0.1 mm to 10 m (limits::MIN_SELF_COLLISION_DISTANCE, \
+                 limits::MAX_SPACING)",
             )?;
         }
         check(

@@ -672,13 +672,15 @@ impl Grid {
         }
         let mut cell = cell;
         loop {
-            let size = (extent / cell).floor().as_ivec3() + 1;
-            let count = size.x as f64 * size.y as f64 * size.z as f64;
+            // Counted in floats: a tiny cell over a large box has more cells along an
+            // axis than an `i32` holds (converted only once the count is small).
+            let size = (extent / cell).floor() + Vec3::ONE;
+            let count = f64::from(size.x) * f64::from(size.y) * f64::from(size.z);
             if count <= most as f64 {
                 return Self {
                     lo,
                     cell,
-                    size: size.to_array(),
+                    size: size.as_ivec3().to_array(),
                 };
             }
             cell *= (count / most as f64).cbrt().max(1.01) as f32;
@@ -795,4 +797,22 @@ pub(super) fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
         }
     }
     cloths[a].self_contact.others = others;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cell far smaller than the box (1e-30 m over 2 m) grows until the grid has at
+    /// most the cells asked for, instead of overflowing the count per axis.
+    #[test]
+    fn a_tiny_cell_over_a_large_box_grows_to_the_cells_allowed() {
+        let grid = Grid::new(Vec3::ZERO, Vec3::new(2.0, 1.0, 0.5), 1e-30, 4096);
+        let count: i64 = grid.size.iter().map(|&n| i64::from(n)).product();
+        assert!((1..=4096).contains(&count), "{:?} cells", grid.size);
+        assert_eq!(
+            grid.cell(Vec3::new(2.0, 1.0, 0.5)),
+            grid.size.map(|n| n - 1)
+        );
+    }
 }
