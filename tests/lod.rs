@@ -3,6 +3,7 @@
 
 use bevy::camera::{Camera, PerspectiveProjection, Projection};
 use bevy::prelude::*;
+use bevy_cloth::ClothLodPlugin;
 use bevy_cloth::params::{Environment, Model, PatchParams};
 use bevy_cloth::prelude::*;
 
@@ -240,4 +241,47 @@ fn a_settled_cloth_switches_without_a_jump() {
             "{from}→{to}: {switch} m against {normal} m"
         );
     }
+}
+
+/// Level of detail is a plugin of the group a game can leave out: with `ClothLodPlugin`
+/// disabled, a cloth with `ClothLod` 30 m from the camera (the patch model's 8×8 parts
+/// with it on) keeps its own model and level 0, and steps.
+#[test]
+fn an_app_without_level_of_detail_keeps_the_cloths_model() {
+    use bevy::time::TimeUpdateStrategy;
+    let mut app = App::new();
+    app.add_plugins((
+        MinimalPlugins,
+        AssetPlugin::default(),
+        ClothPlugin::default().build().disable::<ClothLodPlugin>(),
+    ))
+    .init_asset::<Mesh>()
+    .init_asset::<bevy::mesh::skinning::SkinnedMeshInverseBindposes>()
+    .insert_resource(TimeUpdateStrategy::ManualDuration(
+        std::time::Duration::from_millis(16),
+    ));
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(24, 24, 0.05).with_pins(ClothPins::TopRow),
+            ClothLod::default(),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+        ))
+        .id();
+    app.world_mut().spawn((
+        Camera::default(),
+        Projection::Perspective(PerspectiveProjection::default()),
+        Transform::from_xyz(0.0, 1.4, 30.0).looking_at(Vec3::new(0.0, 1.4, 0.0), Vec3::Y),
+    ));
+    for _ in 0..60 {
+        app.update();
+    }
+    assert_eq!(level(&app, cloth), 0);
+    let sim = app.world().get::<ClothSimulation>(cloth).expect("built");
+    assert_eq!(sim.solver.params().model, Model::MassSpring);
+    assert!(
+        sim.solver.time() > 0.5,
+        "it stepped: {} s",
+        sim.solver.time()
+    );
 }

@@ -98,7 +98,7 @@ impl ClothAttachment {
 /// transforms for this step (the solver reaches them over its substeps). The particles and
 /// their points in the target's frame are chosen the first time (and again when the cloth
 /// is rebuilt); a target without a transform (despawned) lets its particles go.
-pub(crate) fn attach_cloths(
+fn attach_cloths(
     transforms: TransformHelper,
     mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothAttachments)>,
 ) {
@@ -170,5 +170,22 @@ fn choose_held(
                 Vec::new()
             }
         },
+    }
+}
+
+/// Attachments ([`ClothAttachments`]): particles held at points of other entities,
+/// following them every step.
+pub struct ClothAttachPlugin;
+
+impl Plugin for ClothAttachPlugin {
+    fn build(&self, app: &mut App) {
+        let schedule = crate::ecs::plugin::ClothSchedule::of(app);
+        app.register_type::<ClothAttachments>()
+            .register_type::<ClothAttachment>()
+            .register_type::<AttachParticles>()
+            .add_systems(
+                schedule,
+                attach_cloths.in_set(crate::ecs::plugin::ClothPrepareSystems::Attach),
+            );
     }
 }

@@ -13,7 +13,7 @@ use bevy::mesh::skinning::SkinnedMesh;
 use crate::ecs::mesh::{cloth_mesh, mesh_triangles};
 use crate::ecs::skin::{ClothBody, ClothMaxDistance};
 use crate::error::ClothError;
-use crate::layout::garment::Garment;
+use crate::layout::garment::{Garment, GarmentLoader};
 use crate::layout::shape::{ClothPins, ClothShape};
 use crate::params::ClothParams;
 use crate::solver::{self, Layout};
@@ -118,9 +118,21 @@ pub(crate) struct ClothGarment {
     changed: bool,
 }
 
+/// Garments as assets: pattern, seam and garment files loaded in the background and
+/// hot-reloaded ([`Garment`], `GarmentLoader`); a cloth of [`ClothShape::Garment`] needs it.
+pub struct ClothGarmentPlugin;
+
+impl Plugin for ClothGarmentPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_asset::<Garment>()
+            .register_asset_loader(GarmentLoader)
+            .add_systems(Update, watch_garments);
+    }
+}
+
 /// Marks the cloths whose garment was reloaded (an edited garment or pattern file, or a
 /// broken one fixed). Runs every frame, so no asset event is missed between fixed steps.
-pub(crate) fn watch_garments(
+fn watch_garments(
     mut events: MessageReader<AssetEvent<Garment>>,
     mut cloths: Query<(&mut ClothGarment, Has<ClothSimulation>)>,
 ) {
@@ -145,8 +157,16 @@ fn garment_source<'a>(
     file: &str,
     current: Option<&ClothGarment>,
     asset_server: &AssetServer,
-    garments: &'a Assets<Garment>,
+    garments: Option<&'a Assets<Garment>>,
 ) -> Result<Option<&'a Garment>, ClothError> {
+    let Some(garments) = garments else {
+        return Err(ClothError::Garment {
+            file: file.to_string(),
+            line: 1,
+            column: 1,
+            message: "garments are loaded by ClothGarmentPlugin, left out of this app".into(),
+        });
+    };
     let handle = match current {
         Some(current) if current.file == file => current.handle.clone(),
         _ => {
@@ -197,7 +217,7 @@ fn layout_source<'a>(
     ),
     meshes: &'a Assets<Mesh>,
     (commands, entity): (&mut Commands, Entity),
-    (asset_server, garments): (&AssetServer, &'a Assets<Garment>),
+    (asset_server, garments): (&AssetServer, Option<&'a Assets<Garment>>),
 ) -> Result<(LayoutSource<'a>, Option<Handle<Mesh>>), ClothError> {
     Ok(match &cloth.shape {
         ClothShape::Mesh => {
@@ -218,7 +238,7 @@ pub(crate) fn build_cloths(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     asset_server: Res<AssetServer>,
-    garments: Res<Assets<Garment>>,
+    garments: Option<Res<Assets<Garment>>>,
     transforms: TransformHelper,
     mut cloths: Query<(
         Entity,
@@ -265,7 +285,7 @@ pub(crate) fn build_cloths(
             (source, mesh3d, garment.as_deref()),
             &meshes,
             (&mut commands, entity),
-            (&asset_server, &garments),
+            (&asset_server, garments.as_deref()),
         ) {
             Ok(found) => found,
             Err(e) => {

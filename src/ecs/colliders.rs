@@ -531,3 +531,23 @@ pub(crate) fn give_colliders(
         }
     }
 }
+
+/// Colliders ([`ClothCollider`]): placed from their transforms every step and given to
+/// the cloths within reach.
+pub struct ClothCollidersPlugin;
+
+impl Plugin for ClothCollidersPlugin {
+    fn build(&self, app: &mut App) {
+        let schedule = crate::ecs::plugin::ClothSchedule::of(app);
+        app.register_type::<ClothCollider>()
+            .register_type::<ColliderKind>()
+            .register_type::<ClothColliderSpan>()
+            .init_resource::<PlacedColliders>()
+            .add_systems(
+                schedule,
+                (place_colliders, give_colliders)
+                    .chain()
+                    .in_set(crate::ecs::plugin::ClothPrepareSystems::Colliders),
+            );
+    }
+}

@@ -72,7 +72,7 @@ impl ClothLod {
 /// bounding sphere of its particles, `radius / (distance · tan(fov/2))` for a perspective
 /// camera (`radius / half height` for an orthographic one). A new level sets the cloth's
 /// model (its own at 0, patches above), which `build_cloths` then applies.
-pub(crate) fn choose_levels(
+fn choose_levels(
     transforms: TransformHelper,
     cameras: Query<(Entity, &Camera, &Projection)>,
     mut cloths: Query<(&mut Cloth, &mut ClothLod, &ClothSimulation)>,
@@ -116,5 +116,19 @@ pub(crate) fn choose_levels(
                 ..PatchParams::default()
             }),
         };
+    }
+}
+
+/// Level of detail ([`ClothLod`]): each cloth with one picks its model from its size on
+/// screen before it is built and stepped.
+pub struct ClothLodPlugin;
+
+impl Plugin for ClothLodPlugin {
+    fn build(&self, app: &mut App) {
+        let schedule = crate::ecs::plugin::ClothSchedule::of(app);
+        app.register_type::<ClothLod>().add_systems(
+            schedule,
+            choose_levels.in_set(crate::ecs::plugin::ClothPrepareSystems::Levels),
+        );
     }
 }

@@ -174,7 +174,7 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
 /// With [`ClothInterpolation`] on, a cloth that moved in its last step is written every
 /// frame, between where that step began and where it ended (its normals are the step's
 /// end's, computed once a step).
-pub(crate) fn write_meshes(
+fn write_meshes(
     mut meshes: ResMut<Assets<Mesh>>,
     interpolation: Option<Res<ClothInterpolation>>,
     fixed: Res<Time<Fixed>>,
@@ -198,5 +198,25 @@ pub(crate) fn write_meshes(
         let from = blending.then_some((sim.previous.as_slice(), t));
         write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from);
         sim.mesh_dirty = false;
+    }
+}
+
+/// Drawing: once a frame (in `PostUpdate`, [`ClothSystems::WriteMesh`]), each cloth's
+/// positions and normals written into its mesh in place, between the last two fixed
+/// steps when they are fixed ones ([`ClothInterpolation`]). Without it the cloths are
+/// simulated and not drawn (a headless run, a server).
+///
+/// [`ClothSystems::WriteMesh`]: crate::ClothSystems::WriteMesh
+pub struct ClothMeshPlugin;
+
+impl bevy::app::Plugin for ClothMeshPlugin {
+    fn build(&self, app: &mut bevy::app::App) {
+        use bevy::prelude::IntoScheduleConfigs;
+        app.add_systems(
+            bevy::app::PostUpdate,
+            write_meshes
+                .in_set(crate::ClothSystems::WriteMesh)
+                .before(bevy::asset::AssetEventSystems),
+        );
     }
 }

@@ -19,16 +19,20 @@ pub(crate) mod sleep;
 pub(crate) mod stats;
 pub(crate) mod step;
 
-pub use attach::{AttachParticles, ClothAttachment, ClothAttachments};
+pub use attach::{AttachParticles, ClothAttachPlugin, ClothAttachment, ClothAttachments};
+pub use build::ClothGarmentPlugin;
 pub use cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
 };
-pub use colliders::{ClothCollider, ClothColliderSpan, ColliderKind, TELEPORT_SPEED};
+pub use colliders::{
+    ClothCollider, ClothColliderSpan, ClothCollidersPlugin, ColliderKind, TELEPORT_SPEED,
+};
 pub use controls::{ClothControls, ClothControlsPlugin};
 pub use events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
-pub use lod::ClothLod;
-pub use plugin::{ClothPlugin, ClothSystems};
-pub use skin::{ATTRIBUTE_MAX_DISTANCE, ClothMaxDistance};
-pub use sleep::{ClothSleep, ClothWake};
+pub use lod::{ClothLod, ClothLodPlugin};
+pub use mesh::ClothMeshPlugin;
+pub use plugin::{ClothCorePlugin, ClothPlugin, ClothPrepareSystems, ClothSystems};
+pub use skin::{ATTRIBUTE_MAX_DISTANCE, ClothMaxDistance, ClothSkinPlugin};
+pub use sleep::{ClothSleep, ClothSleepPlugin, ClothWake};
 pub use stats::{ClothStats, StatSample};
 pub use step::{ClothSubstep, ClothSubstepPlan, ClothSubstepSystems};

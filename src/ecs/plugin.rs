@@ -1,16 +1,20 @@
-//! `ClothPlugin`: the thin ECS layer over the solver. This file only wires the features,
-//! each in its own file: building (`build.rs`), attachments (`attach.rs`), colliders
-//! (`colliders.rs`), level of detail (`lod.rs`), sleeping (`sleep.rs`), stepping
-//! (`step.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
-//! bodies (`avian.rs`, its own plugin).
+//! `ClothPlugin`: the thin ECS layer over the solver, as a group of one plugin per
+//! feature, each in its own file with its components, systems and registrations:
+//! the core here (the cloth, its building and stepping, the events), garments as assets
+//! (`build.rs`), colliders (`colliders.rs`), attachments (`attach.rs`), motion
+//! constraints from skinned meshes (`skin.rs`), sleeping (`sleep.rs`), level of detail
+//! (`lod.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
+//! bodies (`avian.rs`, added by the game). A game leaves a feature out with
+//! `ClothPlugin::default().build().disable::<ClothLodPlugin>()`.
 //!
 //! In the simulation schedule (`FixedPostUpdate` by default, at the game's fixed rate):
 //! ```text
-//! ClothSystems::Prepare      build / rebuild cloths, apply edited parameters, move pins,
-//!                            place colliders, wake cloths, begin each cloth's step
+//! ClothSystems::Prepare      in the order of ClothPrepareSystems: level of detail, build /
+//!                            rebuild cloths and apply edited parameters, attachments,
+//!                            skinned bodies, colliders, waking, begin each cloth's step
 //! ClothSystems::Substeps     run the ClothSubstep schedule N times, which holds
 //!     ClothSubstepSystems::AccumulateForces → Integrate → FitTargets → Constrain
-//! ClothSystems::Finish       end each step: tearing, sleep, statistics, events
+//! ClothSystems::Finish       end each step: tearing, statistics, events; then sleep
 //! ```
 //! and in `PostUpdate`, once per frame after the fixed loop, `ClothSystems::WriteMesh`
 //! writes positions and normals into each cloth's mesh buffers in place, drawn between
@@ -23,41 +27,39 @@
 
 use std::time::Duration;
 
-use bevy::asset::AssetEventSystems;
+use bevy::app::PluginGroupBuilder;
 use bevy::ecs::intern::Interned;
 use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
-use crate::ecs::attach::{AttachParticles, ClothAttachment, ClothAttachments, attach_cloths};
-use crate::ecs::build::{build_cloths, watch_garments};
+use crate::ecs::attach::ClothAttachPlugin;
+use crate::ecs::build::{ClothGarmentPlugin, build_cloths};
 use crate::ecs::cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
 };
-use crate::ecs::colliders::{
-    ClothCollider, ColliderKind, PlacedColliders, give_colliders, place_colliders,
-};
-use crate::ecs::events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
-use crate::ecs::lod::{ClothLod, choose_levels};
-use crate::ecs::mesh::write_meshes;
-use crate::ecs::skin::{ClothMaxDistance, move_bodies};
-use crate::ecs::sleep::{ClothSleep, ClothWake, wake_cloths};
+use crate::ecs::colliders::ClothCollidersPlugin;
+use crate::ecs::events::{ClothBecameInvalid, ClothBuilt, ClothTorn};
+use crate::ecs::lod::ClothLodPlugin;
+use crate::ecs::mesh::ClothMeshPlugin;
+use crate::ecs::skin::ClothSkinPlugin;
+use crate::ecs::sleep::ClothSleepPlugin;
 use crate::ecs::stats::{ClothStats, StatSample};
 use crate::ecs::step::{
     ClothSubstepPlan, begin_steps, finish_steps, recover_cloths, run_substeps, substep_schedule,
 };
-use crate::layout::garment::{Garment, GarmentLoader};
 use crate::layout::shape::{ClothPins, ClothShape};
 use crate::params::{
-    ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
+    Air, ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
     RotationMethod, SelfCollision, ShapeMatchingParams, SpringFamily, SpringParams, Substeps, Wind,
-    WindField, XpbdParams,
+    WindField, XpbdParams, XpbdSolve,
 };
 
 /// The ordered system sets of the cloth simulation in the plugin's schedule (and, for
 /// [`ClothSystems::WriteMesh`], `PostUpdate`).
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ClothSystems {
-    /// Build new cloths, rebuild changed ones, apply parameter edits, move pins.
+    /// Build new cloths, rebuild changed ones, apply parameter edits, move pins
+    /// ([`ClothPrepareSystems`] orders its parts).
     Prepare,
     /// Run the [`ClothSubstep`](crate::ClothSubstep) schedule as many times as the cloths need.
     Substeps,
@@ -69,7 +71,28 @@ pub enum ClothSystems {
     WriteMesh,
 }
 
-/// Adds cloth simulation to an app.
+/// The parts of [`ClothSystems::Prepare`], in the order they run; each feature's plugin
+/// puts its systems in its part.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ClothPrepareSystems {
+    /// Level of detail picks each cloth's model ([`ClothLodPlugin`]).
+    Levels,
+    /// New cloths are built, changed ones rebuilt, edited parameters applied.
+    Build,
+    /// Attached particles follow their bodies ([`ClothAttachPlugin`]).
+    Attach,
+    /// Skinned bodies move their cloths' motion constraints ([`ClothSkinPlugin`]).
+    Skin,
+    /// The colliders are placed and given to the cloths ([`ClothCollidersPlugin`]).
+    Colliders,
+    /// Sleeping cloths that something may move wake ([`ClothSleepPlugin`]).
+    Wake,
+    /// Each cloth's step begins.
+    Begin,
+}
+
+/// Adds cloth simulation to an app: a group of one plugin per feature (see the module
+/// docs); each can be left out with `ClothPlugin::default().build().disable::<…>()`.
 ///
 /// ```no_run
 /// use bevy::prelude::*;
@@ -81,6 +104,7 @@ pub enum ClothSystems {
 ///     })
 ///     .run();
 /// ```
+#[derive(Clone, Copy, Debug)]
 pub struct ClothPlugin {
     /// The schedule the simulation steps in.
     pub schedule: Interned<dyn ScheduleLabel>,
@@ -124,7 +148,34 @@ impl ClothPlugin {
     }
 }
 
-impl Plugin for ClothPlugin {
+impl PluginGroup for ClothPlugin {
+    fn build(self) -> PluginGroupBuilder {
+        PluginGroupBuilder::start::<Self>()
+            .add(ClothCorePlugin {
+                schedule: self.schedule,
+                timestep: self.timestep,
+            })
+            .add(ClothGarmentPlugin)
+            .add(ClothLodPlugin)
+            .add(ClothAttachPlugin)
+            .add(ClothSkinPlugin)
+            .add(ClothCollidersPlugin)
+            .add(ClothSleepPlugin)
+            .add(ClothMeshPlugin)
+    }
+}
+
+/// The core of [`ClothPlugin`]: the cloth, its parameters, building and stepping, the
+/// substep schedule, pausing, statistics and the events; the system sets the feature
+/// plugins put their systems in. The other plugins of the group need it.
+pub struct ClothCorePlugin {
+    /// The schedule the simulation steps in.
+    pub schedule: Interned<dyn ScheduleLabel>,
+    /// `Time<Fixed>`'s period to set, if any.
+    pub timestep: Option<Duration>,
+}
+
+impl Plugin for ClothCorePlugin {
     fn build(&self, app: &mut App) {
         if let Some(step) = self.timestep {
             app.insert_resource(Time::<Fixed>::from_duration(step));
@@ -140,17 +191,10 @@ impl Plugin for ClothPlugin {
         ];
         app.insert_resource(ClothInterpolation(fixed.contains(&self.schedule)));
         register_types(app);
-        // Every cloth can sleep (a game turns it off per cloth with `ClothSleep::never()`).
-        app.register_required_components::<Cloth, ClothSleep>();
         app.init_resource::<ClothEnvironment>()
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
-            .init_resource::<PlacedColliders>()
-            .add_message::<ClothTorn>()
-            .add_message::<ClothWake>()
-            .init_asset::<Garment>()
-            .register_asset_loader(GarmentLoader)
-            .add_systems(Update, watch_garments);
+            .add_message::<ClothTorn>();
 
         app.add_schedule(substep_schedule());
         // Stepping in `PostUpdate` is stepping after the frame's animation: the step
@@ -168,6 +212,7 @@ impl Plugin for ClothPlugin {
             );
         }
 
+        use ClothPrepareSystems as P;
         app.configure_sets(
             self.schedule,
             (
@@ -177,48 +222,52 @@ impl Plugin for ClothPlugin {
             )
                 .chain(),
         )
+        .configure_sets(
+            self.schedule,
+            (
+                P::Levels,
+                P::Build,
+                P::Attach,
+                P::Skin,
+                P::Colliders,
+                P::Wake,
+                P::Begin,
+            )
+                .chain()
+                .in_set(ClothSystems::Prepare),
+        )
         .add_systems(
             self.schedule,
             (
-                (
-                    choose_levels,
-                    build_cloths,
-                    attach_cloths,
-                    move_bodies,
-                    place_colliders,
-                    give_colliders,
-                    wake_cloths,
-                    recover_cloths,
-                    begin_steps,
-                )
-                    .chain()
-                    .in_set(ClothSystems::Prepare),
+                build_cloths.in_set(P::Build),
+                (recover_cloths, begin_steps).chain().in_set(P::Begin),
                 run_substeps.in_set(ClothSystems::Substeps),
                 finish_steps.in_set(ClothSystems::Finish),
             ),
-        )
-        .add_systems(
-            PostUpdate,
-            write_meshes
-                .in_set(ClothSystems::WriteMesh)
-                .before(AssetEventSystems),
         );
     }
 }
 
 /// The schedule the cloths step in (the plugin's), for plugins that add to the step.
 #[derive(Resource, Clone, Copy, Debug)]
-#[cfg_attr(not(feature = "avian"), allow(dead_code))]
 pub(crate) struct ClothSchedule(pub(crate) Interned<dyn ScheduleLabel>);
 
-/// Registers the plugin's parameter, shape, component, resource, message and event types
-/// for reflection (the inspector, scene files).
+impl ClothSchedule {
+    /// The schedule of the core plugin, which the feature plugins add their systems to.
+    pub(crate) fn of(app: &App) -> Interned<dyn ScheduleLabel> {
+        app.world()
+            .get_resource::<ClothSchedule>()
+            .expect("ClothCorePlugin comes first in ClothPlugin's group")
+            .0
+    }
+}
+
+/// Registers the core's parameter, shape, component, resource, message and event types
+/// for reflection (the inspector, scene files); each feature plugin registers its own.
 fn register_types(app: &mut App) {
     app.register_type::<Cloth>()
         .register_type::<ClothShape>()
         .register_type::<ClothPins>()
-        .register_type::<ClothCollider>()
-        .register_type::<ColliderKind>()
         .register_type::<ClothParams>()
         .register_type::<SpringParams>()
         .register_type::<SpringFamily>()
@@ -228,6 +277,7 @@ fn register_types(app: &mut App) {
         .register_type::<ShapeMatchingParams>()
         .register_type::<PatchParams>()
         .register_type::<XpbdParams>()
+        .register_type::<XpbdSolve>()
         .register_type::<SelfCollision>()
         .register_type::<PatchTargets>()
         .register_type::<RotationMethod>()
@@ -235,26 +285,17 @@ fn register_types(app: &mut App) {
         .register_type::<Environment>()
         .register_type::<Wind>()
         .register_type::<WindField>()
+        .register_type::<Air>()
         .register_type::<ClothEnvironment>()
         .register_type::<ClothPause>()
         .register_type::<ClothInterpolation>()
-        .register_type::<ClothMaxDistance>()
-        .register_type::<crate::ecs::colliders::ClothColliderSpan>()
-        .register_type::<ClothSleep>()
-        .register_type::<ClothLod>()
         .register_type::<ClothSimulation>()
         .register_type::<ClothInvalid>()
         .register_type::<crate::error::ClothError>()
         .register_type::<ClothStats>()
         .register_type::<StatSample>()
         .register_type::<crate::solver::Energy>()
-        .register_type::<ClothAttachments>()
-        .register_type::<ClothAttachment>()
-        .register_type::<AttachParticles>()
         .register_type::<ClothTorn>()
-        .register_type::<ClothWake>()
-        .register_type::<ClothAwoke>()
-        .register_type::<ClothFellAsleep>()
         .register_type::<ClothBecameInvalid>()
         .register_type::<ClothBuilt>();
 }

@@ -221,7 +221,7 @@ impl BodySkin {
 /// Gives each cloth with a body its motion constraints for this step: the targets where
 /// its skin (from its joints' transforms now) or its frame puts each particle, and the
 /// distances. On a cloth's first step its particles are put at their targets.
-pub(crate) fn move_bodies(
+fn move_bodies(
     transforms: TransformHelper,
     bindposes: Option<Res<Assets<SkinnedMeshInverseBindposes>>>,
     mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothBody)>,
@@ -263,5 +263,19 @@ pub(crate) fn move_bodies(
         {
             warn_once!("cloth {entity}: {e}");
         }
+    }
+}
+
+/// Cloth on skinned characters: a cloth made of a skinned mesh follows its skin, each
+/// particle within its painted [`ClothMaxDistance`] of where the skin puts it.
+pub struct ClothSkinPlugin;
+
+impl Plugin for ClothSkinPlugin {
+    fn build(&self, app: &mut App) {
+        let schedule = crate::ecs::plugin::ClothSchedule::of(app);
+        app.register_type::<ClothMaxDistance>().add_systems(
+            schedule,
+            move_bodies.in_set(crate::ecs::plugin::ClothPrepareSystems::Skin),
+        );
     }
 }

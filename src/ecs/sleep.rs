@@ -2,8 +2,10 @@
 
 use bevy::prelude::*;
 
-use crate::ecs::cloth::{ClothEnvironment, ClothSimulation};
-use crate::ecs::events::ClothAwoke;
+use crate::ecs::cloth::{ClothEnvironment, ClothInvalid, ClothSimulation};
+use crate::ecs::events::{ClothAwoke, ClothFellAsleep};
+use crate::ecs::stats::ClothStats;
+use crate::ecs::step::StepProgress;
 use crate::params::Environment;
 
 /// Sleeping: a cloth whose every free particle moves slower than `speed` for
@@ -79,7 +81,7 @@ pub struct ClothWake(pub Entity);
 /// Wakes the sleeping cloths that something may move (see [`ClothSleep`]): the solver's
 /// own record of outside changes (parameters, frame, colliders within reach, tools), a
 /// change of gravity or wind, a [`ClothWake`] message, or sleeping switched off.
-pub(crate) fn wake_cloths(
+fn wake_cloths(
     mut commands: Commands,
     env: Res<ClothEnvironment>,
     mut last_env: Local<Option<Environment>>,
@@ -99,6 +101,68 @@ pub(crate) fn wake_cloths(
             // `ClothStats::asleep` follows at the step this lets run.
             sleep.wake();
             commands.trigger(ClothAwoke { entity });
+        }
+    }
+}
+
+/// Sleeping ([`ClothSleep`], added to every cloth): a still cloth skips its steps, and
+/// wakes on whatever can move it.
+pub struct ClothSleepPlugin;
+
+impl Plugin for ClothSleepPlugin {
+    fn build(&self, app: &mut App) {
+        let schedule = crate::ecs::plugin::ClothSchedule::of(app);
+        // Every cloth can sleep (a game turns it off per cloth with `ClothSleep::never()`).
+        app.register_required_components::<crate::Cloth, ClothSleep>()
+            .register_type::<ClothSleep>()
+            .register_type::<ClothWake>()
+            .register_type::<ClothAwoke>()
+            .register_type::<ClothFellAsleep>()
+            .add_message::<ClothWake>()
+            .add_systems(
+                schedule,
+                (
+                    wake_cloths.in_set(crate::ecs::plugin::ClothPrepareSystems::Wake),
+                    observe_sleep
+                        .after(crate::ecs::step::finish_steps)
+                        .in_set(crate::ClothSystems::Finish),
+                ),
+            );
+    }
+}
+
+/// After each step: a cloth that stepped counts its fastest particle toward falling
+/// asleep ([`ClothSleep::observe`]), and says so in its statistics.
+fn observe_sleep(
+    mut commands: Commands,
+    time: Res<Time>,
+    mut cloths: Query<
+        (
+            Entity,
+            &ClothSimulation,
+            &StepProgress,
+            &mut ClothSleep,
+            Option<&mut ClothStats>,
+        ),
+        Without<ClothInvalid>,
+    >,
+) {
+    for (entity, sim, progress, mut sleep, stats) in &mut cloths {
+        if progress.substeps == 0 || !sim.solver.last_report().finite {
+            continue;
+        }
+        let speed = if sleep.enabled {
+            sim.solver.max_speed()
+        } else {
+            f32::INFINITY
+        };
+        let was_asleep = sleep.asleep;
+        let asleep = sleep.observe(speed, time.delta_secs());
+        if asleep && !was_asleep {
+            commands.trigger(ClothFellAsleep { entity });
+        }
+        if let Some(mut stats) = stats {
+            stats.asleep = asleep;
         }
     }
 }

@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use crate::ecs::cloth::{
     ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
 };
-use crate::ecs::events::{ClothFellAsleep, ClothTorn};
+use crate::ecs::events::ClothTorn;
 use crate::ecs::sleep::ClothSleep;
 use crate::ecs::stats::ClothStats;
 use crate::error::ClothError;
@@ -260,19 +260,17 @@ pub(crate) fn finish_steps(
     mut commands: Commands,
     mut torn: MessageWriter<ClothTorn>,
     env: Res<ClothEnvironment>,
-    time: Res<Time>,
     mut cloths: Query<
         (
             Entity,
             &mut ClothSimulation,
             &StepProgress,
             Option<&mut ClothStats>,
-            Option<&mut ClothSleep>,
         ),
         Without<ClothInvalid>,
     >,
 ) {
-    for (entity, mut sim, progress, stats, sleep) in &mut cloths {
+    for (entity, mut sim, progress, stats) in &mut cloths {
         if progress.substeps == 0 {
             continue;
         }
@@ -299,25 +297,11 @@ pub(crate) fn finish_steps(
             torn.write(event);
             commands.trigger(event);
         }
-        let asleep = sleep.is_some_and(|mut sleep| {
-            let speed = if sleep.enabled {
-                sim.solver.max_speed()
-            } else {
-                f32::INFINITY
-            };
-            let was_asleep = sleep.asleep;
-            let asleep = sleep.observe(speed, time.delta_secs());
-            if asleep && !was_asleep {
-                commands.trigger(ClothFellAsleep { entity });
-            }
-            asleep
-        });
         // The solver's own time for the step (each stage times itself) and this system's.
         sim.last_step_ms = (report.time.total() + start.elapsed()).as_secs_f32() * 1e3;
         sim.mesh_dirty = true;
         if let Some(mut stats) = stats {
             stats.record(&sim.solver, &env, sim.last_step_ms);
-            stats.asleep = asleep;
         }
     }
 }
