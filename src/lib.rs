@@ -55,8 +55,9 @@ pub use params::ClothParams;
 pub use scene::ClothScene;
 
 /// What a game uses to add cloth: the plugin, the components, the events, the shape,
-/// pins and parameters of a cloth. The model's parameter types (`Model`, `XpbdParams`,
-/// `Wind`, …) are in [`params`], so that their names stay out of a game's namespace.
+/// pins and parameters of a cloth, and what the README's features ask for (a fabric,
+/// self-collision, air). The model's parameter types (`Model`, `XpbdParams`, `Wind`, …)
+/// are in [`params`], so that their names stay out of a game's namespace.
 pub mod prelude {
     #[cfg(feature = "avian")]
     pub use crate::ecs::avian::ClothAvianPlugin;
@@ -70,6 +71,6 @@ pub mod prelude {
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;
     pub use crate::layout::shape::{ClothPins, ClothShape};
-    pub use crate::params::ClothParams;
+    pub use crate::params::{Air, ClothParams, SelfCollision};
     pub use crate::scene::ClothScene;
 }

@@ -1361,3 +1361,35 @@ fn cloths_in_contact_step_together_the_same_on_both_paths() {
     assert!(top > bottom + 0.02, "in layers: {top} over {bottom}");
     assert!(alone == with_system, "the two paths differ");
 }
+
+/// A collider with a negative radius is not clamped to 0 in silence: it gets
+/// `ClothInvalid` naming the radius (and is logged) and is left out of the cloths' steps;
+/// fixed, it is a collider again.
+#[test]
+fn a_collider_of_negative_size_is_refused_until_fixed() {
+    let mut app = app();
+    let collider = app
+        .world_mut()
+        .spawn((ClothCollider::sphere(-1.0), Transform::default()))
+        .id();
+    for _ in 0..3 {
+        app.update();
+    }
+    let invalid = app.world().get::<ClothInvalid>(collider).expect("refused");
+    assert!(
+        matches!(
+            invalid.0,
+            ClothError::InvalidParameter {
+                field: "radius",
+                ..
+            }
+        ),
+        "{:?}",
+        invalid.0
+    );
+    *app.world_mut().get_mut::<ClothCollider>(collider).unwrap() = ClothCollider::sphere(0.2);
+    for _ in 0..3 {
+        app.update();
+    }
+    assert!(app.world().get::<ClothInvalid>(collider).is_none());
+}

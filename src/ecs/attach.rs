@@ -140,18 +140,41 @@ fn choose_held(
     let x = solver.positions();
     let to_local = frame.affine().inverse();
     let here = |i: u32| (i, to_local.transform_point3(x[i as usize]));
+    // Particles the cloth does not have are left out, and said so (a cloth whose every
+    // attached index lay outside it fell without a word).
+    let kept = |held: Vec<(u32, Vec3)>, given: usize| {
+        if held.len() < given {
+            warn!(
+                "cloth {cloth}: {} of the attachment's {given} particles are not among its {} \
+                 (or their points are not finite) and are left out{}",
+                given - held.len(),
+                x.len(),
+                if held.is_empty() {
+                    "; it holds nothing"
+                } else {
+                    ""
+                }
+            );
+        }
+        held
+    };
     match particles {
-        AttachParticles::At(points) => points
-            .iter()
-            .copied()
-            .filter(|&(i, local)| (i as usize) < x.len() && local.is_finite())
-            .collect(),
-        AttachParticles::Indices(list) => list
-            .iter()
-            .copied()
-            .filter(|&i| (i as usize) < x.len())
-            .map(here)
-            .collect(),
+        AttachParticles::At(points) => kept(
+            points
+                .iter()
+                .copied()
+                .filter(|&(i, local)| (i as usize) < x.len() && local.is_finite())
+                .collect(),
+            points.len(),
+        ),
+        AttachParticles::Indices(list) => kept(
+            list.iter()
+                .copied()
+                .filter(|&i| (i as usize) < x.len())
+                .map(here)
+                .collect(),
+            list.len(),
+        ),
         AttachParticles::Nearest { point, count } => {
             let at = frame.transform_point(*point);
             let mut order: Vec<u32> = (0..x.len() as u32).collect();

@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 use serde::{Deserialize, Serialize};
 
-use crate::ecs::cloth::{ClothSimulation, Layers};
+use crate::ecs::cloth::{ClothInvalid, ClothSimulation, Layers};
 use crate::error::ClothError;
 use crate::solver;
 
@@ -475,7 +475,7 @@ impl ClothColliderSpan {
 pub(crate) fn place_colliders(
     time: Res<Time>,
     transforms: TransformHelper,
-    colliders: Query<(Entity, &ClothCollider, Option<&ClothColliderSpan>)>,
+    colliders: Query<(Entity, &ClothCollider, Option<&ClothColliderSpan>), Without<ClothInvalid>>,
     mut placed: ResMut<PlacedColliders>,
 ) {
     let placed = &mut *placed;
@@ -532,8 +532,33 @@ pub(crate) fn give_colliders(
     }
 }
 
-/// Colliders ([`ClothCollider`]): placed from their transforms every step and given to
-/// the cloths within reach.
+/// Checks each collider added or changed ([`ClothCollider::validate`]): one with a size
+/// out of range (a negative radius) is logged with its name, marked [`ClothInvalid`] and
+/// left out of every cloth's step until it is fixed (sizes were clamped to 0 in silence).
+fn check_colliders(
+    mut commands: Commands,
+    colliders: Query<
+        (Entity, &ClothCollider, Option<&Name>, Has<ClothInvalid>),
+        Changed<ClothCollider>,
+    >,
+) {
+    for (entity, collider, name, invalid) in &colliders {
+        match collider.validate() {
+            Ok(()) if invalid => {
+                commands.entity(entity).remove::<ClothInvalid>();
+            }
+            Ok(()) => {}
+            Err(error) => {
+                let who = name.map_or_else(|| entity.to_string(), |n| format!("`{n}` ({entity})"));
+                error!("collider {who} is left out: {error}");
+                commands.entity(entity).insert(ClothInvalid(error));
+            }
+        }
+    }
+}
+
+/// Colliders ([`ClothCollider`]): checked when added or changed, placed from their
+/// transforms every step and given to the cloths within reach.
 pub struct ClothCollidersPlugin;
 
 impl Plugin for ClothCollidersPlugin {
@@ -545,7 +570,7 @@ impl Plugin for ClothCollidersPlugin {
             .init_resource::<PlacedColliders>()
             .add_systems(
                 schedule,
-                (place_colliders, give_colliders)
+                (check_colliders, place_colliders, give_colliders)
                     .chain()
                     .in_set(crate::ecs::plugin::ClothPrepareSystems::Colliders),
             );

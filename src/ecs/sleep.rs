@@ -133,6 +133,7 @@ impl Plugin for ClothSleepPlugin {
 
 /// After each step: a cloth that stepped counts its fastest particle toward falling
 /// asleep ([`ClothSleep::observe`]), and says so in its statistics.
+#[allow(clippy::type_complexity)]
 fn observe_sleep(
     mut commands: Commands,
     time: Res<Time>,
