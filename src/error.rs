@@ -53,7 +53,7 @@ pub enum ClothError {
         limit: u64,
     },
     /// A pin names a particle that does not exist.
-    #[error("pin index {index} is out of range: the cloth has {count} particles")]
+    #[error("`pins`: pin index {index} is out of range: the cloth has {count} particles")]
     PinOutOfRange {
         /// The pin index given.
         index: u32,

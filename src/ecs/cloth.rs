@@ -255,9 +255,21 @@ impl ClothPause {
 /// Stops simulating a cloth and says why: logs `error`, marks the entity
 /// [`ClothInvalid`] and triggers [`ClothBecameInvalid`] on it.
 pub(crate) fn pause_invalid(commands: &mut Commands, entity: Entity, error: ClothError) {
-    error!("cloth {entity} is not simulated: {error}");
     commands.entity(entity).insert(ClothInvalid(error.clone()));
     commands.trigger(ClothBecameInvalid { entity, error });
+}
+
+/// Logs why a cloth is not simulated, naming it by its `Name` when it has one (an entity
+/// id alone, `47v0`, says little to a person reading the log).
+pub(crate) fn log_invalid(invalid: On<ClothBecameInvalid>, names: Query<&Name>) {
+    let entity = invalid.entity;
+    match names.get(entity) {
+        Ok(name) => error!(
+            "cloth `{name}` ({entity}) is not simulated: {}",
+            invalid.error
+        ),
+        Err(_) => error!("cloth {entity} is not simulated: {}", invalid.error),
+    }
 }
 
 /// Collision layers as bit masks (avian's `CollisionLayers`, which the `avian` feature

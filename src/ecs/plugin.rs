@@ -194,7 +194,8 @@ impl Plugin for ClothCorePlugin {
         app.init_resource::<ClothEnvironment>()
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
-            .add_message::<ClothTorn>();
+            .add_message::<ClothTorn>()
+            .add_observer(crate::ecs::cloth::log_invalid);
 
         app.add_schedule(substep_schedule());
         // Stepping in `PostUpdate` is stepping after the frame's animation: the step

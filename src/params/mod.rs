@@ -245,7 +245,7 @@ impl ClothParams {
             if !matches!(self.model, Model::MassSpring | Model::Xpbd(_)) {
                 return Err(ClothError::ModelLacks {
                     model: self.model.kind().name(),
-                    feature: "fabric in physical units",
+                    feature: "fabric in physical units (`fabric`)",
                 });
             }
         }
@@ -338,7 +338,7 @@ impl ClothParams {
         if sc.enabled && matches!(model, ModelKind::Patches | ModelKind::ShapeMatching) {
             return Err(ClothError::ModelLacks {
                 model: model.name(),
-                feature: "self-collision",
+                feature: "self-collision (`self_collision`)",
             });
         }
         Ok(())
