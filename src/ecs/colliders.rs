@@ -535,6 +535,7 @@ pub(crate) fn give_colliders(
 /// Checks each collider added or changed ([`ClothCollider::validate`]): one with a size
 /// out of range (a negative radius) is logged with its name, marked [`ClothInvalid`] and
 /// left out of every cloth's step until it is fixed (sizes were clamped to 0 in silence).
+#[allow(clippy::type_complexity)]
 fn check_colliders(
     mut commands: Commands,
     colliders: Query<
