@@ -284,3 +284,42 @@ fn a_fabric_set_on_a_built_cloth_bends_like_one_built_with_it() {
     }
     assert_ne!(built.positions(), limp.positions());
 }
+
+/// A fabric so light that its particles would weigh under `limits::MIN_NODE_MASS` (1e-9
+/// kg: 1e-9 kg/m² on a 5 cm grid gives 2.5e-12 kg) is refused, naming its density, when
+/// built and when set on a running cloth; denim on the same grid is not.
+#[test]
+fn a_fabric_too_light_for_its_spacing_is_refused() {
+    let shape = ClothShape::Grid {
+        width: 8,
+        height: 8,
+        spacing: 0.05,
+    };
+    let params = |density: f32| ClothParams {
+        model: Model::Xpbd(Default::default()),
+        fabric: Some(Fabric {
+            areal_density: density,
+            ..Fabric::DENIM
+        }),
+        ..ClothParams::default()
+    };
+    let error = shape
+        .build_solver(&ClothPins::TopRow, &params(1e-9), Affine3A::IDENTITY)
+        .err()
+        .expect("refused");
+    assert!(
+        matches!(
+            error,
+            ClothError::InvalidParameter {
+                field: "fabric.areal_density",
+                ..
+            }
+        ),
+        "{error}"
+    );
+    let mut cloth = shape
+        .build_solver(&ClothPins::TopRow, &params(0.324), Affine3A::IDENTITY)
+        .expect("denim builds");
+    assert!(cloth.set_params(&params(1e-9)).is_err());
+    assert_eq!(cloth.params().fabric.unwrap().areal_density, 0.324);
+}

@@ -27,9 +27,11 @@ impl ClothSolver {
         params.validate()?;
         check_model_fits(params, layout.grid, !layout.triangles.is_empty())?;
         crate::params::check_work(count, params)?;
+        let structure = Structure::new(layout);
+        super::check_fabric_masses(params, &structure.area)?;
         let mut cloth = ClothSolver {
             particles: Particles::with_len(count),
-            structure: Structure::new(layout),
+            structure,
             drivers: Drivers::new(pins, frame),
             contact: Contact::default(),
             self_contact: Default::default(),

@@ -146,6 +146,7 @@ impl ClothSolver {
             !self.structure.triangles.is_empty(),
         )?;
         crate::params::check_work(self.particles.len(), params)?;
+        check_fabric_masses(params, &self.structure.area)?;
         self.apply_params(params);
         Ok(())
     }
@@ -230,4 +231,24 @@ pub(crate) fn pull_scale(d: f32, length_scale: f32, exponent: f32) -> f32 {
     } else {
         (d / length_scale).max(0.05).powf(exponent - 1.0)
     }
+}
+
+/// A fabric's particles weigh its areal density times their share of the cloth's area:
+/// the lightest must weigh at least [`MIN_NODE_MASS`](crate::limits::MIN_NODE_MASS), or
+/// forces leave `f32`'s range (a density only checked `> 0` gave particles of 0 kg at a
+/// fine spacing, or on a vertex no triangle uses).
+pub(crate) fn check_fabric_masses(params: &ClothParams, area: &[f32]) -> Result<(), ClothError> {
+    let Some(fabric) = &params.fabric else {
+        return Ok(());
+    };
+    let lightest = area.iter().fold(f32::INFINITY, |m, &a| m.min(a)) * fabric.areal_density;
+    if area.is_empty() || lightest >= crate::limits::MIN_NODE_MASS {
+        return Ok(());
+    }
+    Err(ClothError::InvalidParameter {
+        field: "fabric.areal_density",
+        value: fabric.areal_density,
+        expected: "a density whose lightest particle weighs at least 1e-9 kg \
+                   (limits::MIN_NODE_MASS) at this cloth's spacing",
+    })
 }
