@@ -305,8 +305,7 @@ fn a_fabric_too_light_for_its_spacing_is_refused() {
     };
     let error = shape
         .build_solver(&ClothPins::TopRow, &params(1e-9), Affine3A::IDENTITY)
-        .err()
-        .expect("refused");
+        .expect_err("refused");
     assert!(
         matches!(
             error,
