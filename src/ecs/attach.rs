@@ -140,24 +140,7 @@ fn choose_held(
     let x = solver.positions();
     let to_local = frame.affine().inverse();
     let here = |i: u32| (i, to_local.transform_point3(x[i as usize]));
-    // Particles the cloth does not have are left out, and said so (a cloth whose every
-    // attached index lay outside it fell without a word).
-    let kept = |held: Vec<(u32, Vec3)>, given: usize| {
-        if held.len() < given {
-            warn!(
-                "cloth {cloth}: {} of the attachment's {given} particles are not among its {} \
-                 (or their points are not finite) and are left out{}",
-                given - held.len(),
-                x.len(),
-                if held.is_empty() {
-                    "; it holds nothing"
-                } else {
-                    ""
-                }
-            );
-        }
-        held
-    };
+    let kept = |held: Vec<(u32, Vec3)>, given: usize| left_out(cloth, held, given, x.len());
     match particles {
         AttachParticles::At(points) => kept(
             points
@@ -194,6 +177,25 @@ fn choose_held(
             }
         },
     }
+}
+
+/// `held`, the particles of `given` that the cloth (of `count` particles) has: the others
+/// are left out, and said so (a cloth whose every attached index lay outside it fell
+/// without a word).
+fn left_out(cloth: Entity, held: Vec<(u32, Vec3)>, given: usize, count: usize) -> Vec<(u32, Vec3)> {
+    if held.len() < given {
+        let nothing = if held.is_empty() {
+            "; it holds nothing"
+        } else {
+            ""
+        };
+        warn!(
+            "cloth {cloth}: {} of the attachment's {given} particles are not among its {count} \
+             (or their points are not finite) and are left out{nothing}",
+            given - held.len(),
+        );
+    }
+    held
 }
 
 /// Attachments ([`ClothAttachments`]): particles held at points of other entities,

@@ -213,40 +213,46 @@ impl Plugin for ClothCorePlugin {
             );
         }
 
-        use ClothPrepareSystems as P;
-        app.configure_sets(
-            self.schedule,
-            (
-                ClothSystems::Prepare,
-                ClothSystems::Substeps,
-                ClothSystems::Finish,
-            )
-                .chain(),
-        )
-        .configure_sets(
-            self.schedule,
-            (
-                P::Levels,
-                P::Build,
-                P::Attach,
-                P::Skin,
-                P::Colliders,
-                P::Wake,
-                P::Begin,
-            )
-                .chain()
-                .in_set(ClothSystems::Prepare),
-        )
-        .add_systems(
-            self.schedule,
-            (
-                build_cloths.in_set(P::Build),
-                (recover_cloths, begin_steps).chain().in_set(P::Begin),
-                run_substeps.in_set(ClothSystems::Substeps),
-                finish_steps.in_set(ClothSystems::Finish),
-            ),
-        );
+        configure_sets(app, self.schedule);
     }
+}
+
+/// The core's system sets in `schedule` and its systems in them: Prepare (in the order of
+/// [`ClothPrepareSystems`]), Substeps, Finish.
+fn configure_sets(app: &mut App, schedule: Interned<dyn ScheduleLabel>) {
+    use ClothPrepareSystems as P;
+    app.configure_sets(
+        schedule,
+        (
+            ClothSystems::Prepare,
+            ClothSystems::Substeps,
+            ClothSystems::Finish,
+        )
+            .chain(),
+    )
+    .configure_sets(
+        schedule,
+        (
+            P::Levels,
+            P::Build,
+            P::Attach,
+            P::Skin,
+            P::Colliders,
+            P::Wake,
+            P::Begin,
+        )
+            .chain()
+            .in_set(ClothSystems::Prepare),
+    )
+    .add_systems(
+        schedule,
+        (
+            build_cloths.in_set(P::Build),
+            (recover_cloths, begin_steps).chain().in_set(P::Begin),
+            run_substeps.in_set(ClothSystems::Substeps),
+            finish_steps.in_set(ClothSystems::Finish),
+        ),
+    );
 }
 
 /// The schedule the cloths step in (the plugin's), for plugins that add to the step.

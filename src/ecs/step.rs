@@ -123,25 +123,7 @@ pub(crate) fn begin_steps(
     }
     plan.count = 0;
     plan.index = 0;
-    // Cloth–cloth contact: the cloths with self-collision on take each other's
-    // particles near them (a sleeping cloth's stay where they are). With one such cloth
-    // left it still runs, so a copy of a cloth since despawned or switched off is dropped.
-    let colliding = cloths
-        .iter()
-        .any(|(_, sim, ..)| sim.solver.params().self_collision.enabled);
-    if colliding {
-        let mut all: Vec<_> = cloths
-            .iter_mut()
-            .map(|(_, sim, _, sleep)| (sim, run && sleep.is_none_or(|s| !s.asleep)))
-            .collect();
-        let mut solvers: Vec<_> = all
-            .iter_mut()
-            .map(|(sim, moving)| (&mut sim.solver, *moving))
-            .collect();
-        solver::collide_cloths(&mut solvers);
-    }
-    // Cloths in contact with others begin together at one substep count, the rest alone
-    // (`solver::begin_cloths`, as the headless runner does); a sleeping cloth not at all.
+    // Which cloths step (not paused, not asleep).
     let mut all = Vec::new();
     for (entity, mut sim, progress, sleep) in &mut cloths {
         let steps = run && sleep.is_none_or(|s| !s.asleep);
@@ -153,6 +135,17 @@ pub(crate) fn begin_steps(
         .iter_mut()
         .map(|(_, sim, _, steps)| (&mut sim.solver, *steps))
         .collect();
+    // Cloth–cloth contact: the cloths with self-collision on take each other's
+    // particles near them (a sleeping cloth's stay where they are). With one such cloth
+    // left it still runs, so a copy of a cloth since despawned or switched off is dropped.
+    if solvers
+        .iter()
+        .any(|(s, _)| s.params().self_collision.enabled)
+    {
+        solver::collide_cloths(&mut solvers);
+    }
+    // Cloths in contact with others begin together at one substep count, the rest alone
+    // (`solver::begin_cloths`, as the headless runner does); a sleeping cloth not at all.
     solver::begin_cloths(&mut solvers, dt);
     for (entity, sim, progress, steps) in all {
         let substeps = if steps { sim.solver.substeps() } else { 0 };
