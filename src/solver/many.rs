@@ -70,9 +70,10 @@ pub fn run_cloths(cloths: &mut [&mut ClothSolver], env: &Environment) {
     });
 }
 
-/// Begins a step of `dt` for cloths in contact with one another ([`collide_cloths`]): each
-/// plans its step, and all take the most substeps any of them needs, so that they meet
-/// substep by substep at the same times ([`substep_together`]). Returns that count.
+/// Begins a step of `dt` for cloths in contact with one another
+/// ([`collide_cloths`](super::collide_cloths)): each plans its step, and all take the
+/// most substeps any of them needs, so that they meet substep by substep at the same
+/// times ([`substep_together`]). Returns that count.
 /// Three self-colliding cloths stacked on a cushion, each at its own count (64, 55 and
 /// 22), met at times that did not line up and jittered at 0.28 m/s when solved along
 /// lines (`assets/scenes/stack.ron`); at one count they come to rest.
