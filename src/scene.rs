@@ -193,7 +193,7 @@ impl ClothScene {
             .map(|entry| {
                 commands
                     .spawn((
-                        entry.collider,
+                        entry.collider.clone(),
                         entry.transform(),
                         Name::new(entry.name.clone()),
                     ))

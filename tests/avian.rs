@@ -142,7 +142,10 @@ fn a_particle_rests_on_avian_colliders_at_the_analytic_distance() {
     let points = vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
     let shape = Collider::convex_hull(points).unwrap();
     let hull_of = |c: bevy_cloth::solver::Collider| match c.shape {
-        bevy_cloth::solver::ColliderShape::Convex { hull, .. } => hull,
+        bevy_cloth::solver::ColliderShape::Convex(bevy_cloth::solver::shapes::Convex {
+            hull,
+            ..
+        }) => hull,
         other => panic!("{other:?}"),
     };
     let first = hull_of(to_solver_collider(&shape, &at(0.0, 0.0, 0.0), None, &mut hulls).unwrap());

@@ -457,7 +457,12 @@ fn a_capsule_spanning_two_joints_follows_them_and_keeps_the_cloth_out() {
         let Some(collider) = sim.solver.colliders().first() else {
             continue;
         };
-        let bevy_cloth::solver::ColliderShape::Capsule { a, b, radius: r } = collider.shape else {
+        let bevy_cloth::solver::ColliderShape::Capsule(bevy_cloth::solver::shapes::Capsule {
+            a,
+            b,
+            radius: r,
+        }) = collider.shape
+        else {
             panic!("a capsule: {:?}", collider.shape);
         };
         // The joints where this step put them.
@@ -588,7 +593,12 @@ fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
         };
         assert!(sim.solver.is_stable(), "frame {frame}");
         for collider in sim.solver.colliders() {
-            let bevy_cloth::solver::ColliderShape::Capsule { a, b, .. } = collider.shape else {
+            let bevy_cloth::solver::ColliderShape::Capsule(bevy_cloth::solver::shapes::Capsule {
+                a,
+                b,
+                ..
+            }) = collider.shape
+            else {
                 continue;
             };
             for &x in sim.solver.positions() {

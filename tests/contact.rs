@@ -21,10 +21,12 @@ fn collider(shape: ColliderShape) -> Collider {
 
 /// A 1 cm plate, 4 × 4 m, its top face at y = 0.
 fn plate() -> Collider {
-    collider(ColliderShape::cuboid(
-        Vec3::new(0.0, -0.005, 0.0),
-        Quat::IDENTITY,
-        Vec3::new(2.0, 0.005, 2.0),
+    collider(ColliderShape::from(
+        bevy_cloth::solver::shapes::Cuboid::new(
+            Vec3::new(0.0, -0.005, 0.0),
+            Quat::IDENTITY,
+            Vec3::new(2.0, 0.005, 2.0),
+        ),
     ))
 }
 
@@ -108,10 +110,12 @@ fn a_particle_spawned_inside_a_sphere_is_moved_out_without_being_launched() {
     // by the whole depth in one substep, its velocity used to be depth / h: 3.4 m/s here.
     for substeps in [1, 4] {
         let mut p = particle(Vec3::new(0.0, 0.15, 0.0), substeps);
-        p.set_colliders([collider(ColliderShape::Sphere {
-            center: Vec3::ZERO,
-            radius: 0.2,
-        })]);
+        p.set_colliders([collider(ColliderShape::Sphere(
+            bevy_cloth::solver::shapes::Sphere {
+                center: Vec3::ZERO,
+                radius: 0.2,
+            },
+        ))]);
         p.step(DT, &weightless());
         let x = p.positions()[0];
         let speed = p.particles().velocity[0].length();
@@ -133,16 +137,20 @@ fn a_particle_spawned_inside_a_sphere_is_moved_out_without_being_launched() {
 fn a_particle_in_a_crease_of_two_capsules_ends_outside_both_in_either_order() {
     // Two capsules (radius 0.1) crossing in a V; a particle dropped into the crease where
     // they meet, from each of a few starting points.
-    let a = collider(ColliderShape::Capsule {
-        a: Vec3::new(-0.5, 0.3, 0.0),
-        b: Vec3::new(0.05, 0.0, 0.0),
-        radius: 0.1,
-    });
-    let b = collider(ColliderShape::Capsule {
-        a: Vec3::new(0.5, 0.3, 0.0),
-        b: Vec3::new(-0.05, 0.0, 0.0),
-        radius: 0.1,
-    });
+    let a = collider(ColliderShape::Capsule(
+        bevy_cloth::solver::shapes::Capsule {
+            a: Vec3::new(-0.5, 0.3, 0.0),
+            b: Vec3::new(0.05, 0.0, 0.0),
+            radius: 0.1,
+        },
+    ));
+    let b = collider(ColliderShape::Capsule(
+        bevy_cloth::solver::shapes::Capsule {
+            a: Vec3::new(0.5, 0.3, 0.0),
+            b: Vec3::new(-0.05, 0.0, 0.0),
+            radius: 0.1,
+        },
+    ));
     for start in [
         Vec3::new(0.0, 0.5, 0.0),
         Vec3::new(0.02, 0.4, 0.01),
@@ -204,10 +212,10 @@ fn a_ball_fired_through_a_curtain_at_20_m_s_leaves_no_particle_inside_it() {
     let mut pushed = 0.0f32;
     for _ in 0..20 {
         let next = centre + Vec3::Z * speed * DT;
-        let mut ball = collider(ColliderShape::Sphere {
+        let mut ball = collider(ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
             center: next,
             radius,
-        });
+        }));
         ball.motion = Motion::between((Quat::IDENTITY, centre), (Quat::IDENTITY, next), DT);
         cloth.set_colliders([ball]);
         cloth.step(DT, &Environment::default());
@@ -235,11 +243,13 @@ fn a_cloth_dropped_across_a_rope_hangs_over_it() {
     let (radius, thickness) = (0.002, 0.005);
     let rope = Collider {
         thickness,
-        ..collider(ColliderShape::Capsule {
-            a: Vec3::new(0.0, 0.0, -1.0),
-            b: Vec3::new(0.0, 0.0, 1.0),
-            radius,
-        })
+        ..collider(ColliderShape::Capsule(
+            bevy_cloth::solver::shapes::Capsule {
+                a: Vec3::new(0.0, 0.0, -1.0),
+                b: Vec3::new(0.0, 0.0, 1.0),
+                radius,
+            },
+        ))
     };
     for (name, model) in [
         ("mass-spring", Model::MassSpring),
@@ -281,4 +291,52 @@ fn a_cloth_dropped_across_a_rope_hangs_over_it() {
         );
         assert!(cloth.is_stable(), "{name}");
     }
+}
+
+/// A shape registered by one file (the torus): a level cloth dropped through a ring
+/// drapes over it, every particle outside the tube, and the middle sags through the hole
+/// below the ring's top.
+#[test]
+fn a_cloth_dropped_onto_a_ring_drapes_over_it_with_no_particle_inside() {
+    let mut cloth = lying_cloth(Model::Xpbd(XpbdParams::default()), 8, 0.2);
+    let start = cloth.positions().to_vec();
+    let centre = start.iter().sum::<Vec3>() / start.len() as f32;
+    let middle = (0..start.len())
+        .min_by(|&i, &j| {
+            start[i]
+                .distance(centre)
+                .total_cmp(&start[j].distance(centre))
+        })
+        .unwrap();
+    let ring = bevy_cloth::solver::shapes::Torus {
+        center: Vec3::new(centre.x, 0.0, centre.z),
+        axis: Vec3::Y,
+        major_radius: 0.25,
+        minor_radius: 0.03,
+    };
+    cloth.set_colliders([collider(ring.into())]);
+    for _ in 0..90 {
+        cloth.step(DT, &Environment::default());
+    }
+    let tube = |x: Vec3| {
+        let d = x - ring.center;
+        let radial = Vec3::new(d.x, 0.0, d.z).length();
+        (radial - ring.major_radius).hypot(d.y) - ring.minor_radius
+    };
+    let deepest = cloth
+        .positions()
+        .iter()
+        .map(|&x| tube(x))
+        .fold(f32::MAX, f32::min);
+    let lowest = cloth
+        .positions()
+        .iter()
+        .map(|x| x.y)
+        .fold(f32::MAX, f32::min);
+    let middle = cloth.positions()[middle];
+    eprintln!("nearest the tube {deepest} m, lowest {lowest} m, middle {middle}");
+    assert!(deepest > 0.0, "a particle {deepest} m inside the tube");
+    // Held by the ring (not fallen through), the middle hanging inside the hole.
+    assert!(lowest > -0.6, "fell through: lowest at {lowest} m");
+    assert!(middle.y < 0.0, "the middle did not sag: {middle}");
 }

@@ -354,50 +354,54 @@ fn a_dropped_particle_comes_to_rest_on_a_sphere_a_capsule_a_box_and_a_plane() {
     let cases = [
         (
             "sphere",
-            collider(ColliderShape::Sphere {
+            collider(ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
                 center: Vec3::new(0.2, 1.0, -0.1),
                 radius: 0.3,
-            }),
+            })),
             Vec3::new(0.2, 2.0, -0.1),
             Vec3::new(0.2, 1.3 + thickness, -0.1),
         ),
         (
             "capsule",
-            collider(ColliderShape::Capsule {
-                a: Vec3::new(-0.5, 0.5, 0.0),
-                b: Vec3::new(0.5, 0.5, 0.0),
-                radius: 0.1,
-            }),
+            collider(ColliderShape::Capsule(
+                bevy_cloth::solver::shapes::Capsule {
+                    a: Vec3::new(-0.5, 0.5, 0.0),
+                    b: Vec3::new(0.5, 0.5, 0.0),
+                    radius: 0.1,
+                },
+            )),
             Vec3::new(0.1, 1.5, 0.0),
             Vec3::new(0.1, 0.6 + thickness, 0.0),
         ),
         (
             "capsule end cap",
-            collider(ColliderShape::Capsule {
-                a: Vec3::new(0.0, 0.0, 0.0),
-                b: Vec3::new(0.0, 0.5, 0.0),
-                radius: 0.1,
-            }),
+            collider(ColliderShape::Capsule(
+                bevy_cloth::solver::shapes::Capsule {
+                    a: Vec3::new(0.0, 0.0, 0.0),
+                    b: Vec3::new(0.0, 0.5, 0.0),
+                    radius: 0.1,
+                },
+            )),
             Vec3::new(0.0, 1.5, 0.0),
             Vec3::new(0.0, 0.6 + thickness, 0.0),
         ),
         (
             // An axis-aligned box: the particle rests on its top face.
             "box, top face",
-            collider(ColliderShape::Cuboid {
+            collider(ColliderShape::Cuboid(bevy_cloth::solver::shapes::Cuboid {
                 center: Vec3::new(0.0, 0.5, 0.0),
                 axes: [Vec3::X, Vec3::Y, Vec3::Z],
                 half_extents: Vec3::new(0.3, 0.2, 0.1),
-            }),
+            })),
             Vec3::new(0.1, 1.5, 0.05),
             Vec3::new(0.1, 0.7 + thickness, 0.05),
         ),
         (
             "plane",
-            collider(ColliderShape::Plane {
+            collider(ColliderShape::Plane(bevy_cloth::solver::shapes::Plane {
                 point: Vec3::new(0.0, 0.25, 0.0),
                 normal: Vec3::Y,
-            }),
+            })),
             Vec3::new(0.3, 1.0, 0.3),
             Vec3::new(0.3, 0.25 + thickness, 0.3),
         ),
@@ -426,11 +430,11 @@ fn a_particle_rests_on_a_turned_box_at_the_thickness_from_its_top_face() {
     let turn = bevy::math::Quat::from_rotation_z(20f32.to_radians());
     let axes = [turn * Vec3::X, turn * Vec3::Y, turn * Vec3::Z];
     let c = Collider {
-        shape: ColliderShape::Cuboid {
+        shape: ColliderShape::Cuboid(bevy_cloth::solver::shapes::Cuboid {
             center: Vec3::new(0.0, 0.5, 0.0),
             axes,
             half_extents: Vec3::new(0.4, 0.1, 0.2),
-        },
+        }),
         thickness: 0.01,
         friction: 0.5,
         motion: bevy_cloth::solver::Motion::NONE,
@@ -460,10 +464,10 @@ fn friction_holds_on_a_slope_below_its_angle_and_lets_go_above() {
     let theta = 20f32.to_radians();
     let normal = Vec3::new(-theta.sin(), theta.cos(), 0.0);
     let plane = |friction| Collider {
-        shape: ColliderShape::Plane {
+        shape: ColliderShape::Plane(bevy_cloth::solver::shapes::Plane {
             point: Vec3::ZERO,
             normal,
-        },
+        }),
         thickness: 0.0,
         friction,
         motion: bevy_cloth::solver::Motion::NONE,
@@ -748,11 +752,11 @@ fn friction_against_a_moving_box_carries_the_cloth_along() {
     // the world and the box slides away under it.
     let (dt, steps, speed) = (0.016, 62, 0.5);
     let box_at = |t: f32, motion| Collider {
-        shape: ColliderShape::Cuboid {
+        shape: ColliderShape::Cuboid(bevy_cloth::solver::shapes::Cuboid {
             center: Vec3::new(speed * t, 0.0, 0.0),
             axes: [Vec3::X, Vec3::Y, Vec3::Z],
             half_extents: Vec3::new(1.0, 0.1, 1.0),
-        },
+        }),
         thickness: 0.005,
         friction: 0.8,
         motion,
@@ -815,10 +819,10 @@ fn a_moving_ball_pushes_a_particle_at_its_own_speed() {
     for k in 1..=steps {
         let centre = Vec3::X * speed * k as f32 * dt;
         cloth.set_colliders([Collider {
-            shape: ColliderShape::Sphere {
+            shape: ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
                 center: centre,
                 radius: 0.2,
-            },
+            }),
             thickness: 0.005,
             friction: 0.3,
             motion: bevy_cloth::solver::Motion {
@@ -839,10 +843,10 @@ fn a_moving_ball_pushes_a_particle_at_its_own_speed() {
 /// A plane far below, for a particle that should meet nothing else.
 fn plane_far() -> Collider {
     Collider {
-        shape: ColliderShape::Plane {
+        shape: ColliderShape::Plane(bevy_cloth::solver::shapes::Plane {
             point: Vec3::new(0.0, -100.0, 0.0),
             normal: Vec3::Y,
-        },
+        }),
         thickness: 0.0,
         friction: 0.0,
         motion: bevy_cloth::solver::Motion::NONE,
@@ -856,12 +860,12 @@ fn a_turntable_carries_a_particle_round_and_a_cylinder_is_exact() {
     let omega = 1.0;
     // (A cylinder about its own axis is the same at every angle: only its motion turns.)
     let table = || Collider {
-        shape: ColliderShape::Cylinder {
+        shape: ColliderShape::Cylinder(bevy_cloth::solver::shapes::Cylinder {
             center: Vec3::ZERO,
             axis: Vec3::Y,
             half_height: 0.05,
             radius: 0.5,
-        },
+        }),
         thickness: 0.005,
         friction: 1.0,
         motion: bevy_cloth::solver::Motion {
@@ -992,10 +996,10 @@ fn a_resting_particle_gives_the_ground_its_weight_as_impulse() {
     // weight's impulse, m g dt downwards, and its moment about the origin, x × (−m g dt ŷ).
     let start = Vec3::new(1.0, 0.02, 0.5);
     let ground = Collider {
-        shape: ColliderShape::Plane {
+        shape: ColliderShape::Plane(bevy_cloth::solver::shapes::Plane {
             point: Vec3::ZERO,
             normal: Vec3::Y,
-        },
+        }),
         thickness: 0.005,
         friction: 0.5,
         motion: bevy_cloth::solver::Motion::NONE,
@@ -1055,21 +1059,21 @@ fn a_convex_hull_is_exact_the_box_hull_matches_the_box_everywhere() {
     let rotation = bevy::math::Quat::from_euler(bevy::math::EulerRot::YXZ, 0.4, -0.3, 0.2);
     let center = Vec3::new(0.5, 1.0, -0.2);
     let hull = Collider {
-        shape: ColliderShape::Convex {
+        shape: ColliderShape::Convex(bevy_cloth::solver::shapes::Convex {
             center,
             rotation,
             hull: std::sync::Arc::new(box_hull(h)),
-        },
+        }),
         thickness: 0.005,
         friction: 0.5,
         motion: bevy_cloth::solver::Motion::NONE,
     };
     let cuboid = Collider {
-        shape: ColliderShape::Cuboid {
+        shape: ColliderShape::Cuboid(bevy_cloth::solver::shapes::Cuboid {
             center,
             axes: [rotation * Vec3::X, rotation * Vec3::Y, rotation * Vec3::Z],
             half_extents: h,
-        },
+        }),
         ..hull.clone()
     };
     let mut seed = 7u64;

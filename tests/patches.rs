@@ -599,10 +599,10 @@ fn part_centres_meet_the_colliders() {
         flat,
     );
     c.set_colliders([Collider {
-        shape: ColliderShape::Plane {
+        shape: ColliderShape::Plane(bevy_cloth::solver::shapes::Plane {
             point: Vec3::ZERO,
             normal: Vec3::Y,
-        },
+        }),
         thickness: 0.01,
         friction: 0.5,
         motion: bevy_cloth::solver::Motion::NONE,

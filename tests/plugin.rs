@@ -541,7 +541,7 @@ fn collider_entities_keep_cloth_out_and_follow_their_transform() {
     assert_eq!(colliders.len(), 2);
     assert!(colliders.iter().any(|c| matches!(
         c.shape,
-        bevy_cloth::solver::ColliderShape::Sphere { center, radius }
+        bevy_cloth::solver::ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere { center, radius })
             if center.distance(centre) < 1e-6 && radius == 0.15
     )));
     // Moving the entity moves the collider.
@@ -554,7 +554,7 @@ fn collider_entities_keep_cloth_out_and_follow_their_transform() {
     let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
     assert!(sim.solver.colliders().iter().any(|c| matches!(
         c.shape,
-        bevy_cloth::solver::ColliderShape::Sphere { center, .. }
+        bevy_cloth::solver::ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere { center, .. })
             if center.distance(Vec3::new(1.0, 0.5, 0.0)) < 1e-6
     )));
 }
@@ -1061,7 +1061,10 @@ fn colliders_take_the_sizes_of_bevys_primitives() {
 fn planes_and_half_spaces_convert_with_their_normals_and_offsets() {
     let identity = GlobalTransform::IDENTITY;
     let plane = |c: ClothCollider| match c.to_world(&identity).shape {
-        bevy_cloth::solver::ColliderShape::Plane { point, normal } => (point, normal),
+        bevy_cloth::solver::ColliderShape::Plane(bevy_cloth::solver::shapes::Plane {
+            point,
+            normal,
+        }) => (point, normal),
         other => panic!("not a plane: {other:?}"),
     };
     // Bevy's infinite plane: the solid behind it, like avian's `Collider::half_space`.
@@ -1092,6 +1095,35 @@ fn planes_and_half_spaces_convert_with_their_normals_and_offsets() {
         ron::from_str::<ClothCollider>("(thickness: 0.01)").is_err(),
         "no shape"
     );
+}
+
+/// A solver shape of its own file (the torus) is a component like the built-in kinds:
+/// placed by its entity's transform, checked by its own sizes.
+#[test]
+fn a_torus_collider_is_placed_by_its_transform_and_checked() {
+    use bevy_cloth::solver::shapes::Torus;
+    let ring = Torus {
+        center: Vec3::ZERO,
+        axis: Vec3::Y,
+        major_radius: 0.3,
+        minor_radius: 0.02,
+    };
+    let transform = Transform::from_xyz(0.0, 1.0, 2.0)
+        .with_rotation(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2))
+        .with_scale(Vec3::splat(2.0));
+    let world = ClothCollider::from_shape(ring).to_world(&GlobalTransform::from(transform));
+    let bevy_cloth::solver::ColliderShape::Torus(placed) = world.shape else {
+        panic!("{:?}", world.shape)
+    };
+    assert!((placed.center - Vec3::new(0.0, 1.0, 2.0)).length() < 1e-6);
+    assert!((placed.axis - Vec3::Z).length() < 1e-6, "{}", placed.axis);
+    assert!((placed.major_radius - 0.6).abs() < 1e-6 && (placed.minor_radius - 0.04).abs() < 1e-6);
+    let thin = Torus {
+        minor_radius: -0.01,
+        ..ring
+    };
+    let refused = ClothCollider::from_shape(thin).validate().unwrap_err();
+    assert!(refused.to_string().contains("minor_radius"), "{refused}");
 }
 
 /// `value` is registered (with `ReflectComponent` when `component`) and comes back equal

@@ -244,11 +244,11 @@ fn a_box_collider_reads_from_a_scene_and_scales_with_its_transform() {
         .to_world(&GlobalTransform::from(transform))
         .shape
     {
-        bevy_cloth::solver::ColliderShape::Cuboid {
+        bevy_cloth::solver::ColliderShape::Cuboid(bevy_cloth::solver::shapes::Cuboid {
             center,
             half_extents,
             ..
-        } => {
+        }) => {
             assert_eq!(center, Vec3::new(1.0, 0.0, 0.0));
             assert_eq!(half_extents, Vec3::new(0.2, 0.2, 0.3));
         }
@@ -273,12 +273,12 @@ fn a_box_collider_reads_from_a_scene_and_scales_with_its_transform() {
         .to_world(&GlobalTransform::from(transform))
         .shape
     {
-        bevy_cloth::solver::ColliderShape::Cylinder {
+        bevy_cloth::solver::ColliderShape::Cylinder(bevy_cloth::solver::shapes::Cylinder {
             half_height,
             radius,
             axis,
             ..
-        } => {
+        }) => {
             assert_eq!((half_height, radius, axis), (0.2, 0.2, Vec3::Y));
         }
         other => panic!("{other:?}"),

@@ -198,7 +198,7 @@ pub fn spawn_scene(
     commands.insert_resource(Time::<Fixed>::from_seconds(f64::from(scene.timestep)));
     for (entry, entity) in scene.colliders.iter().zip(spawned.colliders) {
         if let Some([r, g, b]) = entry.color {
-            let mesh = match entry.collider.shape {
+            let mesh = match entry.collider.shape.clone() {
                 ColliderKind::Sphere { radius } => Sphere::new(radius).mesh().build(),
                 ColliderKind::Capsule {
                     radius,
@@ -219,6 +219,8 @@ pub fn spawn_scene(
                         .build()
                         .translated_by(*normal * distance)
                 }
+                // A scene file names only the kinds above.
+                ColliderKind::Shape(_) => continue,
             };
             commands.entity(entity).insert((
                 Mesh3d(meshes.add(mesh)),

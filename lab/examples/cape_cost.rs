@@ -91,11 +91,11 @@ fn run(solve: XpbdSolve, substeps: Substeps) -> Run {
         }
         let up = now.0 * Vec3::Y * HALF_LENGTH;
         cloth.set_colliders([Collider {
-            shape: ColliderShape::Capsule {
+            shape: ColliderShape::Capsule(bevy_cloth::solver::shapes::Capsule {
                 a: now.1 - up,
                 b: now.1 + up,
                 radius: RADIUS,
-            },
+            }),
             thickness: 0.01,
             friction: 0.3,
             motion: Motion::between(before, now, DT),

@@ -337,7 +337,11 @@ pub fn ledge(
     // lid `2·thickness` above the ledge, so the strip behind the edge lies flat between
     // them (without it, it lifts off behind the edge and the overhang is no clamp).
     let block = |y: f32| Collider {
-        shape: ColliderShape::cuboid(Vec3::new(-0.5, y, 0.0), Quat::IDENTITY, Vec3::splat(0.5)),
+        shape: ColliderShape::from(bevy_cloth::solver::shapes::Cuboid::new(
+            Vec3::new(-0.5, y, 0.0),
+            Quat::IDENTITY,
+            Vec3::splat(0.5),
+        )),
         thickness,
         friction: 0.1,
         motion: Motion::NONE,

@@ -26,7 +26,8 @@ use crate::ecs::cloth::{ClothEnvironment, ClothInvalid, ClothSimulation, Layers}
 use crate::ecs::colliders::{ClothCollider, PlacedColliders, give_colliders, place_colliders};
 use crate::ecs::plugin::{ClothSchedule, ClothSystems};
 use crate::ecs::step::{StepProgress, finish_steps};
-use crate::solver::{self, ColliderShape, ConvexHull};
+use crate::solver::shapes::{Capsule, Convex, Cuboid, Cylinder, Plane, Sphere};
+use crate::solver::{self, ColliderShape, ConvexHull, Placement, Shape};
 
 /// Cloth with avian3d bodies. Add it after `ClothPlugin` (and with avian's
 /// `PhysicsPlugins`, in the schedule avian steps in, `FixedPostUpdate` by default):
@@ -212,50 +213,9 @@ pub fn to_solver_collider(
     friction: Option<&Friction>,
     hulls: &mut HullCache,
 ) -> Option<solver::Collider> {
-    let shape = collider.shape_scaled();
-    let (rotation, translation) = {
-        let (_, r, t) = transform.to_scale_rotation_translation();
-        (r, t)
-    };
-    let place = |p: Vec3| translation + rotation * p;
-    let shape = if let Some(ball) = shape.as_ball() {
-        ColliderShape::Sphere {
-            center: translation,
-            radius: ball.radius,
-        }
-    } else if let Some(capsule) = shape.as_capsule() {
-        ColliderShape::Capsule {
-            a: place(capsule.segment.a),
-            b: place(capsule.segment.b),
-            radius: capsule.radius,
-        }
-    } else if let Some(cuboid) = shape.as_cuboid() {
-        ColliderShape::cuboid(translation, rotation, cuboid.half_extents)
-    } else if let Some(cylinder) = shape.as_cylinder() {
-        ColliderShape::Cylinder {
-            center: translation,
-            axis: rotation * Vec3::Y,
-            half_height: cylinder.half_height,
-            radius: cylinder.radius,
-        }
-    } else if let Some(polyhedron) = shape.as_convex_polyhedron() {
-        // The shape's own allocation names it (avian keeps a scaled shape until the scale
-        // changes).
-        let key = Arc::as_ptr(&shape.0) as *const () as usize;
-        let hull = hulls.get_or_make(key, polyhedron)?;
-        ColliderShape::Convex {
-            center: translation,
-            rotation,
-            hull,
-        }
-    } else if let Some(half_space) = shape.as_halfspace() {
-        ColliderShape::Plane {
-            point: translation,
-            normal: rotation * half_space.normal,
-        }
-    } else {
-        return None;
-    };
+    let shape = local_shape(collider, hulls)?;
+    let (_, rotation, translation) = transform.to_scale_rotation_translation();
+    let shape = shape.placed(&Placement::about(Vec3::ZERO, rotation, translation));
     Some(solver::Collider {
         shape,
         thickness: THICKNESS,
@@ -263,6 +223,56 @@ pub fn to_solver_collider(
         motion: solver::Motion::NONE,
     })
 }
+/// An avian collider's solid in its own frame, scaled: `None` for a shape the cloth does
+/// not collide with.
+fn local_shape(collider: &Collider, hulls: &mut HullCache) -> Option<ColliderShape> {
+    let shape = collider.shape_scaled();
+    let local = if let Some(ball) = shape.as_ball() {
+        Sphere {
+            center: Vec3::ZERO,
+            radius: ball.radius,
+        }
+        .into()
+    } else if let Some(capsule) = shape.as_capsule() {
+        Capsule {
+            a: capsule.segment.a,
+            b: capsule.segment.b,
+            radius: capsule.radius,
+        }
+        .into()
+    } else if let Some(cuboid) = shape.as_cuboid() {
+        Cuboid::new(Vec3::ZERO, Quat::IDENTITY, cuboid.half_extents).into()
+    } else if let Some(cylinder) = shape.as_cylinder() {
+        Cylinder {
+            center: Vec3::ZERO,
+            axis: Vec3::Y,
+            half_height: cylinder.half_height,
+            radius: cylinder.radius,
+        }
+        .into()
+    } else if let Some(polyhedron) = shape.as_convex_polyhedron() {
+        // The shape's own allocation names it (avian keeps a scaled shape until the scale
+        // changes).
+        let key = Arc::as_ptr(&shape.0) as *const () as usize;
+        let hull = hulls.get_or_make(key, polyhedron)?;
+        Convex {
+            center: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            hull,
+        }
+        .into()
+    } else if let Some(half_space) = shape.as_halfspace() {
+        Plane {
+            point: Vec3::ZERO,
+            normal: half_space.normal,
+        }
+        .into()
+    } else {
+        return None;
+    };
+    Some(local)
+}
+
 /// The cloth pushes back: every cloth that stepped gives each avian
 /// dynamic body among its colliders the impulse of its particles' contacts with it
 /// ([`solver::ClothSolver::collider_impulses`]), so a ball dropped on a hammock is held.

@@ -20,7 +20,7 @@ use crate::solver;
 /// world.spawn((ClothCollider::sphere(0.3), Transform::from_xyz(0.0, 1.0, 0.0)));
 /// world.spawn(ClothCollider::plane().with_friction(0.8)); // the ground, y = 0
 /// ```
-#[derive(Component, Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[derive(Component, Clone, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 #[reflect(Component, Debug, PartialEq)]
 #[require(Transform)]
 #[serde(deny_unknown_fields)]
@@ -38,7 +38,7 @@ pub struct ClothCollider {
 
 /// The solid of a [`ClothCollider`], in its entity's local frame (the same conventions as
 /// Bevy's `Sphere`, `Capsule3d` and `Plane3d` meshes).
-#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 pub enum ColliderKind {
     /// A ball about the origin.
     Sphere {
@@ -79,9 +79,62 @@ pub enum ColliderKind {
         /// The plane's distance from the origin along `normal`, m.
         distance: f32,
     },
+    /// Any of the solver's [shapes](crate::solver::shapes) (a torus, a convex hull, one of
+    /// your own), in the local frame; built in code only (a scene file names the kinds
+    /// above).
+    #[serde(skip)]
+    Shape(solver::ColliderShape),
 }
 
 impl ColliderKind {
+    /// The solid in the local frame, as a solver shape (negative sizes count as 0).
+    pub fn local(&self) -> solver::ColliderShape {
+        use solver::shapes::{Capsule, Cuboid, Cylinder, Plane, Sphere};
+        match *self {
+            ColliderKind::Sphere { radius } => Sphere {
+                center: Vec3::ZERO,
+                radius: radius.max(0.0),
+            }
+            .into(),
+            ColliderKind::Capsule {
+                radius,
+                half_length,
+            } => Capsule {
+                a: Vec3::new(0.0, -half_length.max(0.0), 0.0),
+                b: Vec3::new(0.0, half_length.max(0.0), 0.0),
+                radius: radius.max(0.0),
+            }
+            .into(),
+            ColliderKind::Cuboid { half_extents } => {
+                Cuboid::new(Vec3::ZERO, Quat::IDENTITY, half_extents.max(Vec3::ZERO)).into()
+            }
+            ColliderKind::Cylinder {
+                radius,
+                half_height,
+            } => Cylinder {
+                center: Vec3::ZERO,
+                axis: Vec3::Y,
+                half_height: half_height.max(0.0),
+                radius: radius.max(0.0),
+            }
+            .into(),
+            ColliderKind::Plane => Plane {
+                point: Vec3::ZERO,
+                normal: Vec3::Y,
+            }
+            .into(),
+            ColliderKind::HalfSpace { normal, distance } => {
+                let normal = normal.normalize_or(Vec3::Y);
+                Plane {
+                    point: normal * distance,
+                    normal,
+                }
+                .into()
+            }
+            ColliderKind::Shape(ref shape) => shape.clone(),
+        }
+    }
+
     /// Checks the sizes: radii and half-extents > 0, half-lengths ≥ 0, a half-space's
     /// normal non-zero, each within [`crate::limits::MAX_POSITION`].
     pub fn validate(&self) -> Result<(), ClothError> {
@@ -127,6 +180,7 @@ impl ColliderKind {
                 )?;
             }
             ColliderKind::Plane => {}
+            ColliderKind::Shape(ref shape) => solver::Shape::validate(shape)?,
             ColliderKind::HalfSpace { normal, distance } => {
                 let length = normal.length();
                 crate::params::check(
@@ -264,6 +318,21 @@ impl ClothCollider {
         Self::new(ColliderKind::HalfSpace { normal, distance })
     }
 
+    /// Any of the solver's [shapes](crate::solver::shapes), in the entity's local frame
+    /// (a torus, a convex hull, a shape of your own registered there).
+    ///
+    /// ```
+    /// use bevy::prelude::*;
+    /// use bevy_cloth::prelude::*;
+    /// use bevy_cloth::solver::shapes::Torus;
+    /// # let mut world = World::new();
+    /// let ring = Torus { center: Vec3::ZERO, axis: Vec3::Y, major_radius: 0.3, minor_radius: 0.02 };
+    /// world.spawn((ClothCollider::from_shape(ring), Transform::from_xyz(0.0, 1.0, 0.0)));
+    /// ```
+    pub fn from_shape(shape: impl Into<solver::ColliderShape>) -> Self {
+        Self::new(ColliderKind::Shape(shape.into()))
+    }
+
     fn default_thickness() -> f32 {
         Self::THICKNESS
     }
@@ -302,57 +371,14 @@ impl ClothCollider {
         )
     }
 
-    /// The collider in world space under `transform` (radii scale with the largest scale
-    /// factor). Negative sizes count as 0.
+    /// The collider in world space under `transform`: its [`ColliderKind::local`] shape
+    /// placed by it ([`Shape::placed`](solver::Shape::placed): radii scale with the
+    /// largest scale factor across their axis, lengths along theirs).
     pub fn to_world(&self, transform: &GlobalTransform) -> solver::Collider {
-        use solver::ColliderShape;
-        let scale = transform.scale().abs().max_element();
-        let shape = match self.shape {
-            ColliderKind::Sphere { radius } => ColliderShape::Sphere {
-                center: transform.translation(),
-                radius: radius.max(0.0) * scale,
-            },
-            ColliderKind::Capsule {
-                radius,
-                half_length,
-            } => ColliderShape::Capsule {
-                a: transform.transform_point(Vec3::new(0.0, -half_length.max(0.0), 0.0)),
-                b: transform.transform_point(Vec3::new(0.0, half_length.max(0.0), 0.0)),
-                radius: radius.max(0.0) * scale,
-            },
-            ColliderKind::Cuboid { half_extents } => ColliderShape::cuboid(
-                transform.translation(),
-                transform.rotation(),
-                half_extents.max(Vec3::ZERO) * transform.scale().abs(),
-            ),
-            ColliderKind::Cylinder {
-                radius,
-                half_height,
-            } => {
-                // Its height scales with y, its radius with the larger of x and z.
-                let s = transform.scale().abs();
-                ColliderShape::Cylinder {
-                    center: transform.translation(),
-                    axis: transform.rotation() * Vec3::Y,
-                    half_height: half_height.max(0.0) * s.y,
-                    radius: radius.max(0.0) * s.x.max(s.z),
-                }
-            }
-            ColliderKind::Plane => ColliderShape::Plane {
-                point: transform.translation(),
-                normal: transform.rotation() * Vec3::Y,
-            },
-            // The plane turns with the entity; scale moves its point, not its normal.
-            ColliderKind::HalfSpace { normal, distance } => {
-                let normal = normal.normalize_or(Vec3::Y);
-                ColliderShape::Plane {
-                    point: transform.transform_point(normal * distance),
-                    normal: transform.rotation() * normal,
-                }
-            }
-        };
+        use solver::Shape;
+        let placement = solver::Placement::affine(transform.affine());
         solver::Collider {
-            shape,
+            shape: self.shape.local().placed(&placement),
             thickness: self.thickness.max(0.0),
             friction: self.friction.max(0.0),
             motion: solver::Motion::NONE,
@@ -491,7 +517,7 @@ pub(crate) fn place_colliders(
         let Some(transform) = transform else {
             continue;
         };
-        let mut collider = *collider;
+        let mut collider = collider.clone();
         if let (Some(_), ColliderKind::Capsule { half_length, .. }) = (span, &mut collider.shape) {
             *half_length = 0.5 * transform.scale().y;
         }

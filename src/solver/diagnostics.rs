@@ -99,7 +99,7 @@ impl ClothSolver {
     /// The centre and radius of a sphere around every particle (the centre of their
     /// bounding box and its half diagonal), for level of detail.
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        super::collide::Bounds::around(&self.particles.position).sphere()
+        super::contact::Bounds::around(&self.particles.position).sphere()
     }
 
     /// The largest speed of a free particle, m/s (0 for none): what a sleeping cloth's

@@ -11,7 +11,6 @@ mod bending;
 mod build;
 mod chains;
 mod clock;
-mod collide;
 mod contact;
 mod diagnostics;
 mod drivers;
@@ -35,7 +34,8 @@ mod tethers;
 pub mod topology;
 mod xpbd;
 
-pub use collide::{Collider, ColliderImpulse, ColliderShape, ConvexHull, Motion};
+pub use contact::shapes::{self, ColliderShape, ConvexHull, Placement, Shape};
+pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};
 pub use interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};

@@ -163,7 +163,7 @@ impl ClothSolver {
     /// limit overshot by 2.4 points in its first gust, `tests/fabric.rs`).
     pub(super) fn xpbd_substeps(&self, dt: f32, target: f32) -> u32 {
         const G: f32 = 9.81;
-        let size = super::collide::Bounds::around(&self.structure.local_rest).size();
+        let size = super::contact::Bounds::around(&self.structure.local_rest).size();
         let l = self.structure.length_scale.max(f32::EPSILON);
         let lines = matches!(self.params.model, Model::Xpbd(x) if x.solve == XpbdSolve::Lines);
         let across = size.max_element().max(l) / l;

@@ -259,7 +259,7 @@ impl ClothSolver {
         self.structure.torn_this_step.clear();
         self.contact
             .collider_impulses
-            .fill(super::collide::ColliderImpulse::default());
+            .fill(super::contact::ColliderImpulse::default());
         self.report.substeps = n;
         self.report.under_resolved = self.clock.under_resolved;
         self.report.time.begin += start.elapsed();

@@ -1,10 +1,17 @@
-//! The contact stage: particles kept out of the colliders (shapes and distances in
-//! `collide.rs`), with Coulomb friction against the surface's own motion, and the
-//! reaction each collider takes.
+//! Contact: the colliders ([`Collider`], each a solid of [`shapes`] with a thickness,
+//! friction and motion) and the contact stage, which keeps the particles out of them with
+//! Coulomb friction against the surface's own motion and sums the reaction each collider
+//! takes.
 
 use bevy::math::{Quat, Vec3};
 
-use super::collide::{Bounds, Collider, ColliderImpulse, ColliderShape};
+mod collider;
+pub mod shapes;
+
+pub(crate) use collider::Bounds;
+pub use collider::{Collider, ColliderImpulse, Motion};
+use shapes::Shape;
+
 use super::{ClothSolver, Particles, SpringKind, Springs};
 
 /// The colliders a cloth meets and the scratch of its contact stage.
@@ -217,23 +224,10 @@ impl Contact {
 /// The springs the edge pass keeps out of thin colliders.
 const EDGES: [SpringKind; 2] = [SpringKind::Structural, SpringKind::Shear];
 
-/// A capsule's or cylinder's axis and its reach (radius plus thickness), or `None` for
-/// another shape.
+/// A thin solid's axis (a capsule's, a cylinder's: [`Shape::axis`]) and its reach
+/// (radius plus thickness), or `None` for another shape.
 fn axis(c: &Collider) -> Option<(Vec3, Vec3, f32)> {
-    let (a, b, radius) = match c.shape {
-        ColliderShape::Capsule { a, b, radius } => (a, b, radius),
-        ColliderShape::Cylinder {
-            center,
-            axis,
-            half_height,
-            radius,
-        } => (
-            center - axis * half_height,
-            center + axis * half_height,
-            radius,
-        ),
-        _ => return None,
-    };
+    let (a, b, radius) = c.shape.axis()?;
     Some((a, b, radius + c.thickness))
 }
 
