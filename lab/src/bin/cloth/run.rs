@@ -1,0 +1,235 @@
+//! `cloth run`: a scene headless, a JSON summary, positions dumped on request.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::Args;
+
+use crate::args::*;
+use bevy_cloth::params::ModelKind;
+use bevy_cloth::prelude::*;
+use bevy_cloth::solver;
+use bevy_cloth_lab::SceneRun;
+
+#[derive(Args)]
+pub(crate) struct RunArgs {
+    /// The scene file (RON).
+    pub(crate) scene: String,
+    /// Steps to run (at most 10,000,000; streamed, nothing is allocated per step).
+    #[arg(long, default_value_t = 300, value_parser = steps)]
+    pub(crate) steps: usize,
+    /// Replaces every cloth's model: mass-spring, shape-matching, patches or xpbd.
+    #[arg(long, value_parser = model_kind)]
+    pub(crate) model: Option<ModelKind>,
+    /// Overrides a scene field, e.g. `environment.wind.strength=0` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    pub(crate) set: Vec<String>,
+    /// Writes positions to FILE.json, FILE.csv or FILE_<step>.obj.
+    #[arg(long, value_name = "FILE", value_parser = dump_path)]
+    pub(crate) dump: Option<PathBuf>,
+    /// Dumps every K steps.
+    #[arg(long, value_name = "K", default_value_t = 10, value_parser = at_least_one)]
+    pub(crate) every: usize,
+    /// Keeps every kernel on one thread (the results are the same bits; for comparing).
+    #[arg(long = "one-thread")]
+    pub(crate) one_thread: bool,
+}
+
+pub(crate) fn run(args: RunArgs) -> Result<(), String> {
+    bevy_cloth::solver::set_parallel(!args.one_thread);
+    let scene_path = &args.scene;
+    let mut scene = ClothScene::load(scene_path).map_err(|e| e.to_string())?;
+    if let Some(model) = args.model {
+        // `{model:?}` is the variant's name in a scene file (`MassSpring`, …).
+        scene
+            .apply_override(&format!("cloth.params.model={model:?}"))
+            .map_err(|e| e.to_string())?;
+    }
+    for spec in &args.set {
+        scene.apply_override(spec).map_err(|e| e.to_string())?;
+    }
+    if scene.cloths.is_empty() {
+        return Err(format!(
+            "{scene_path}: the scene has no cloths: nothing to run"
+        ));
+    }
+    let (steps, every, timestep) = (args.steps, args.every, scene.timestep);
+    // The solver's clock (its substeps' sum); a scene with no cloths has only the steps.
+    let clock = |step: usize, cloths: &[(String, solver::ClothSolver)]| {
+        cloths
+            .first()
+            .map_or(step as f32 * timestep, |(_, cloth)| cloth.time())
+    };
+    let mut run = SceneRun::new(&scene).map_err(|e| format!("{scene_path}: {e}"))?;
+    let mut dump = match &args.dump {
+        Some(path) => Some(Dump::new(path)?),
+        None => None,
+    };
+    if let Some(d) = &mut dump {
+        d.frame(0, 0.0, &run.cloths)?;
+    }
+    let mut dump_error = None;
+    let summary = run.run(steps, |step, cloths| {
+        if let Some(d) = &mut dump
+            && step % every == 0
+            && dump_error.is_none()
+            && let Err(e) = d.frame(step, clock(step, cloths), cloths)
+        {
+            dump_error = Some(e);
+        }
+    });
+    if let Some(e) = dump_error {
+        return Err(e);
+    }
+    if let Some(d) = dump {
+        d.finish()?;
+    }
+    for cloth in summary.cloths.iter().filter(|c| c.under_resolved) {
+        eprintln!(
+            "warning: `{}` needed more automatic substeps than its cap (substeps.max, or \
+             limits::MAX_WORK_PER_STEP for its {} particles), or more strain-limiter sweeps \
+             than a step's budget (limits::limiter_budget): it ran at {} substeps and may be \
+             unstable or inaccurate",
+            cloth.name, cloth.particles, cloth.substeps
+        );
+    }
+    let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
+    println!("{json}");
+    Ok(())
+}
+
+/// Particle positions every K steps: JSON (one document), CSV (one row per particle) or
+/// OBJ (one file per frame, `NAME_000010.obj`, with the cloth's triangles).
+pub(crate) struct Dump {
+    path: PathBuf,
+    kind: DumpKind,
+    out: Option<std::io::BufWriter<std::fs::File>>,
+    frames: usize,
+}
+
+#[derive(PartialEq)]
+enum DumpKind {
+    Json,
+    Csv,
+    Obj,
+}
+
+impl DumpKind {
+    /// The kind a dump file's extension asks for.
+    fn of(path: &Path) -> Result<Self, String> {
+        match path.extension().and_then(|e| e.to_str()) {
+            Some("json") => Ok(DumpKind::Json),
+            Some("csv") => Ok(DumpKind::Csv),
+            Some("obj") => Ok(DumpKind::Obj),
+            _ => Err(format!(
+                "--dump {}: the file must end in .json, .csv or .obj",
+                path.display()
+            )),
+        }
+    }
+}
+
+impl Dump {
+    fn new(path: &Path) -> Result<Self, String> {
+        let kind = DumpKind::of(path)?;
+        let mut dump = Dump {
+            path: path.to_path_buf(),
+            kind,
+            out: None,
+            frames: 0,
+        };
+        if dump.kind != DumpKind::Obj {
+            dump.out = Some(dump.create(path)?);
+            let header = match dump.kind {
+                DumpKind::Csv => "step,time,cloth,particle,x,y,z\n",
+                _ => "{\"frames\":[\n",
+            };
+            dump.write(header)?;
+        }
+        Ok(dump)
+    }
+
+    fn create(&self, path: &Path) -> Result<std::io::BufWriter<std::fs::File>, String> {
+        std::fs::File::create(path)
+            .map(std::io::BufWriter::new)
+            .map_err(|e| format!("--dump {}: {e}", path.display()))
+    }
+
+    fn write(&mut self, text: &str) -> Result<(), String> {
+        let path = self.path.display().to_string();
+        self.out
+            .as_mut()
+            .expect("open")
+            .write_all(text.as_bytes())
+            .map_err(|e| format!("--dump {path}: {e}"))
+    }
+
+    fn frame(
+        &mut self,
+        step: usize,
+        time: f32,
+        cloths: &[(String, solver::ClothSolver)],
+    ) -> Result<(), String> {
+        let mut text = String::new();
+        match self.kind {
+            DumpKind::Csv => {
+                for (c, (_, cloth)) in cloths.iter().enumerate() {
+                    for (i, p) in cloth.positions().iter().enumerate() {
+                        text += &format!("{step},{time},{c},{i},{},{},{}\n", p.x, p.y, p.z);
+                    }
+                }
+                self.write(&text)
+            }
+            DumpKind::Json => {
+                let positions: Vec<Vec<[f32; 3]>> = cloths
+                    .iter()
+                    .map(|(_, c)| c.positions().iter().map(|p| p.to_array()).collect())
+                    .collect();
+                let frame = serde_json::json!({ "step": step, "time": time, "cloths": positions });
+                let separator = if self.frames == 0 { "" } else { ",\n" };
+                self.frames += 1;
+                self.write(&format!("{separator}{frame}"))
+            }
+            DumpKind::Obj => {
+                let stem = self.path.with_extension("");
+                let path = PathBuf::from(format!("{}_{step:06}.obj", stem.display()));
+                let mut base = 1;
+                for (name, cloth) in cloths {
+                    text += &format!("o {name}\n");
+                    for p in cloth.positions() {
+                        text += &format!("v {} {} {}\n", p.x, p.y, p.z);
+                    }
+                    for (t, visible) in cloth.triangles().iter().zip(cloth.triangle_visible()) {
+                        if *visible {
+                            text += &format!(
+                                "f {} {} {}\n",
+                                t[0] as usize + base,
+                                t[1] as usize + base,
+                                t[2] as usize + base
+                            );
+                        }
+                    }
+                    base += cloth.particle_count();
+                }
+                std::fs::write(&path, text).map_err(|e| format!("--dump {}: {e}", path.display()))
+            }
+        }
+    }
+
+    fn finish(mut self) -> Result<(), String> {
+        if self.kind == DumpKind::Json {
+            self.write("\n]}\n")?;
+        }
+        if let Some(out) = self.out.as_mut() {
+            out.flush()
+                .map_err(|e| format!("--dump {}: {e}", self.path.display()))?;
+        }
+        Ok(())
+    }
+}
+
+fn dump_path(text: &str) -> Result<PathBuf, String> {
+    let path = PathBuf::from(text);
+    DumpKind::of(&path)?;
+    Ok(path)
+}
