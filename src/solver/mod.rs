@@ -2,44 +2,44 @@
 //! benches all call the same [`ClothSolver::step`], so what is measured is what runs in a game.
 //!
 //! A step is a pipeline of stages (`steps/mod.rs` describes it; one file per model under
-//! `steps/`). A cloth's state is kept by concern: its particles ([`Particles`]), what it
-//! is made of (`structure.rs`), what holds it from outside (`drivers.rs`), what it touches
-//! (`contact.rs`), how it keeps out of itself (`self_contact.rs`), its clock (`clock.rs`) and
-//! the active model's own state.
+//! `steps/`). The code is kept in rooms by concern: `constraints/` (stretch, bending,
+//! tethers), `contact/` (colliders, one file per [shape](shapes), self-collision and
+//! cloth–cloth contact), `drivers/` (pins, attachments, motion constraints, the grab),
+//! `models/` (each model's own state), `diagnostics/` (energy, strain); beside them a
+//! cloth's particles ([`Particles`]), what it is made of (`structure.rs`), its clock
+//! (`clock.rs`) and the shared stages (`forces.rs`, `integrate.rs`).
 
-mod bending;
 mod build;
-mod chains;
 mod clock;
+mod constraints;
 mod contact;
 mod diagnostics;
 mod drivers;
 mod forces;
 mod integrate;
-mod interact;
-mod lattice;
 mod layout;
 mod many;
+mod models;
 mod parallel;
-pub mod patches;
 mod queries;
-mod self_contact;
-pub mod shape_matching;
 mod state;
 mod steps;
 mod structure;
 mod substeps;
-mod switch;
-mod tethers;
 pub mod topology;
-mod xpbd;
+
+// The rooms' modules the other stages name.
+use constraints::{bending, chains, lattice, tethers, xpbd};
+use contact::self_contact;
+use models::switch;
 
 pub use contact::shapes::{self, ColliderShape, ConvexHull, Placement, Shape};
 pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};
-pub use interact::Grab;
+pub use drivers::interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
 pub use many::{begin_cloths, begin_together, run_cloths, substep_together};
+pub use models::{patches, shape_matching};
 pub use parallel::{for_each_indexed, pool as task_pool, set_parallel, threads};
 pub use self_contact::{collide_cloths, exchange_cloths};
 pub use state::Particles;

@@ -6,6 +6,7 @@
 use bevy::math::{Quat, Vec3};
 
 mod collider;
+pub(super) mod self_contact;
 pub mod shapes;
 
 pub(crate) use collider::Bounds;

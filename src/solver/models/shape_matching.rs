@@ -32,7 +32,7 @@ pub struct ShapeMatching {
     /// `1 / (number of clusters holding the particle)`.
     inv_cluster_count: Vec<f32>,
     /// The `k` of k×k clusters these were built for.
-    pub(super) built_for: u32,
+    pub(in crate::solver) built_for: u32,
 }
 
 impl ShapeMatching {

@@ -20,8 +20,8 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
-use super::parallel::{self, PIECE};
-use super::{Particles, SpringKind, Springs};
+use crate::solver::parallel::{self, PIECE};
+use crate::solver::{Particles, SpringKind, Springs};
 
 mod xpbd;
 
@@ -198,7 +198,7 @@ impl SpringPass<'_> {
 
 /// A grid cloth's springs as stencil offsets.
 #[derive(Clone, Debug)]
-pub(super) struct Stencil {
+pub(in crate::solver) struct Stencil {
     width: usize,
     offsets: Vec<Offset>,
     /// For each spring: its offset and `a`, to follow tearing.

@@ -25,10 +25,10 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
-use super::chains::Chains;
-use super::parallel::{self, PIECE};
-use super::tethers::Tethers;
-use super::{Particles, SpringKind, Springs};
+use crate::solver::chains::Chains;
+use crate::solver::parallel::{self, PIECE};
+use crate::solver::tethers::Tethers;
+use crate::solver::{Particles, SpringKind, Springs};
 
 /// A colour goes to the compute pool from this many pieces (16,384 constraints) on: a
 /// colour's two fork-joins cost about 20 µs, and at 16,384 particles (colours of about
@@ -37,7 +37,7 @@ use super::{Particles, SpringKind, Springs};
 const PARALLEL_PIECES: usize = 8;
 
 /// The order families are projected in within a substep (see [`Constraints::new`]).
-pub(super) const PROJECTION_ORDER: [SpringKind; 5] = [
+pub(in crate::solver) const PROJECTION_ORDER: [SpringKind; 5] = [
     SpringKind::Seam,
     SpringKind::BendDiagonal,
     SpringKind::Bend,
@@ -47,7 +47,7 @@ pub(super) const PROJECTION_ORDER: [SpringKind; 5] = [
 
 /// The constraints of a cloth's springs, grouped by colour.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Constraints {
+pub(in crate::solver) struct Constraints {
     /// Each constraint's spring (index into [`Springs`]), colour after colour.
     spring: Vec<u32>,
     /// Its particles, in the same order (copied so the projection reads one array).
@@ -71,7 +71,7 @@ pub(super) struct Constraints {
 
 /// What one family's constraints take in a substep.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub(super) struct Family {
+pub(in crate::solver) struct Family {
     /// Whether its constraints act (the family is on with a stiffness > 0).
     pub on: bool,
     /// `α̃ = 1/(k h²)` (0 for `k = inf`).
@@ -310,7 +310,7 @@ fn greedy_colours(springs: &Springs, n: usize) -> (Vec<u32>, usize) {
 /// `Δx_b = s w_b d`. `DAMPED`, `LIMITED`: whether the family has damping, a strain limit
 /// (chosen once per colour, not per constraint).
 #[inline(always)]
-pub(super) fn correction<const DAMPED: bool, const LIMITED: bool>(
+pub(in crate::solver) fn correction<const DAMPED: bool, const LIMITED: bool>(
     len: f32,
     rest: f32,
     w: f32,

@@ -22,11 +22,11 @@
 
 use bevy::math::Vec3;
 
-use super::Particles;
+use crate::solver::Particles;
 
 /// The hinges of a cloth (see the module doc).
 #[derive(Clone, Debug, Default)]
-pub(super) struct Hinges {
+pub(in crate::solver) struct Hinges {
     /// `[x0, x1, x2, x3]`: the edge, then the far corners.
     corners: Vec<[u32; 4]>,
     /// The cotangent weights `K`.
@@ -234,7 +234,7 @@ fn flipped(triangles: &[[u32; 3]], rest: &[Vec3]) -> Option<Vec<[u32; 3]>> {
 
 /// Each particle's share of the triangles' rest area: a third of each triangle it is a
 /// corner of, m².
-pub(super) fn particle_areas(triangles: &[[u32; 3]], rest: &[Vec3]) -> Vec<f32> {
+pub(in crate::solver) fn particle_areas(triangles: &[[u32; 3]], rest: &[Vec3]) -> Vec<f32> {
     let mut area = vec![0.0f32; rest.len()];
     for t in triangles {
         let [a, b, c] = t.map(|i| rest[i as usize]);

@@ -16,12 +16,12 @@
 //! is that particle, so its centre is pinned outright; with the seed's targets, or a
 //! cloth one part across, a pin fixes its part, as in the thesis (see `Patches::new`).
 
-use super::parallel::{self, PIECE};
+use crate::solver::parallel::{self, PIECE};
 use bevy::math::{Affine3A, Vec3};
 
-use super::{ClothSolver, Layout, topology};
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model, PatchParams, PatchTargets, Substeps};
+use crate::solver::{ClothSolver, Layout, topology};
 
 /// A pin's hold on its part: the part's centre stays `length` from the pin.
 #[derive(Clone, Copy, Debug)]
@@ -76,7 +76,7 @@ pub struct Patches {
     rest_step: (f32, f32),
     /// `(part_width, part_height, targets)` these were built for (the targets decide how
     /// pins hold the lattice).
-    pub(super) built_for: (u32, u32, PatchTargets),
+    pub(in crate::solver) built_for: (u32, u32, PatchTargets),
     /// After a switch into this model: each particle's offset from its target at the
     /// switch, faded out over [`EASE_TIME`] (see [`Patches::adopt_state`]).
     ease: Vec<Vec3>,
@@ -91,7 +91,7 @@ pub const EASE_TIME: f32 = 0.5;
 
 /// The share of the switch offset left when `left` of [`EASE_TIME`] remains: smoothstep,
 /// so the targets start and end the fade at rest relative to the parts.
-pub(super) fn ease_share(left: f32) -> f32 {
+pub(in crate::solver) fn ease_share(left: f32) -> f32 {
     let s = (left / EASE_TIME).clamp(0.0, 1.0);
     s * s * (3.0 - 2.0 * s)
 }
@@ -313,7 +313,7 @@ impl Patches {
     /// the pins' rods.
     pub fn adopt_state(
         &mut self,
-        particles: &super::Particles,
+        particles: &crate::solver::Particles,
         pins: &[u32],
         h: f32,
         patch: &PatchParams,

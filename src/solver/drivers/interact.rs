@@ -2,7 +2,7 @@
 
 use bevy::math::Vec3;
 
-use super::ClothSolver;
+use crate::solver::ClothSolver;
 
 /// A particle held by a tool: it moves to `target` over the next step, like a pin.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -10,11 +10,11 @@ pub struct Grab {
     /// The held particle.
     pub particle: u32,
     /// Where it was at the start of the step.
-    pub(super) from: Vec3,
+    pub(in crate::solver) from: Vec3,
     /// Where the tool wants it.
     pub target: Vec3,
     /// Its inverse mass before it was grabbed (restored on release).
-    pub(super) inv_mass: f32,
+    pub(in crate::solver) inv_mass: f32,
 }
 
 impl ClothSolver {

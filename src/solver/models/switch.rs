@@ -17,13 +17,13 @@
 
 use bevy::math::Vec3;
 
-use super::ClothSolver;
-use super::patches::{EASE_TIME, ease_share};
 use crate::params::{Environment, Model};
+use crate::solver::ClothSolver;
+use crate::solver::patches::{EASE_TIME, ease_share};
 
 /// A switch in progress.
 #[derive(Clone, Debug)]
-pub(super) struct Switch {
+pub(in crate::solver) struct Switch {
     /// The cloth with the old model, until its one step has been taken.
     old: Option<Box<ClothSolver>>,
     /// The extra force on each node the new model integrates (empty until computed).
@@ -34,7 +34,7 @@ pub(super) struct Switch {
 
 impl Switch {
     /// A switch away from `old`'s model, a copy of the cloth before the switch.
-    pub(super) fn new(old: ClothSolver) -> Self {
+    pub(in crate::solver) fn new(old: ClothSolver) -> Self {
         Switch {
             old: Some(Box::new(old)),
             correction: Vec::new(),
@@ -46,7 +46,7 @@ impl Switch {
 impl ClothSolver {
     /// Starts a switch from the current model to `params`' (call before taking them).
     /// Nothing for a cloth that has not moved yet.
-    pub(super) fn begin_switch(&mut self, params: &crate::params::ClothParams) {
+    pub(in crate::solver) fn begin_switch(&mut self, params: &crate::params::ClothParams) {
         if self.clock.time == 0.0 || !changes_model(self.params.model, params.model) {
             return;
         }
@@ -58,7 +58,7 @@ impl ClothSolver {
     /// Adds the switch's extra force to this substep's forces (after they are
     /// accumulated); on the first substep after the switch, computes it from the old
     /// model's step (see the module doc). Allocates only then.
-    pub(super) fn add_switch_force(&mut self, env: &Environment) {
+    pub(in crate::solver) fn add_switch_force(&mut self, env: &Environment) {
         let Some(mut switch) = self.switch.take() else {
             return;
         };

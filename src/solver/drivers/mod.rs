@@ -5,6 +5,8 @@
 //! of targets that move (NvCloth's motion constraints, Unreal's painted max distance: a
 //! skirt on a walking body).
 
+pub(super) mod interact;
+
 use bevy::math::{Affine3A, Vec3};
 
 use super::{ClothSolver, Grab, ModelState, Particles, SpringKind};

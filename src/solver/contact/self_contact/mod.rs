@@ -44,15 +44,23 @@
 //! not slowed; only its parts' motion relative to one another is bounded, to `d/2` per
 //! substep (at 13 substeps of 16 ms and `d` = 3 cm, 12 m/s).
 
+mod cloths;
+mod grid;
+
+pub(in crate::solver) use cloths::refresh;
+use cloths::{Other, bounds};
+pub use cloths::{collide_cloths, exchange_cloths};
+use grid::Grid;
+
 use bevy::math::{Vec3, Vec3A};
 
-use super::parallel::{self, PIECE};
-use super::{Particles, SpringKind, Springs};
 use crate::params::SelfCollision;
+use crate::solver::parallel::{self, PIECE};
+use crate::solver::{Particles, SpringKind, Springs};
 
 /// The self-collision stage's state (see the module doc).
 #[derive(Clone, Debug, Default)]
-pub(super) struct SelfContact {
+pub(in crate::solver) struct SelfContact {
     /// The distance kept this step (0: off).
     d: f32,
     /// The most a free particle moves relative to the mean in one substep.
@@ -98,18 +106,6 @@ pub(super) struct SelfContact {
     tag: Option<u32>,
     /// The clamp's sums of motion and free particles, piece by piece.
     sums: Vec<(Vec3, usize)>,
-}
-
-/// A particle of another cloth, as it was when the step began.
-#[derive(Clone, Copy, Debug, Default)]
-struct Other {
-    x: Vec3,
-    v: Vec3,
-    w: f32,
-    /// Where it comes from: its cloth's place among those given to [`collide_cloths`],
-    /// and its index there ([`exchange_cloths`] reads it again).
-    cloth: u32,
-    particle: u32,
 }
 
 impl SelfContact {
@@ -647,157 +643,6 @@ const RELIST_AFTER: f32 = 0.25;
 /// cell in six of its box at cells of `2.5 d`; a crumpled or swinging one spreads through
 /// more, and its cells grow to stay within this (the scratch stays a few bytes a particle).
 const CELLS_PER_PARTICLE: usize = 4;
-
-/// A uniform grid over a box: cells `size` a side, of side `cell`, from `lo`, indexed
-/// x fastest (so a row of cells along x is one run of entries).
-#[derive(Clone, Copy, Debug, Default)]
-struct Grid {
-    lo: Vec3,
-    cell: f32,
-    size: [i32; 3],
-}
-
-impl Grid {
-    /// The grid over `lo..=hi` with cells of `cell` or, if that takes more than
-    /// `most` cells, the smallest larger cells that take at most that many.
-    fn new(lo: Vec3, hi: Vec3, cell: f32, most: usize) -> Self {
-        let extent = hi - lo;
-        if !(extent.is_finite() && cell.is_finite() && cell > 0.0) {
-            // Nothing to list by: one cell (a non-finite step is undone after).
-            return Self {
-                lo,
-                cell: f32::INFINITY,
-                size: [1, 1, 1],
-            };
-        }
-        let mut cell = cell;
-        loop {
-            // Counted in floats: a tiny cell over a large box has more cells along an
-            // axis than an `i32` holds (converted only once the count is small).
-            let size = (extent / cell).floor() + Vec3::ONE;
-            let count = f64::from(size.x) * f64::from(size.y) * f64::from(size.z);
-            if count <= most as f64 {
-                return Self {
-                    lo,
-                    cell,
-                    size: size.as_ivec3().to_array(),
-                };
-            }
-            cell *= (count / most as f64).cbrt().max(1.01) as f32;
-        }
-    }
-
-    /// The cell holding `x`, clamped to the grid (every particle listed is inside it).
-    fn cell(&self, x: Vec3) -> [i32; 3] {
-        let c = ((x - self.lo) / self.cell).floor();
-        let clamp = |v: f32, n: i32| (v.max(0.0) as i32).min(n - 1);
-        [
-            clamp(c.x, self.size[0]),
-            clamp(c.y, self.size[1]),
-            clamp(c.z, self.size[2]),
-        ]
-    }
-
-    fn index(&self, [x, y, z]: [i32; 3]) -> u32 {
-        ((z * self.size[1] + y) * self.size[0] + x) as u32
-    }
-
-    fn coords(&self, k: usize) -> [i32; 3] {
-        let k = k as i32;
-        let (nx, ny) = (self.size[0], self.size[1]);
-        [k % nx, (k / nx) % ny, k / (nx * ny)]
-    }
-
-    fn len(&self) -> usize {
-        self.size.iter().map(|&n| n as usize).product()
-    }
-}
-
-/// The box around `x`.
-fn bounds(x: &[Vec3]) -> (Vec3, Vec3) {
-    x.iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
-            (lo.min(p), hi.max(p))
-        })
-}
-
-/// Cloth–cloth contact for the step about to begin (see the module doc): each cloth of
-/// `cloths` with self-collision on takes the particles of the others with it on that
-/// lie within its box grown by a margin (their positions and velocities now, and their
-/// inverse masses: 0 for a cloth that will not step, `moving` false, such as a sleeping
-/// one, so the cloth that steps takes the whole correction). Call it before the cloths'
-/// `begin_step`; a cloth keeps its copy until the next call.
-pub fn collide_cloths(cloths: &mut [(&mut super::ClothSolver, bool)]) {
-    let on: Vec<bool> = cloths
-        .iter()
-        .map(|(c, _)| c.params.self_collision.enabled)
-        .collect();
-    let boxes: Vec<(Vec3, Vec3)> = cloths
-        .iter()
-        .map(|(c, _)| bounds(&c.particles.position))
-        .collect();
-    for a in 0..cloths.len() {
-        cloths[a].0.self_contact.tag = Some(a as u32);
-        let mut others = std::mem::take(&mut cloths[a].0.self_contact.others);
-        others.clear();
-        if on[a] {
-            // What can come within reach of the cloth in a step: four spacings, and where
-            // a particle's speed takes it in 50 ms (three 16 ms steps).
-            let (lo, hi) = boxes[a];
-            let margin = 4.0 * cloths[a].0.self_contact.spacing.max(0.01);
-            for b in (0..cloths.len()).filter(|&b| b != a && on[b]) {
-                let (other, moving) = (&*cloths[b].0, cloths[b].1);
-                let p = &other.particles;
-                for i in 0..p.len() {
-                    let reach = margin + p.velocity[i].length() * 0.05;
-                    let x = p.position[i];
-                    if x.cmpge(lo - reach).all() && x.cmple(hi + reach).all() {
-                        others.push(Other {
-                            x,
-                            v: p.velocity[i],
-                            w: if moving { p.inv_mass[i] } else { 0.0 },
-                            cloth: b as u32,
-                            particle: i as u32,
-                        });
-                    }
-                }
-            }
-        }
-        cloths[a].0.self_contact.others = others;
-    }
-}
-
-/// Refreshes every cloth's copy of the other cloths' particles ([`collide_cloths`]) to
-/// where those are now, for cloths stepped stage by stage together: each substep's
-/// cloth–cloth contact then keeps apart from where the others were one substep ago, not
-/// one step ago. `cloths` may be any of those given to [`collide_cloths`], in any order;
-/// a copy of a cloth not among them stays as it was.
-pub fn exchange_cloths(cloths: &mut [&mut super::ClothSolver]) {
-    for a in 0..cloths.len() {
-        refresh(cloths, a);
-    }
-}
-
-/// Cloth `a`'s copy of the others' particles, refreshed from those of `cloths` (matched
-/// by the place [`collide_cloths`] gave each).
-pub(super) fn refresh(cloths: &mut [&mut super::ClothSolver], a: usize) {
-    let mut others = std::mem::take(&mut cloths[a].self_contact.others);
-    let mut from: Option<(u32, usize)> = None; // the last source found (they come in runs)
-    for o in &mut others {
-        let found = match from {
-            Some((tag, b)) if tag == o.cloth => Some(b),
-            _ => cloths
-                .iter()
-                .position(|c| c.self_contact.tag == Some(o.cloth)),
-        };
-        let Some(b) = found else { continue };
-        from = Some((o.cloth, b));
-        if let Some(&x) = cloths[b].particles.position.get(o.particle as usize) {
-            o.x = x;
-        }
-    }
-    cloths[a].self_contact.others = others;
-}
 
 #[cfg(test)]
 mod tests {

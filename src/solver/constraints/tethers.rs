@@ -20,8 +20,8 @@ use std::collections::BinaryHeap;
 
 use bevy::math::Vec3;
 
-use super::parallel::{self, PIECE, XPBD_PARALLEL_FROM};
-use super::{Particles, SpringKind, Springs};
+use crate::solver::parallel::{self, PIECE, XPBD_PARALLEL_FROM};
+use crate::solver::{Particles, SpringKind, Springs};
 
 /// At most this many groups of pins get their own tethers; a cloth held by more (a cape
 /// pinned at scattered points) is tethered to its nearest pin of all, as one group.
@@ -38,7 +38,7 @@ struct Key {
 
 /// Each particle's bound to the nearest pin of each group.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Tethers {
+pub(in crate::solver) struct Tethers {
     key: Option<Key>,
     /// Per group, per particle: the anchor, as its place in the pins given to
     /// [`Self::refresh`] (`u32::MAX` where none reaches).
