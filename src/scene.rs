@@ -333,6 +333,25 @@ impl ClothScene {
         None
     }
 
+    /// What is wrong with cloth entry `i`, if anything: the field's path, its key in the
+    /// file and the message (its garment file first, then its shape, pins and params).
+    fn cloth_error(i: usize, entry: &SceneCloth) -> Option<(String, &'static str, String)> {
+        if let crate::layout::shape::ClothShape::Garment { file, resolution } = &entry.cloth.shape {
+            let path = crate::layout::garment::asset_path(file);
+            if let Err(e) = crate::layout::garment::GarmentLayout::load(&path, *resolution) {
+                return Some((format!("cloths[{i}].cloth.shape"), "Garment", e.to_string()));
+            }
+        }
+        let e = entry.cloth.validate().err()?;
+        let field = error_field(&e);
+        let path = if field.starts_with("shape") || field == "pins" {
+            format!("cloths[{i}].cloth.{field}")
+        } else {
+            format!("cloths[{i}].cloth.params.{field}")
+        };
+        Some((path, leaf(field), e.to_string()))
+    }
+
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
         let invalid = |field: String, key: &str, message: String, after: usize| {
             // Point at the line of the offending key, searching from the cloth's entry.
@@ -375,32 +394,8 @@ impl ClothScene {
                 .get(search_from..)
                 .and_then(|rest| rest.find("cloth:"))
                 .map_or(search_from, |o| search_from + o);
-            let garment = match &entry.cloth.shape {
-                crate::layout::shape::ClothShape::Garment { file, resolution } => {
-                    crate::layout::garment::GarmentLayout::load(
-                        &crate::layout::garment::asset_path(file),
-                        *resolution,
-                    )
-                    .err()
-                }
-                _ => None,
-            };
-            if let Some(e) = garment {
-                return Err(invalid(
-                    format!("cloths[{i}].cloth.shape"),
-                    "Garment",
-                    e.to_string(),
-                    entry_start,
-                ));
-            }
-            if let Err(e) = entry.cloth.validate() {
-                let field = error_field(&e);
-                let path = if field.starts_with("shape") || field == "pins" {
-                    format!("cloths[{i}].cloth.{field}")
-                } else {
-                    format!("cloths[{i}].cloth.params.{field}")
-                };
-                return Err(invalid(path, leaf(field), e.to_string(), entry_start));
+            if let Some((path, key, message)) = Self::cloth_error(i, entry) {
+                return Err(invalid(path, key, message, entry_start));
             }
             search_from = entry_start + 1;
         }

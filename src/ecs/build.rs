@@ -35,7 +35,11 @@ struct BodySource<'a> {
 }
 
 /// A built cloth: its solver, its mesh, and for a mesh-shaped cloth its body.
-type Built = (solver::ClothSolver, Mesh, Option<ClothBody>);
+struct BuiltCloth {
+    solver: solver::ClothSolver,
+    mesh: Mesh,
+    body: Option<ClothBody>,
+}
 
 /// Builds a cloth's solver and mesh. `Ok(None)`: its mesh or garment is not loaded yet.
 fn build_one(
@@ -43,65 +47,72 @@ fn build_one(
     frame: bevy::math::Affine3A,
     source: LayoutSource,
     body: BodySource,
-) -> Result<Option<Built>, ClothError> {
+) -> Result<Option<BuiltCloth>, ClothError> {
     cloth.validate()?;
-    let (solver, uvs, body) = match (&cloth.shape, source) {
+    let plain = |solver: solver::ClothSolver| BuiltCloth {
+        mesh: cloth_mesh(&solver, None),
+        solver,
+        body: None,
+    };
+    let built = match (&cloth.shape, source) {
         (ClothShape::Garment { resolution, .. }, LayoutSource::Garment(garment)) => {
             let Some(garment) = garment else {
                 return Ok(None);
             };
-            (
-                cloth.build_garment(garment.layout(*resolution)?, frame)?,
-                None,
-                None,
-            )
+            plain(cloth.build_garment(garment.layout(*resolution)?, frame)?)
         }
         (ClothShape::Mesh, LayoutSource::Mesh(mesh)) => {
             let Some(mesh) = mesh else {
                 return Ok(None);
             };
-            let source = mesh_triangles(mesh)?;
-            let layout = Layout::from_mesh(&source.positions, &source.triangles)?;
-            let pins = match &cloth.pins {
-                // The mesh's own vertex indices, each to the particle it was welded into.
-                ClothPins::Indices(vertices) => {
-                    let count = source.particle_of.len();
-                    let mut pins = vertices
-                        .iter()
-                        .map(|&v| {
-                            source
-                                .particle_of
-                                .get(v as usize)
-                                .copied()
-                                .ok_or(ClothError::PinOutOfRange { index: v, count })
-                        })
-                        .collect::<Result<Vec<u32>, _>>()?;
-                    pins.sort_unstable();
-                    pins.dedup();
-                    pins
-                }
-                pins => pins.resolve_for(&layout)?,
-            };
-            let body = ClothBody::read(mesh, &source, body.skin, body.max, &pins)?;
-            // A skinned cloth's pins follow its skin (distance 0), not the entity's frame.
-            let frame_pins = if body.as_ref().is_some_and(|b| b.skin.is_some()) {
-                Vec::new()
-            } else {
-                pins
-            };
-            let solver = solver::ClothSolver::new(layout, &frame_pins, &cloth.params, frame)?;
-            (solver, source.uvs, body)
+            build_from_mesh(cloth, mesh, frame, body)?
         }
-        _ => (
+        _ => plain(
             cloth
                 .shape
                 .build_solver(&cloth.pins, &cloth.params, frame)?,
-            None,
-            None,
         ),
     };
-    let mesh = cloth_mesh(&solver, uvs);
-    Ok(Some((solver, mesh, body)))
+    Ok(Some(built))
+}
+
+/// A mesh-shaped cloth: its solver, its mesh (with the source's UVs) and its body (skin,
+/// painted max distance).
+fn build_from_mesh(
+    cloth: &Cloth,
+    mesh: &Mesh,
+    frame: bevy::math::Affine3A,
+    body: BodySource,
+) -> Result<BuiltCloth, ClothError> {
+    let source = mesh_triangles(mesh)?;
+    let layout = Layout::from_mesh(&source.positions, &source.triangles)?;
+    let pins = match &cloth.pins {
+        // The mesh's own vertex indices, each to the particle it was welded into.
+        ClothPins::Indices(vertices) => {
+            let count = source.particle_of.len();
+            let mut pins = vertices
+                .iter()
+                .map(|&v| {
+                    let particle = source.particle_of.get(v as usize).copied();
+                    particle.ok_or(ClothError::PinOutOfRange { index: v, count })
+                })
+                .collect::<Result<Vec<u32>, _>>()?;
+            pins.sort_unstable();
+            pins.dedup();
+            pins
+        }
+        pins => pins.resolve_for(&layout)?,
+    };
+    let body = ClothBody::read(mesh, &source, body.skin, body.max, &pins)?;
+    // A skinned cloth's pins follow its skin (distance 0), not the entity's frame.
+    let frame_pins = if body.as_ref().is_some_and(|b| b.skin.is_some()) {
+        Vec::new()
+    } else {
+        pins
+    };
+    let solver = solver::ClothSolver::new(layout, &frame_pins, &cloth.params, frame)?;
+    let mesh = cloth_mesh(&solver, source.uvs);
+    Ok(BuiltCloth { solver, mesh, body })
 }
 
 /// Remembers the mesh a mesh-shaped cloth was made from (its `Mesh3d` is replaced by the
@@ -233,51 +244,50 @@ fn layout_source<'a>(
     })
 }
 
-#[allow(clippy::type_complexity, clippy::too_many_arguments)]
+/// Every cloth, with what building it reads: its simulation, mesh, source mesh, garment,
+/// whether it was refused, and its skin, body and painted max distance.
+type ClothsToBuild<'w, 's> = Query<
+    'w,
+    's,
+    (
+        Entity,
+        Ref<'static, Cloth>,
+        Option<&'static mut ClothSimulation>,
+        Option<&'static Mesh3d>,
+        Option<&'static ClothSourceMesh>,
+        Option<&'static mut ClothGarment>,
+        Has<ClothInvalid>,
+        (
+            Option<&'static SkinnedMesh>,
+            Option<&'static ClothBody>,
+            Option<Ref<'static, ClothMaxDistance>>,
+        ),
+    ),
+>;
+
+/// Builds every cloth that is new or whose shape, pins, garment or painted max distance
+/// changed; applies changed params alone in place; refuses what is invalid.
 pub(crate) fn build_cloths(
     mut commands: Commands,
     mut meshes: ResMut<Assets<Mesh>>,
     asset_server: Res<AssetServer>,
     garments: Option<Res<Assets<Garment>>>,
     transforms: TransformHelper,
-    mut cloths: Query<(
-        Entity,
-        Ref<Cloth>,
-        Option<&mut ClothSimulation>,
-        Option<&Mesh3d>,
-        Option<&ClothSourceMesh>,
-        Option<&mut ClothGarment>,
-        Has<ClothInvalid>,
-        (
-            Option<&SkinnedMesh>,
-            Option<&ClothBody>,
-            Option<Ref<ClothMaxDistance>>,
-        ),
-    )>,
+    mut cloths: ClothsToBuild,
 ) {
-    for (entity, cloth, sim, mesh3d, source, garment, invalid, (skin, body, max)) in &mut cloths {
-        // A changed max distance rebuilds, as a changed shape does.
-        let repainted = max.as_ref().is_some_and(|m| m.is_changed());
+    for (entity, cloth, sim, mesh3d, source, mut garment, invalid, (skin, body, max)) in &mut cloths
+    {
         let frame = transforms
             .compute_global_transform(entity)
             .map(|g| g.affine())
             .unwrap_or_default();
-        let mut garment = garment;
-        let reload = garment
+        // A reloaded garment or a changed max distance rebuilds, as a changed shape does
+        // (both read every time: `|`, not `||`).
+        let forced = garment
             .as_mut()
-            .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed));
-        let changed = cloth.is_changed() || reload || repainted;
-        if let Some(mut sim) = sim {
-            sim.solver.set_frame(frame);
-            if !changed {
-                continue;
-            }
-            if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !reload && !repainted
-            {
-                apply_params(&mut commands, entity, &mut sim, &cloth.params, invalid);
-                continue;
-            }
-        } else if invalid && !changed {
+            .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed))
+            | max.as_ref().is_some_and(|m| m.is_changed());
+        if !wants_build(&mut commands, entity, &cloth, sim, frame, forced, invalid) {
             continue;
         }
         let (layout_source, source_handle) = match layout_source(
@@ -300,12 +310,8 @@ pub(crate) fn build_cloths(
         };
         match build_one(&cloth, frame, layout_source, body_source) {
             Ok(Some(built)) => {
-                let mut entity_commands = commands.entity(entity);
-                insert_built(&mut entity_commands, &cloth, built, &mut meshes);
-                if let Some(source_handle) = source_handle {
-                    entity_commands.insert(ClothSourceMesh(source_handle));
-                }
-                commands.trigger(ClothBuilt { entity });
+                let source = source_handle;
+                insert_built(&mut commands, entity, &cloth, built, &mut meshes, source);
             }
             Ok(None) => {}
             Err(e) => invalidate(&mut commands, entity, e),
@@ -313,23 +319,59 @@ pub(crate) fn build_cloths(
     }
 }
 
-/// Puts a built cloth on its entity: the simulation, its mesh (the entity's `Mesh3d`
-/// now), and its body or none; a skinned cloth's skin comes off the entity, so it is
-/// drawn as simulated.
+/// Whether a cloth must be built (again): always when it has no simulation, unless it was
+/// refused and has not changed since; for one simulated, when its shape or pins changed
+/// (or `forced`: its garment reloaded, its max distance repainted). A simulated cloth
+/// follows its `frame` here, and a change of its params alone is applied in place.
+fn wants_build(
+    commands: &mut Commands,
+    entity: Entity,
+    cloth: &Ref<Cloth>,
+    sim: Option<Mut<ClothSimulation>>,
+    frame: bevy::math::Affine3A,
+    forced: bool,
+    invalid: bool,
+) -> bool {
+    let changed = cloth.is_changed() || forced;
+    let Some(mut sim) = sim else {
+        return changed || !invalid;
+    };
+    sim.solver.set_frame(frame);
+    if !changed {
+        return false;
+    }
+    if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !forced {
+        apply_params(commands, entity, &mut sim, &cloth.params, invalid);
+        return false;
+    }
+    true
+}
+
+/// Puts a built cloth on its entity: the simulation, its `mesh` (the entity's `Mesh3d`
+/// now; the mesh it was made from, if any, kept as its `source`), and its body or none; a
+/// skinned cloth's skin comes off the entity, so it is drawn as simulated. Then tells
+/// observers it was built.
 fn insert_built(
-    entity: &mut EntityCommands,
+    commands: &mut Commands,
+    entity: Entity,
     cloth: &Cloth,
-    (solver, mesh, body): Built,
+    BuiltCloth { solver, mesh, body }: BuiltCloth,
     meshes: &mut Assets<Mesh>,
+    source: Option<Handle<Mesh>>,
 ) {
     let sim = ClothSimulation::new(solver, cloth);
-    entity
+    let mut entity_commands = commands.entity(entity);
+    entity_commands
         .insert((sim, Mesh3d(meshes.add(mesh))))
         .remove::<ClothInvalid>();
     match body {
-        Some(body) => entity.insert(body).remove::<SkinnedMesh>(),
-        None => entity.remove::<ClothBody>(),
+        Some(body) => entity_commands.insert(body).remove::<SkinnedMesh>(),
+        None => entity_commands.remove::<ClothBody>(),
     };
+    if let Some(source) = source {
+        entity_commands.insert(ClothSourceMesh(source));
+    }
+    commands.trigger(ClothBuilt { entity });
 }
 
 /// Applies edited parameters to a built cloth; bad ones pause it until they are fixed.

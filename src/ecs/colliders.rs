@@ -8,6 +8,7 @@ use serde::{Deserialize, Serialize};
 use crate::ecs::cloth::{ClothInvalid, ClothSimulation, Layers};
 use crate::error::ClothError;
 use crate::solver;
+use crate::solver::shapes::check_size;
 
 /// A solid the cloths are kept out of, placed by its entity's transform: spheres,
 /// capsules and planes with a thickness and friction. Every cloth collides with every
@@ -136,85 +137,55 @@ impl ColliderKind {
     }
 
     /// Checks the sizes: radii and half-extents > 0, half-lengths ≥ 0, a half-space's
-    /// normal non-zero, each within [`crate::limits::MAX_POSITION`].
+    /// normal non-zero, each within [`crate::limits::MAX_POSITION`]; a solver shape by its
+    /// own [`Shape::validate`](solver::Shape::validate).
     pub fn validate(&self) -> Result<(), ClothError> {
-        let radius = |r: f32| check_size("radius", r, true, "a radius from 0 (excluded) to 1e5 m");
+        use solver::Shape;
+        use solver::shapes::{Cuboid, Cylinder, Sphere};
         match *self {
-            ColliderKind::Sphere { radius: r } => radius(r)?,
+            // The solver's shapes name the same fields.
+            ColliderKind::Sphere { radius } => Sphere {
+                center: Vec3::ZERO,
+                radius,
+            }
+            .validate(),
             ColliderKind::Capsule {
-                radius: r,
+                radius,
                 half_length,
             } => {
-                radius(r)?;
                 check_size(
-                    "half_length",
-                    half_length,
+                    "radius",
+                    radius,
                     false,
-                    "a half-length from 0 to 1e5 m",
+                    "a radius from 0 (excluded) to 1e5 m",
                 )?;
+                let expected = "a half-length from 0 to 1e5 m";
+                check_size("half_length", half_length, true, expected)
             }
-            ColliderKind::Cuboid { half_extents: h } => {
-                for (field, value) in [
-                    ("half_extents.x", h.x),
-                    ("half_extents.y", h.y),
-                    ("half_extents.z", h.z),
-                ] {
-                    check_size(
-                        field,
-                        value,
-                        true,
-                        "a half-extent from 0 (excluded) to 1e5 m",
-                    )?;
-                }
+            ColliderKind::Cuboid { half_extents } => {
+                Cuboid::new(Vec3::ZERO, Quat::IDENTITY, half_extents).validate()
             }
             ColliderKind::Cylinder {
-                radius: r,
+                radius,
                 half_height,
-            } => {
-                radius(r)?;
-                check_size(
-                    "half_height",
-                    half_height,
-                    true,
-                    "a half-height from 0 (excluded) to 1e5 m",
-                )?;
+            } => Cylinder {
+                center: Vec3::ZERO,
+                axis: Vec3::Y,
+                half_height,
+                radius,
             }
-            ColliderKind::Plane => {}
-            ColliderKind::Shape(ref shape) => solver::Shape::validate(shape)?,
+            .validate(),
+            ColliderKind::Plane => Ok(()),
+            ColliderKind::Shape(ref shape) => shape.validate(),
             ColliderKind::HalfSpace { normal, distance } => {
                 let length = normal.length();
-                crate::params::check(
-                    "normal",
-                    length,
-                    length.is_finite() && length > 1e-6,
-                    "a finite, non-zero normal",
-                )?;
-                crate::params::check(
-                    "distance",
-                    distance,
-                    distance.abs() <= crate::limits::MAX_POSITION,
-                    "a distance within ±1e5 m",
-                )?;
+                let ok = length.is_finite() && length > 1e-6;
+                crate::params::check("normal", length, ok, "a finite, non-zero normal")?;
+                let ok = distance.abs() <= crate::limits::MAX_POSITION;
+                crate::params::check("distance", distance, ok, "a distance within ±1e5 m")
             }
         }
-        Ok(())
     }
-}
-
-/// A size from 0 (excluded, with `least_excluded`) to [`crate::limits::MAX_POSITION`].
-fn check_size(
-    field: &'static str,
-    value: f32,
-    least_excluded: bool,
-    expected: &'static str,
-) -> Result<(), ClothError> {
-    let low = if least_excluded {
-        value > 0.0
-    } else {
-        value >= 0.0
-    };
-    let ok = low && value <= crate::limits::MAX_POSITION;
-    crate::params::check(field, value, ok, expected)
 }
 
 impl From<InfinitePlane3d> for ClothCollider {
@@ -360,15 +331,11 @@ impl ClothCollider {
         check_size(
             "thickness",
             self.thickness,
-            false,
+            true,
             "a thickness from 0 to 1e5 m",
         )?;
-        check_size(
-            "friction",
-            self.friction,
-            false,
-            "a friction coefficient from 0 to 1e5",
-        )
+        let expected = "a friction coefficient from 0 to 1e5";
+        check_size("friction", self.friction, true, expected)
     }
 
     /// The collider in world space under `transform`: its [`ColliderKind::local`] shape

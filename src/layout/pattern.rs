@@ -101,6 +101,48 @@ impl std::fmt::Display for PatternWarning {
     }
 }
 
+/// Reads one line's nodes onto `nodes` (and their places, on line `line_number`), checked
+/// against the first row's `width` (0 before it): how many it had, or the column and kind
+/// of the first error.
+fn read_row(
+    line: &str,
+    width: usize,
+    nodes: &mut Vec<bool>,
+    places: &mut Vec<(u32, u32)>,
+    line_number: u32,
+) -> Result<usize, (usize, PatternErrorKind)> {
+    let mut row = 0usize;
+    for (c, ch) in line.chars().enumerate() {
+        match ch {
+            '0' | '1' => {
+                nodes.push(ch == '1');
+                places.push((line_number, c as u32 + 1));
+                row += 1;
+                if nodes.len() > MAX_PATTERN_NODES {
+                    let kind = PatternErrorKind::TooLarge {
+                        nodes: nodes.len(),
+                        limit: MAX_PATTERN_NODES,
+                    };
+                    return Err((c + 1, kind));
+                }
+                if width > 0 && row > width {
+                    let kind = PatternErrorKind::Ragged {
+                        expected: width,
+                        found: line.chars().filter(|c| matches!(c, '0' | '1')).count(),
+                    };
+                    return Err((c + 1, kind));
+                }
+            }
+            ' ' | '\t' | '\r' => {}
+            '#' => break,
+            other => {
+                return Err((c + 1, PatternErrorKind::BadCharacter(other)));
+            }
+        }
+    }
+    Ok(row)
+}
+
 impl Pattern {
     /// Reads and parses a pattern file.
     pub fn load(path: &Path) -> Result<(Pattern, Vec<PatternWarning>), PatternError> {
@@ -130,35 +172,8 @@ impl Pattern {
         let mut places: Vec<(u32, u32)> = Vec::new();
         let mut first_row_line = 0;
         for (l, line) in text.lines().enumerate() {
-            let mut row = 0usize;
-            for (c, ch) in line.chars().enumerate() {
-                match ch {
-                    '0' | '1' => {
-                        nodes.push(ch == '1');
-                        places.push((l as u32 + 1, c as u32 + 1));
-                        row += 1;
-                        if nodes.len() > MAX_PATTERN_NODES {
-                            let kind = PatternErrorKind::TooLarge {
-                                nodes: nodes.len(),
-                                limit: MAX_PATTERN_NODES,
-                            };
-                            return Err(error(l + 1, c + 1, kind));
-                        }
-                        if width > 0 && row > width {
-                            let kind = PatternErrorKind::Ragged {
-                                expected: width,
-                                found: line.chars().filter(|c| matches!(c, '0' | '1')).count(),
-                            };
-                            return Err(error(l + 1, c + 1, kind));
-                        }
-                    }
-                    ' ' | '\t' | '\r' => {}
-                    '#' => break,
-                    other => {
-                        return Err(error(l + 1, c + 1, PatternErrorKind::BadCharacter(other)));
-                    }
-                }
-            }
+            let row = read_row(line, width, &mut nodes, &mut places, l as u32 + 1)
+                .map_err(|(column, kind)| error(l + 1, column, kind))?;
             if row == 0 {
                 continue;
             }

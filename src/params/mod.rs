@@ -190,6 +190,39 @@ impl ClothParams {
             (MIN_NODE_MASS..=MAX_NODE_MASS).contains(&self.node_mass),
             "a mass from 1e-9 to 1,000 kg (limits::MIN_NODE_MASS, MAX_NODE_MASS)",
         )?;
+        self.validate_springs()?;
+        check(
+            "drag",
+            self.drag,
+            (0.0..=MAX_DAMPING).contains(&self.drag),
+            "a drag from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
+        )?;
+        self.validate_stepping()?;
+        if let Some(ratio) = self.tear_ratio {
+            check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
+        }
+        self.validate_self_collision()?;
+        if let Some(fabric) = &self.fabric {
+            fabric.validate()?;
+            if !matches!(self.model, Model::MassSpring | Model::Xpbd(_)) {
+                return Err(ClothError::ModelLacks {
+                    model: self.model.kind().name(),
+                    feature: "fabric in physical units (`fabric`)",
+                });
+            }
+        }
+        match &self.model {
+            Model::ShapeMatching(sm) => sm.validate()?,
+            Model::Patches(patches) => patches.validate()?,
+            Model::Xpbd(xpbd) => xpbd.validate()?,
+            Model::MassSpring => {}
+        }
+        Ok(())
+    }
+
+    /// The spring families' stiffnesses, the damping, the seams' rest length and sewing
+    /// time.
+    fn validate_springs(&self) -> Result<(), ClothError> {
         let s = &self.springs;
         // XPBD takes an infinite stiffness as an inextensible constraint (compliance 0);
         // the explicit models need a finite one.
@@ -228,34 +261,7 @@ impl ClothParams {
             s.sew_time,
             s.sew_time >= 0.0,
             "a time ≥ 0 s",
-        )?;
-        check(
-            "drag",
-            self.drag,
-            (0.0..=MAX_DAMPING).contains(&self.drag),
-            "a drag from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
-        )?;
-        self.validate_stepping()?;
-        if let Some(ratio) = self.tear_ratio {
-            check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
-        }
-        self.validate_self_collision()?;
-        if let Some(fabric) = &self.fabric {
-            fabric.validate()?;
-            if !matches!(self.model, Model::MassSpring | Model::Xpbd(_)) {
-                return Err(ClothError::ModelLacks {
-                    model: self.model.kind().name(),
-                    feature: "fabric in physical units (`fabric`)",
-                });
-            }
-        }
-        match &self.model {
-            Model::ShapeMatching(sm) => sm.validate()?,
-            Model::Patches(patches) => patches.validate()?,
-            Model::Xpbd(xpbd) => xpbd.validate()?,
-            Model::MassSpring => {}
-        }
-        Ok(())
+        )
     }
 
     /// The substeps and the strain limiter: counts within their limits, a limit and a

@@ -211,39 +211,8 @@ impl GarmentLayout {
             message: e.code.to_string(),
         })?;
         check_header(&desc, resolution, &error)?;
-        let spacing = desc.spacing / resolution as f32;
         let mut layout = GarmentLayout::default();
-        // Per piece: its pattern and the particle index of each grid node.
-        let mut grids: Vec<(Pattern, Vec<u32>)> = Vec::new();
-        for piece in &desc.pieces {
-            if desc.pieces.iter().filter(|p| p.name == piece.name).count() > 1 {
-                return Err(error(
-                    &format!("\"{}\"", piece.name),
-                    format!("two pieces are named `{}`", piece.name),
-                ));
-            }
-            let (pattern, warnings) = read_pattern(&piece.pattern)?;
-            layout.warnings.extend(warnings);
-            check_nodes(&pattern, &piece.name, resolution, &error)?;
-            let pattern = pattern.rescale(resolution);
-            let start = layout.positions.len() as u32;
-            let index = add_piece(&mut layout, &pattern, piece, spacing);
-            if layout.positions.len() > crate::solver::MAX_PARTICLES {
-                return Err(error(
-                    &format!("\"{}\"", piece.name),
-                    format!(
-                        "{} particles up to piece `{}` is more than the limit of {} (limits.rs)",
-                        layout.positions.len(),
-                        piece.name,
-                        crate::solver::MAX_PARTICLES
-                    ),
-                ));
-            }
-            layout
-                .pieces
-                .push((piece.name.clone(), start..layout.positions.len() as u32));
-            grids.push((pattern, index));
-        }
+        let grids = lay_pieces(&desc, resolution, &mut layout, &mut read_pattern, &error)?;
         for seam in &desc.seams {
             let pairs = seam_pairs(seam, &desc.pieces, &grids, resolution, &error)?;
             layout
@@ -254,6 +223,55 @@ impl GarmentLayout {
         layout.runs = runs(&desc, &grids, resolution, &error)?;
         Ok(layout)
     }
+}
+
+/// Lays out every piece of `desc` in `layout` (its particles, springs and faces) in
+/// order; per piece, its pattern at `resolution` and the particle index of each grid node.
+fn lay_pieces(
+    desc: &GarmentFile,
+    resolution: u32,
+    layout: &mut GarmentLayout,
+    read_pattern: &mut impl FnMut(
+        &str,
+    ) -> Result<
+        (Pattern, Vec<PatternWarning>),
+        crate::layout::pattern::PatternError,
+    >,
+    error: &impl Fn(&str, String) -> ClothError,
+) -> Result<Vec<(Pattern, Vec<u32>)>, ClothError> {
+    let spacing = desc.spacing / resolution as f32;
+    // Per piece: its pattern and the particle index of each grid node.
+    let mut grids: Vec<(Pattern, Vec<u32>)> = Vec::new();
+    for piece in &desc.pieces {
+        if desc.pieces.iter().filter(|p| p.name == piece.name).count() > 1 {
+            return Err(error(
+                &format!("\"{}\"", piece.name),
+                format!("two pieces are named `{}`", piece.name),
+            ));
+        }
+        let (pattern, warnings) = read_pattern(&piece.pattern)?;
+        layout.warnings.extend(warnings);
+        check_nodes(&pattern, &piece.name, resolution, error)?;
+        let pattern = pattern.rescale(resolution);
+        let start = layout.positions.len() as u32;
+        let index = add_piece(layout, &pattern, piece, spacing);
+        if layout.positions.len() > crate::solver::MAX_PARTICLES {
+            return Err(error(
+                &format!("\"{}\"", piece.name),
+                format!(
+                    "{} particles up to piece `{}` is more than the limit of {} (limits::MAX_PARTICLES)",
+                    layout.positions.len(),
+                    piece.name,
+                    crate::solver::MAX_PARTICLES
+                ),
+            ));
+        }
+        layout
+            .pieces
+            .push((piece.name.clone(), start..layout.positions.len() as u32));
+        grids.push((pattern, index));
+    }
+    Ok(grids)
 }
 
 /// The refined grid of `pattern` at `resolution` within the limit, before it is
@@ -472,6 +490,14 @@ fn add_piece(
                 .push((kind, index[a as usize], index[b as usize]));
         }
     }
+    add_piece_triangles(layout, w, h, &index);
+    index
+}
+
+/// A piece's triangles, by the particle index of each grid node of its `w × h` grid
+/// (`u32::MAX` where the pattern has a 0).
+fn add_piece_triangles(layout: &mut GarmentLayout, w: u32, h: u32, index: &[u32]) {
+    let present = |g: u32| index[g as usize] != u32::MAX;
     // Full cells keep the grid's two triangles; a cell with three nodes (a diagonal edge
     // of the outline) gets the one triangle they make, wound the same way.
     let full = grid_triangles(w, h);
@@ -500,7 +526,6 @@ fn add_piece(
             }
         }
     }
-    index
 }
 
 /// The grid nodes of a seam edge at `resolution`, from `from` to `to` inclusive: a row, a

@@ -346,18 +346,7 @@ impl World<'_> {
                     add_push(pushes, k, -n * into);
                 }
             }
-            let share = pushes
-                .iter()
-                .find(|(j, _)| *j == k)
-                .map_or(Vec3::ZERO, |p| p.1);
-            let total = share.length();
-            // (Ties, as above, by the push's direction rather than the order.)
-            let more = |&(_, m, p): &(usize, f32, Vec3)| {
-                total > m || (total == m && share.to_array() > p.to_array())
-            };
-            if most.is_none_or(|m| more(&m)) {
-                most = Some((k, total, share));
-            }
+            keep_most(&mut most, pushes, k);
         }
         let (k, _, _) = most?;
         let previous = previous + shift;
@@ -464,6 +453,24 @@ impl World<'_> {
 }
 
 /// Adds `push` to collider `k`'s share.
+/// Keeps in `most` the collider whose whole push on the particle so far (its entry of
+/// `pushes`) is the largest, `k` having just pushed; ties go by the push's direction
+/// rather than the colliders' order.
+#[inline]
+fn keep_most(most: &mut Option<(usize, f32, Vec3)>, pushes: &[(usize, Vec3)], k: usize) {
+    let share = pushes
+        .iter()
+        .find(|(j, _)| *j == k)
+        .map_or(Vec3::ZERO, |p| p.1);
+    let total = share.length();
+    let more = |&(_, m, p): &(usize, f32, Vec3)| {
+        total > m || (total == m && share.to_array() > p.to_array())
+    };
+    if most.is_none_or(|m| more(&m)) {
+        *most = Some((k, total, share));
+    }
+}
+
 fn add_push(pushes: &mut Vec<(usize, Vec3)>, k: usize, push: Vec3) {
     match pushes.iter_mut().find(|(j, _)| *j == k) {
         Some((_, p)) => *p += push,
