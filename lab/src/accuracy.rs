@@ -66,6 +66,13 @@ pub struct Config {
 /// at 3k; XPBD (the same springs as constraints, the same strain limit) at 5, 10, 20,
 /// 40 and 80 substeps and automatic (its stretch-error target).
 pub fn configs(base: &ClothParams) -> Vec<Config> {
+    let mut out = mass_spring_configs(base);
+    out.extend(other_model_configs(base));
+    out
+}
+
+/// [`configs`]' mass-spring ones.
+fn mass_spring_configs(base: &ClothParams) -> Vec<Config> {
     let mut out = Vec::new();
     for integrator in Integrator::ALL {
         for substeps in [
@@ -108,6 +115,12 @@ pub fn configs(base: &ClothParams) -> Vec<Config> {
             },
         });
     }
+    out
+}
+
+/// [`configs`]' shape-matching, patch and XPBD ones.
+fn other_model_configs(base: &ClothParams) -> Vec<Config> {
+    let mut out = Vec::new();
     let k = base.springs.structural.stiffness;
     for clusters in [1, 4] {
         for factor in [1.0, 4.0, 16.0, 64.0] {
@@ -427,36 +440,7 @@ pub fn measure(
     let scale = reference.mass as f64 * g * reference.diagonal as f64;
     let mut rows = Vec::new();
     for config in configs {
-        let run = case.simulate(&config.params)?;
-        let errors = run.error_against(&reference);
-        let (ms_per_second, ms_range) = match errors {
-            Some(_) => {
-                let mut times = vec![run.milliseconds / case.seconds as f64];
-                for _ in 1..repeats.max(1) {
-                    times.push(case.simulate(&config.params)?.milliseconds / case.seconds as f64);
-                }
-                let range = times.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
-                    (lo.min(t), hi.max(t))
-                });
-                (Some(super::median(&mut times)), Some(range))
-            }
-            None => (None, None),
-        };
-        let row = Row {
-            scene: case.name.clone(),
-            model: config.model,
-            label: config.label.clone(),
-            ms_per_second,
-            ms_range,
-            substeps: run.mean_substeps,
-            error: errors.map(|e| e.0),
-            final_error: errors.map(|e| e.1),
-            max_strain: run.max_strain,
-            energy_drift: errors
-                .map(|_| (run.energy_end as f64 - reference.energy_end as f64) / scale),
-            failed_at: run.failed_at,
-            pareto: false,
-        };
+        let row = measure_one(case, config, repeats, &reference, scale)?;
         progress(&row);
         rows.push(row);
     }
@@ -491,6 +475,46 @@ pub fn measure(
         },
         rows,
     ))
+}
+
+/// One configuration's row: its error against `reference` and, when it ran, the median
+/// and range of `repeats` timed runs; its energy drift in units of `scale`.
+fn measure_one(
+    case: &Case,
+    config: &Config,
+    repeats: usize,
+    reference: &Trajectory,
+    scale: f64,
+) -> Result<Row, ClothError> {
+    let run = case.simulate(&config.params)?;
+    let errors = run.error_against(reference);
+    let (ms_per_second, ms_range) = match errors {
+        Some(_) => {
+            let mut times = vec![run.milliseconds / case.seconds as f64];
+            for _ in 1..repeats.max(1) {
+                times.push(case.simulate(&config.params)?.milliseconds / case.seconds as f64);
+            }
+            let range = times.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
+                (lo.min(t), hi.max(t))
+            });
+            (Some(super::median(&mut times)), Some(range))
+        }
+        None => (None, None),
+    };
+    Ok(Row {
+        scene: case.name.clone(),
+        model: config.model,
+        label: config.label.clone(),
+        ms_per_second,
+        ms_range,
+        substeps: run.mean_substeps,
+        error: errors.map(|e| e.0),
+        final_error: errors.map(|e| e.1),
+        max_strain: run.max_strain,
+        energy_drift: errors.map(|_| (run.energy_end as f64 - reference.energy_end as f64) / scale),
+        failed_at: run.failed_at,
+        pareto: false,
+    })
 }
 
 /// A measured configuration: its cost as the range of its timed runs, and its error.

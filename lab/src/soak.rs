@@ -13,6 +13,7 @@ use bevy_cloth::params::{
     ClothParams, Model, PatchParams, ShapeMatchingParams, Substeps, XpbdParams,
 };
 use bevy_cloth::scene::ClothScene;
+use bevy_cloth::solver::ClothSolver;
 use bevy_cloth::stats::StepTimes;
 
 /// A small seeded generator (xorshift64*): the same seed drives the same soak.
@@ -170,6 +171,77 @@ fn invalid_params(rng: &mut Rng, base: &ClothParams) -> ClothParams {
     p
 }
 
+/// A grab lasts a while; its target wanders.
+#[derive(Default)]
+struct Grabbing {
+    /// Steps left.
+    left: u32,
+    target: Vec3,
+}
+
+/// What the player does in a step, by chance: grabs and drags, cuts, edits (valid and
+/// invalid: `base` and whether the cloth is a `grid` bound them), resets; counted in
+/// `summary`.
+fn act(
+    cloth: &mut ClothSolver,
+    rng: &mut Rng,
+    summary: &mut SoakSummary,
+    grab: &mut Grabbing,
+    (base, grid): (&ClothParams, bool),
+) -> Result<(), String> {
+    if grab.left > 0 {
+        grab.left -= 1;
+        grab.target += Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0) * 0.01;
+        cloth.drag_grab(grab.target);
+        if grab.left == 0 {
+            cloth.release_grab();
+        }
+    } else if rng.chance(0.01) {
+        let i = rng.below(cloth.particle_count()) as u32;
+        if cloth.grab(i) {
+            summary.grabs += 1;
+            grab.left = 20 + rng.below(100) as u32;
+            grab.target = cloth.positions()[i as usize];
+        }
+    }
+    if rng.chance(0.005) {
+        // A stroke through the cloth's middle from a camera in front of it.
+        let (centre, radius) = cloth.bounding_sphere();
+        let eye = centre + Vec3::Z * (3.0 * radius + 1.0);
+        let far = |rng: &mut Rng| {
+            let aim = centre + Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0) * radius;
+            eye + (aim - eye) * 3.0
+        };
+        let (b, c) = (far(rng), far(rng));
+        summary.cuts += 1;
+        summary.springs_cut += cloth.cut(eye, b, c) as u64;
+    }
+    if rng.chance(0.004) {
+        let before = *cloth.params();
+        let params = random_params(rng, base, grid);
+        cloth
+            .set_params(&params)
+            .map_err(|e| format!("a valid edit was refused: {e}"))?;
+        summary.edits += 1;
+        if std::mem::discriminant(&before.model) != std::mem::discriminant(&params.model) {
+            summary.model_switches += 1;
+        }
+    }
+    if rng.chance(0.002) {
+        let before = *cloth.params();
+        let params = invalid_params(rng, &before);
+        match cloth.set_params(&params) {
+            Err(_) if *cloth.params() == before => summary.refused_edits += 1,
+            _ => summary.accepted_invalid_edits += 1,
+        }
+    }
+    if rng.chance(0.001) {
+        cloth.reset();
+        summary.resets += 1;
+    }
+    Ok(())
+}
+
 /// Soaks cloth `index` of `scene` for `duration` of wall-clock time with `seed`.
 /// `progress` is called about once a second with the summary so far.
 pub fn soak(
@@ -198,9 +270,7 @@ pub fn soak(
     let start = Instant::now();
     let mut last_report = start;
     let mut settled = false;
-    // A grab lasts a while; its target wanders.
-    let mut grab_left = 0u32;
-    let mut grab_target = Vec3::ZERO;
+    let mut grab = Grabbing::default();
     while start.elapsed() < duration {
         let t = summary.steps as f32 * dt;
         // Gusty wind: the scene's, swelling and turning, with random gusts.
@@ -208,57 +278,7 @@ pub fn soak(
             * (1.0 + (0.7 * t).sin() + if rng.chance(0.02) { 4.0 } else { 0.0 });
         env.wind.direction = Vec3::new((0.3 * t).sin(), 0.0, (0.3 * t).cos());
         // What the player does.
-        if grab_left > 0 {
-            grab_left -= 1;
-            grab_target += Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0) * 0.01;
-            cloth.drag_grab(grab_target);
-            if grab_left == 0 {
-                cloth.release_grab();
-            }
-        } else if rng.chance(0.01) {
-            let i = rng.below(cloth.particle_count()) as u32;
-            if cloth.grab(i) {
-                summary.grabs += 1;
-                grab_left = 20 + rng.below(100) as u32;
-                grab_target = cloth.positions()[i as usize];
-            }
-        }
-        if rng.chance(0.005) {
-            // A stroke through the cloth's middle from a camera in front of it.
-            let (centre, radius) = cloth.bounding_sphere();
-            let eye = centre + Vec3::Z * (3.0 * radius + 1.0);
-            let far = |rng: &mut Rng| {
-                let aim =
-                    centre + Vec3::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0), 0.0) * radius;
-                eye + (aim - eye) * 3.0
-            };
-            let (b, c) = (far(&mut rng), far(&mut rng));
-            summary.cuts += 1;
-            summary.springs_cut += cloth.cut(eye, b, c) as u64;
-        }
-        if rng.chance(0.004) {
-            let before = *cloth.params();
-            let params = random_params(&mut rng, &base, grid);
-            cloth
-                .set_params(&params)
-                .map_err(|e| format!("a valid edit was refused: {e}"))?;
-            summary.edits += 1;
-            if std::mem::discriminant(&before.model) != std::mem::discriminant(&params.model) {
-                summary.model_switches += 1;
-            }
-        }
-        if rng.chance(0.002) {
-            let before = *cloth.params();
-            let params = invalid_params(&mut rng, &before);
-            match cloth.set_params(&params) {
-                Err(_) if *cloth.params() == before => summary.refused_edits += 1,
-                _ => summary.accepted_invalid_edits += 1,
-            }
-        }
-        if rng.chance(0.001) {
-            cloth.reset();
-            summary.resets += 1;
-        }
+        act(cloth, &mut rng, &mut summary, &mut grab, (&base, grid))?;
         let clock = Instant::now();
         cloth.step(dt, &env);
         let torn = cloth.last_torn().len() as u64;

@@ -93,11 +93,17 @@ pub(crate) fn accuracy(args: AccuracyArgs) -> Result<(), String> {
     if args.output.json {
         return print_json(&serde_json::json!({ "references": references, "rows": rows }));
     }
+    print_tables(&references, &rows, repeats);
+    Ok(())
+}
+
+/// The references' table, then every configuration's cost and errors.
+fn print_tables(references: &[accuracy::Reference], rows: &[accuracy::Row], repeats: usize) {
     println!(
         "| scene | reference substeps per step | its change when halved | smallest error reported | converged (< 5%) |"
     );
     println!("|---|---:|---:|---:|---|");
-    for r in &references {
+    for r in references {
         println!(
             "| {} | {} | {:.2e} | {:.2e} | {} |",
             r.scene,
@@ -112,7 +118,7 @@ pub(crate) fn accuracy(args: AccuracyArgs) -> Result<(), String> {
         "| scene | model | configuration | ms per simulated s, median [fastest–slowest of {repeats}] | substeps | error | final drape error | max strain | energy drift | Pareto |"
     );
     println!("|---|---|---|---:|---:|---:|---:|---:|---:|---|");
-    for r in &rows {
+    for r in rows {
         let error = match (r.error, r.failed_at) {
             (Some(e), _) => format!("{e:.2e}"),
             (None, Some(t)) => format!("fails at {t:.2} s"),
@@ -134,5 +140,4 @@ pub(crate) fn accuracy(args: AccuracyArgs) -> Result<(), String> {
             if r.pareto { "yes" } else { "" }
         );
     }
-    Ok(())
 }

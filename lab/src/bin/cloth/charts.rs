@@ -169,6 +169,16 @@ pub fn bench(png: &Path, cells: &[BenchCell], app: &[AppFrame]) -> Result<()> {
     both(png, (1100, 750), &Bench { cells, app })
 }
 
+/// The bench models' names in the legend, in the order of `BENCH_MODELS`.
+const BENCH_NAMES: [&str; 6] = [
+    "1 mass-spring",
+    "2 shape matching (α = 1280 N/m)",
+    "3a patches 2×2",
+    "3b patches 4×4",
+    "3c patches 8×8",
+    "x XPBD (auto substeps)",
+];
+
 struct Bench<'a> {
     cells: &'a [BenchCell],
     app: &'a [AppFrame],
@@ -203,14 +213,6 @@ impl Chart for Bench<'_> {
             .axis_desc_style((FONT, 17))
             .draw()
             .map_err(err)?;
-        let names = [
-            "1 mass-spring",
-            "2 shape matching (α = 1280 N/m)",
-            "3a patches 2×2",
-            "3b patches 4×4",
-            "3c patches 8×8",
-            "x XPBD (auto substeps)",
-        ];
         for (m, model) in BENCH_MODELS.iter().enumerate() {
             let color = PALETTE[m];
             let ours: Vec<(f64, f64)> = cells
@@ -222,7 +224,7 @@ impl Chart for Bench<'_> {
                 chart
                     .draw_series(LineSeries::new(ours.clone(), color.stroke_width(2)))
                     .map_err(err)?
-                    .label(names[m])
+                    .label(BENCH_NAMES[m])
                     .legend(move |(x, y)| {
                         PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
                     });
@@ -243,30 +245,7 @@ impl Chart for Bench<'_> {
                     .legend(|(x, y)| TriangleMarker::new((x + 10, y), 6, BLACK.stroke_width(2)));
             }
         }
-        let mut app_models: Vec<&str> = app.iter().map(|a| a.model.as_str()).collect();
-        app_models.dedup();
-        for (i, model) in app_models.iter().enumerate() {
-            let color = if i == 0 {
-                BLACK
-            } else {
-                RGBColor(120, 120, 120)
-            };
-            let line: Vec<(f64, f64)> = app
-                .iter()
-                .filter(|a| a.model == *model)
-                .filter_map(|a| Some((a.particles as f64, a.ms_per_frame?)))
-                .collect();
-            chart
-                .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
-                .map_err(err)?
-                .label(format!("full app, model {model}: ms per frame"))
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
-                });
-            chart
-                .draw_series(line.iter().map(|&p| Circle::new(p, 4, color.filled())))
-                .map_err(err)?;
-        }
+        draw_app_lines(&mut chart, app)?;
         chart
             .draw_series(SEED_002_FPS.iter().map(|&(c, f)| {
                 EmptyElement::at((c as f64, 1e3 / f))
@@ -280,6 +259,38 @@ impl Chart for Bench<'_> {
         legend(&mut chart, SeriesLabelPosition::UpperLeft, 15)?;
         Ok(())
     }
+}
+
+/// The full app's ms per frame, a line per model (black, then grey).
+fn draw_app_lines<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>,
+    app: &[AppFrame],
+) -> Result<()> {
+    let mut app_models: Vec<&str> = app.iter().map(|a| a.model.as_str()).collect();
+    app_models.dedup();
+    for (i, model) in app_models.iter().enumerate() {
+        let color = if i == 0 {
+            BLACK
+        } else {
+            RGBColor(120, 120, 120)
+        };
+        let line: Vec<(f64, f64)> = app
+            .iter()
+            .filter(|a| a.model == *model)
+            .filter_map(|a| Some((a.particles as f64, a.ms_per_frame?)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(line.clone(), color.stroke_width(2)))
+            .map_err(err)?
+            .label(format!("full app, model {model}: ms per frame"))
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
+        chart
+            .draw_series(line.iter().map(|&p| Circle::new(p, 4, color.filled())))
+            .map_err(err)?;
+    }
+    Ok(())
 }
 
 // ----- accuracy -----------------------------------------------------------------------
@@ -338,26 +349,7 @@ impl Chart for Accuracy<'_> {
                     Some(PathElement::new(vec![(lo, *e), (hi, *e)], BLACK.mix(0.5)))
                 }))
                 .map_err(err)?;
-            let mut frontier: Vec<(f64, f64)> = ok
-                .iter()
-                .filter(|(r, _, _)| r.pareto)
-                .map(|(_, ms, e)| (*ms, *e))
-                .collect();
-            frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
-            let mut stairs = Vec::new();
-            for (i, p) in frontier.iter().enumerate() {
-                if i > 0 {
-                    stairs.push((p.0, frontier[i - 1].1));
-                }
-                stairs.push(*p);
-            }
-            chart
-                .draw_series(LineSeries::new(stairs, BLACK.stroke_width(1)))
-                .map_err(err)?
-                .label("Pareto frontier")
-                .legend(|(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1))
-                });
+            draw_frontier(&mut chart, &ok)?;
             for (m, model) in ACCURACY_MODELS.iter().enumerate() {
                 let color = PALETTE[m];
                 let points: Vec<(f64, f64)> = ok
@@ -392,6 +384,32 @@ impl Chart for Accuracy<'_> {
         }
         Ok(())
     }
+}
+
+/// The Pareto frontier of `ok` (row, ms, error) as a staircase.
+fn draw_frontier<'a, DB: DrawingBackend + 'a>(
+    chart: &mut ChartContext<'a, DB, LogLog>,
+    ok: &[(&Row, f64, f64)],
+) -> Result<()> {
+    let mut frontier: Vec<(f64, f64)> = ok
+        .iter()
+        .filter(|(r, _, _)| r.pareto)
+        .map(|(_, ms, e)| (*ms, *e))
+        .collect();
+    frontier.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut stairs = Vec::new();
+    for (i, p) in frontier.iter().enumerate() {
+        if i > 0 {
+            stairs.push((p.0, frontier[i - 1].1));
+        }
+        stairs.push(*p);
+    }
+    chart
+        .draw_series(LineSeries::new(stairs, BLACK.stroke_width(1)))
+        .map_err(err)?
+        .label("Pareto frontier")
+        .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(1)));
+    Ok(())
 }
 
 // ----- stability ----------------------------------------------------------------------

@@ -1,5 +1,7 @@
 //! `cloth choose`: the cheapest configuration of a scene's cloth within an error, or the most accurate within a cost.
 
+use std::path::Path;
+
 use std::path::PathBuf;
 
 use clap::Args;
@@ -42,6 +44,12 @@ pub(crate) struct ChooseArgs {
 /// then the configuration the goal asks for ([`bevy_cloth_lab::choose::pick`]).
 pub(crate) fn choose(args: ChooseArgs) -> Result<(), String> {
     use bevy_cloth_lab::choose::{self, Goal};
+    // Refused before any work.
+    let goal = match (args.max_error, args.budget_ms) {
+        (Some(e), _) => Goal::MaxError(e as f64),
+        (None, Some(b)) => Goal::BudgetMs(b as f64),
+        (None, None) => return Err("give --max-error or --budget-ms".into()),
+    };
     let scene = ClothScene::load(&args.scene).map_err(|e| e.to_string())?;
     let Some(entry) = scene.cloths.get(args.cloth) else {
         return Err(format!(
@@ -67,11 +75,6 @@ pub(crate) fn choose(args: ChooseArgs) -> Result<(), String> {
     let (reference, rows) = accuracy::measure(&case, &configs, args.repeats, |_| bar.inc(1))
         .map_err(|e| e.to_string())?;
     bar.finish_and_clear();
-    let goal = match (args.max_error, args.budget_ms) {
-        (Some(e), _) => Goal::MaxError(e as f64),
-        (None, Some(b)) => Goal::BudgetMs(b as f64),
-        (None, None) => return Err("give --max-error or --budget-ms".into()),
-    };
     let timestep = scene.timestep as f64;
     let chosen = choose::pick(&rows, goal, timestep);
     let overrides = chosen
@@ -92,42 +95,11 @@ pub(crate) fn choose(args: ChooseArgs) -> Result<(), String> {
             "overrides": overrides,
         }))?;
     } else {
-        println!(
-            "{name}: reference {} substeps per step, its change when halved {:.2e} ({})",
-            reference.substeps,
-            reference.halving_change,
-            if reference.converged {
-                "converged"
-            } else {
-                "not converged: errors below that cannot be told apart"
-            }
-        );
-        println!();
-        println!("| model | configuration | ms per step | error | within |");
-        println!("|---|---|---:|---:|---|");
-        for (i, r) in rows.iter().enumerate() {
-            let ms = r.ms_per_second.map(|ms| ms * timestep);
-            let within = ms.zip(r.error).is_some_and(|(ms, e)| goal.admits(ms, e));
-            println!(
-                "| {} | {} | {} | {} | {}{} |",
-                r.model,
-                r.label,
-                ms.map_or("-".into(), |ms| format!("{ms:.3}")),
-                r.error.map_or("failed".into(), |e| format!("{e:.2e}")),
-                if within { "yes" } else { "" },
-                if chosen == Some(i) { " ← chosen" } else { "" }
-            );
-        }
-        println!();
+        print_reference(&name, &reference);
+        print_rows(&rows, goal, timestep, chosen);
         if let Some(i) = chosen {
-            println!("chosen: {} {}", configs[i].model, configs[i].label);
-            println!("overrides:");
-            for o in &overrides {
-                println!("  --set '{o}'");
-            }
-            if let Some(file) = &args.write {
-                println!("wrote {}", file.display());
-            }
+            let write = args.write.as_deref();
+            print_chosen(configs[i].model, &configs[i].label, &overrides, write);
         }
     }
     match chosen {
@@ -136,5 +108,57 @@ pub(crate) fn choose(args: ChooseArgs) -> Result<(), String> {
             Goal::MaxError(e) => format!("no configuration is within an error of {e}"),
             Goal::BudgetMs(b) => format!("no configuration costs {b} ms per step or less"),
         }),
+    }
+}
+
+/// The reference's substeps and how converged it is.
+fn print_reference(name: &str, reference: &accuracy::Reference) {
+    println!(
+        "{name}: reference {} substeps per step, its change when halved {:.2e} ({})",
+        reference.substeps,
+        reference.halving_change,
+        if reference.converged {
+            "converged"
+        } else {
+            "not converged: errors below that cannot be told apart"
+        }
+    );
+    println!();
+}
+
+/// Every configuration's cost and error, marking those the goal admits and the chosen.
+fn print_rows(
+    rows: &[accuracy::Row],
+    goal: bevy_cloth_lab::choose::Goal,
+    timestep: f64,
+    chosen: Option<usize>,
+) {
+    println!("| model | configuration | ms per step | error | within |");
+    println!("|---|---|---:|---:|---|");
+    for (i, r) in rows.iter().enumerate() {
+        let ms = r.ms_per_second.map(|ms| ms * timestep);
+        let within = ms.zip(r.error).is_some_and(|(ms, e)| goal.admits(ms, e));
+        println!(
+            "| {} | {} | {} | {} | {}{} |",
+            r.model,
+            r.label,
+            ms.map_or("-".into(), |ms| format!("{ms:.3}")),
+            r.error.map_or("failed".into(), |e| format!("{e:.2e}")),
+            if within { "yes" } else { "" },
+            if chosen == Some(i) { " ← chosen" } else { "" }
+        );
+    }
+    println!();
+}
+
+/// The chosen configuration, the `--set` overrides that give it, and the file written.
+fn print_chosen(model: &str, label: &str, overrides: &[String], write: Option<&Path>) {
+    println!("chosen: {model} {label}");
+    println!("overrides:");
+    for o in overrides {
+        println!("  --set '{o}'");
+    }
+    if let Some(file) = write {
+        println!("wrote {}", file.display());
     }
 }

@@ -41,30 +41,7 @@ pub(crate) fn peers(args: PeersArgs) -> Result<(), String> {
         .into_iter()
         .filter(|p| solvers.contains(&p.key()))
         .collect();
-    let bar = progress(configs.len() * args.sides.len(), "runs");
-    let mut rows: Vec<PeerRow> = Vec::new();
-    for &side in &args.sides {
-        for &peer in &configs {
-            let row = peers::measure(side, args.hang, peer, args.frames)?;
-            bar.suspend(|| {
-                eprintln!(
-                    "  {:>6} {:<26} {:<26} {}",
-                    side * side,
-                    row.solver,
-                    row.label,
-                    match (&row.failed, row.ms, row.strain) {
-                        (Some(why), _, _) => format!("failed: {why}"),
-                        (None, Some(ms), Some(strain)) =>
-                            format!("{ms:.3} ms  strain {:.3}%", strain * 100.0),
-                        _ => String::new(),
-                    }
-                )
-            });
-            bar.inc(1);
-            rows.push(row);
-        }
-    }
-    bar.finish_and_clear();
+    let rows = measure_all(&configs, &args.sides, args.hang, args.frames)?;
     if let Some(chart) = &args.output.chart {
         charts::peers(chart, &rows)?;
     }
@@ -84,12 +61,53 @@ pub(crate) fn peers(args: PeersArgs) -> Result<(), String> {
         peers::WARMUP_FRAMES,
         solver::threads()
     );
+    print_rows(&rows);
+    print_best(&best);
+    Ok(())
+}
+
+/// Every configuration on every side, a line on stderr per run.
+fn measure_all(
+    configs: &[Peer],
+    sides: &[usize],
+    hang: Hang,
+    frames: usize,
+) -> Result<Vec<PeerRow>, String> {
+    let bar = progress(configs.len() * sides.len(), "runs");
+    let mut rows: Vec<PeerRow> = Vec::new();
+    for &side in sides {
+        for &peer in configs {
+            let row = peers::measure(side, hang, peer, frames)?;
+            bar.suspend(|| {
+                eprintln!(
+                    "  {:>6} {:<26} {:<26} {}",
+                    side * side,
+                    row.solver,
+                    row.label,
+                    match (&row.failed, row.ms, row.strain) {
+                        (Some(why), _, _) => format!("failed: {why}"),
+                        (None, Some(ms), Some(strain)) =>
+                            format!("{ms:.3} ms  strain {:.3}%", strain * 100.0),
+                        _ => String::new(),
+                    }
+                )
+            });
+            bar.inc(1);
+            rows.push(row);
+        }
+    }
+    bar.finish_and_clear();
+    Ok(rows)
+}
+
+/// Every run's cost, strain and sag.
+fn print_rows(rows: &[PeerRow]) {
     println!();
     println!(
         "| particles | solver | configuration | ms per frame, median [p10–p90] | ns per projection | strain | sag |"
     );
     println!("|---:|---|---|---:|---:|---:|---:|");
-    for r in &rows {
+    for r in rows {
         let (time, ns, strain, sag) = match (r.ms, r.ms_spread, r.strain, r.sag) {
             (Some(ms), Some((lo, hi)), Some(strain), Some(sag)) => (
                 format!("{ms:.3} [{lo:.3}–{hi:.3}]"),
@@ -112,6 +130,10 @@ pub(crate) fn peers(args: PeersArgs) -> Result<(), String> {
             r.label
         );
     }
+}
+
+/// Each solver's cheapest configuration within each strain, against rapier-cloth-core's.
+fn print_best(best: &[peers::Cheapest]) {
     println!();
     println!(
         "The cheapest configuration of each solver within a strain, and rapier-cloth-core's cost over its:"
@@ -121,7 +143,7 @@ pub(crate) fn peers(args: PeersArgs) -> Result<(), String> {
         "| particles | strain within | solver | configuration | ms per frame | strain | rapier / it |"
     );
     println!("|---:|---:|---|---|---:|---:|---:|");
-    for b in &best {
+    for b in best {
         println!(
             "| {} | {}% | {} | {} | {:.3} | {:.3}% | {} |",
             b.side * b.side,
@@ -133,5 +155,4 @@ pub(crate) fn peers(args: PeersArgs) -> Result<(), String> {
             b.rapier_over.map_or("-".into(), |r| format!("{r:.2}x"))
         );
     }
-    Ok(())
 }

@@ -1,6 +1,7 @@
 //! `cloth stability`: where each method fails, the linear and the nonlinear stability maps.
 
 use clap::Args;
+use indicatif::ProgressBar;
 
 use crate::args::*;
 use crate::charts;
@@ -20,17 +21,62 @@ pub(crate) struct StabilityArgs {
 
 pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
     let models = or_all(args.models, &MODELS);
-    let in_list = |model: &str| models.iter().any(|m| model.split(' ').next() == Some(*m));
     let per_map = STIFFNESS.len() * MASS.len();
-    let nonlinear_models = NONLINEAR_MODELS.iter().filter(|m| in_list(m)).count();
+    let nonlinear_models = NONLINEAR_MODELS
+        .iter()
+        .filter(|m| in_list(&models, m))
+        .count();
     let bar = progress(
         per_map
             * (models.len() * 4 * TIMESTEP.len()
                 + Regime::NONLINEAR.len() * nonlinear_models * NONLINEAR_TIMESTEP.len()),
         "cells",
     );
+    let cells = linear_cells(&models, &bar)?;
+    let nonlinear = nonlinear_cells(&models, &bar)?;
+    bar.finish_and_clear();
+    let thresholds = thresholds()?;
+    // XPBD's panel shows the mass-spring lattice's explicit bound, which it ignores.
+    let lattice = stability::lattice_factor();
+    let factors = [lattice, 1.0, 1.0, lattice];
+    if let Some(chart) = &args.output.chart {
+        charts::stability(chart, &cells, &factors)?;
+        let stem = chart
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("stability");
+        charts::stability_nonlinear(
+            &chart.with_file_name(format!("{stem}_nonlinear.png")),
+            &nonlinear,
+        )?;
+    }
+    if args.output.json {
+        return print_json(&serde_json::json!({
+            "cells": cells,
+            "nonlinear": nonlinear,
+            "thresholds": thresholds,
+            "lattice_factor": factors[0],
+        }));
+    }
+    print_linear(&models, &cells);
+    print_nonlinear(&models, &nonlinear);
+    print_thresholds(factors[0], &thresholds);
+    Ok(())
+}
+
+/// Whether `model` (a name, perhaps followed by its variant) is among `models`.
+fn in_list(models: &[&str], model: &str) -> bool {
+    models.iter().any(|m| model.split(' ').next() == Some(*m))
+}
+
+/// The linear regime's maps: every model, integrator and substep rule over the stiffness,
+/// mass and timestep grid; a line on stderr per map.
+fn linear_cells(
+    models: &[&'static str],
+    bar: &ProgressBar,
+) -> Result<Vec<stability::Cell>, String> {
     let mut cells = Vec::new();
-    for &model in &models {
+    for &model in models {
         for integrator in Integrator::ALL {
             for auto in [false, true] {
                 let (mut failed, mut total) = (0, 0);
@@ -56,10 +102,14 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
             }
         }
     }
-    // The nonlinear regimes: Verlet with automatic substeps, the claim under test.
+    Ok(cells)
+}
+
+/// The nonlinear regimes: Verlet with automatic substeps, the claim under test.
+fn nonlinear_cells(models: &[&str], bar: &ProgressBar) -> Result<Vec<stability::Cell>, String> {
     let mut nonlinear = Vec::new();
     for regime in Regime::NONLINEAR {
-        for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(m)) {
+        for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(models, m)) {
             let mut here = Vec::new();
             for &k in &STIFFNESS {
                 for &m in &MASS {
@@ -87,7 +137,12 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
             nonlinear.extend(here);
         }
     }
-    bar.finish_and_clear();
+    Ok(nonlinear)
+}
+
+/// The measured stability thresholds of a single spring and of the lattice, against
+/// their predictions.
+fn thresholds() -> Result<Vec<stability::Threshold>, String> {
     let mut thresholds = Vec::new();
     for integrator in Integrator::ALL {
         for (k, m) in [(100.0, 1e-3), (1_000.0, 1e-4), (25_000.0, 1e-6)] {
@@ -95,35 +150,18 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
             thresholds.push(stability::lattice(k, m, integrator).map_err(|e| e.to_string())?);
         }
     }
-    // XPBD's panel shows the mass-spring lattice's explicit bound, which it ignores.
-    let lattice = stability::lattice_factor();
-    let factors = [lattice, 1.0, 1.0, lattice];
-    if let Some(chart) = &args.output.chart {
-        charts::stability(chart, &cells, &factors)?;
-        let stem = chart
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("stability");
-        charts::stability_nonlinear(
-            &chart.with_file_name(format!("{stem}_nonlinear.png")),
-            &nonlinear,
-        )?;
-    }
-    if args.output.json {
-        return print_json(&serde_json::json!({
-            "cells": cells,
-            "nonlinear": nonlinear,
-            "thresholds": thresholds,
-            "lattice_factor": factors[0],
-        }));
-    }
+    Ok(thresholds)
+}
+
+/// The linear regime's table.
+fn print_linear(models: &[&str], cells: &[stability::Cell]) {
     println!("Linear regime (free 12×12 cloth, 1% perturbation, no gravity, no limiter):");
     println!();
     println!(
         "| model | integrator | substeps | failed cells | over the substep cap | first failure: smallest ω₀·h that failed | largest ω₀·h that ran stable |"
     );
     println!("|---|---|---|---:|---:|---:|---:|");
-    for &model in &models {
+    for &model in models {
         for integrator in Integrator::ALL {
             for auto in [false, true] {
                 let here: Vec<_> = cells
@@ -156,6 +194,10 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
             }
         }
     }
+}
+
+/// The nonlinear regimes' table (none when no model of them was asked for).
+fn print_nonlinear(models: &[&str], nonlinear: &[stability::Cell]) {
     if !nonlinear.is_empty() {
         println!();
         println!(
@@ -170,7 +212,7 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
         );
         println!("|---|---|---:|---:|---:|---:|---|");
         for regime in Regime::NONLINEAR {
-            for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(m)) {
+            for model in NONLINEAR_MODELS.into_iter().filter(|m| in_list(models, m)) {
                 let here: Vec<_> = nonlinear
                     .iter()
                     .filter(|c| c.regime == regime && c.model == model)
@@ -204,18 +246,22 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
             }
         }
     }
+}
+
+/// The lattice's factor and the thresholds' table.
+fn print_thresholds(lattice_factor: f32, thresholds: &[stability::Threshold]) {
     println!();
     println!(
         "ω_max/√(k/m) of the {0}×{0} lattice: {1:.3}",
         stability::PROBE_SIZE,
-        factors[0]
+        lattice_factor
     );
     println!();
     println!(
         "| case | k, N/m | m, g | ω_max, rad/s | predicted 2/ω_max, ms | auto substeps' bound, ms | measured, ms | measured / predicted |"
     );
     println!("|---|---:|---:|---:|---:|---:|---:|---:|");
-    for t in &thresholds {
+    for t in thresholds {
         println!(
             "| {} | {} | {:.3} | {:.0} | {:.4} | {:.4} | {:.4} | {:.3} |",
             t.case,
@@ -228,5 +274,4 @@ pub(crate) fn stability(args: StabilityArgs) -> Result<(), String> {
             t.measured / t.predicted
         );
     }
-    Ok(())
 }
