@@ -153,14 +153,3 @@ pub enum ClothError {
         message: String,
     },
 }
-
-/// A multi-line message (a command-line parser's, with its usage block) folded onto one
-/// line, without its leading `error: `: every bad input is reported in one line.
-pub fn one_line(message: &str) -> String {
-    let lines: Vec<&str> = message
-        .lines()
-        .map(str::trim)
-        .take_while(|l| !l.is_empty() && !l.starts_with("Usage:"))
-        .collect();
-    lines.join(" ").trim_start_matches("error: ").to_string()
-}

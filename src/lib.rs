@@ -39,6 +39,8 @@ mod ecs;
 pub mod error;
 pub mod fabric;
 pub mod headless;
+#[doc(hidden)]
+pub mod lab;
 pub mod layout;
 pub mod limits;
 pub mod params;
@@ -63,10 +65,10 @@ pub mod prelude {
     pub use crate::ecs::avian::ClothAvianPlugin;
     pub use crate::ecs::{
         AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBecameInvalid,
-        ClothBuilt, ClothCollider, ClothColliderSpan, ClothControlsPlugin, ClothEnvironment,
-        ClothFellAsleep, ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause,
-        ClothPlugin, ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems,
-        ClothSystems, ClothTorn, ClothWake,
+        ClothBuilt, ClothCollider, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
+        ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
+        ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
+        ClothTorn, ClothWake,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;

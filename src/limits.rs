@@ -94,7 +94,7 @@ use std::io::Read;
 
 /// Reads a file whole, refusing one over [`MAX_FILE_BYTES`] without reading more than
 /// that (a device such as `/dev/zero` reports no size and never ends).
-pub fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
+pub(crate) fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
     let mut bytes = Vec::new();
     std::fs::File::open(path)?
         .take(MAX_FILE_BYTES + 1)
@@ -108,13 +108,13 @@ pub fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
 }
 
 /// [`read_file`] as UTF-8 text.
-pub fn read_text(path: &std::path::Path) -> std::io::Result<String> {
+pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     String::from_utf8(read_file(path)?)
         .map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
 }
 /// The most automatic substeps a cloth of `particles` may take per step: its `max`,
 /// lowered to keep particles × substeps within [`MAX_WORK_PER_STEP`] (at least 1).
-pub fn auto_substeps_cap(particles: usize, max: u32) -> u32 {
+pub(crate) fn auto_substeps_cap(particles: usize, max: u32) -> u32 {
     let budget = MAX_WORK_PER_STEP / (particles.max(1) as u64);
     max.min(budget.min(u32::MAX as u64) as u32).max(1)
 }

@@ -1,6 +1,7 @@
 //! Small statistics shared by the live stats and the measurements.
 
 /// The median of `values` (the upper one of an even count; 0 for none); reorders them.
+#[doc(hidden)]
 pub fn median<T: Copy + Default + PartialOrd>(values: &mut [T]) -> T {
     if values.is_empty() {
         return T::default();

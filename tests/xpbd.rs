@@ -324,7 +324,7 @@ fn the_energy_of_a_free_undamped_cloth_does_not_grow_over_ten_thousand_steps() {
         .build_solver(&ClothPins::None, &params, Affine3A::IDENTITY)
         .unwrap();
     for (i, x) in cloth.particles_mut().position.iter_mut().enumerate() {
-        let offset = |axis| bevy_cloth::solver::unit_hash(i, axis) * 0.01;
+        let offset = |axis| bevy_cloth::lab::unit_hash(i, axis) * 0.01;
         *x += Vec3::new(offset(0), offset(1), offset(2));
     }
     let env = Environment {

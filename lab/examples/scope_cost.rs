@@ -6,7 +6,7 @@
 use std::time::{Duration, Instant};
 
 fn main() {
-    let pool = bevy_cloth::solver::task_pool();
+    let pool = bevy_cloth::lab::task_pool();
     println!("pool threads: {}", pool.thread_num());
     for gap in [Duration::ZERO, Duration::from_micros(100)] {
         let mut total = Duration::ZERO;

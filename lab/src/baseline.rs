@@ -7,7 +7,7 @@
 use std::time::Instant;
 
 use crate::grid_for;
-use bevy_cloth::stats::median;
+use bevy_cloth::lab::median;
 
 /// A grid cloth reduced to the arithmetic of one mass-spring substep.
 pub struct BareGrid {

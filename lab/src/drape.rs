@@ -154,7 +154,7 @@ fn specimen(
     let p = cloth.particles_mut();
     for i in 0..p.len() {
         if p.inv_mass[i] > 0.0 {
-            let lift = 0.001 * bevy_cloth::solver::unit_hash(i, seed);
+            let lift = 0.001 * bevy_cloth::lab::unit_hash(i, seed);
             p.position[i].y += lift;
             p.previous[i].y += lift;
         }

@@ -27,7 +27,7 @@ use bevy_cloth::params::{
 use bevy_cloth::solver;
 
 pub use bevy_cloth::headless::SceneRun;
-pub use bevy_cloth::stats::median;
+pub use bevy_cloth::lab::median;
 
 /// The models of Sladović's (2014) timing table (fig. 23): 1 mass-spring, 2 shape matching,
 /// 3a–3c patches of 2×2, 4×4 and 8×8 particles.

@@ -26,11 +26,11 @@ use bevy::math::{Affine3A, Quat, Vec3};
 use serde::Serialize;
 
 use bevy_cloth::error::ClothError;
+use bevy_cloth::lab::median;
 use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{
     ClothParams, Environment, Model, SpringFamily, Substeps, XpbdParams, XpbdSolve,
 };
-use bevy_cloth::stats::median;
 
 /// Rest spacing of the grid, m.
 pub const SPACING: f32 = 0.05;

@@ -174,9 +174,9 @@ pub fn perturb(cloth: &mut solver::ClothSolver, spacing: f32, fraction: f32) {
             continue;
         }
         let offset = Vec3::new(
-            solver::unit_hash(i, 0),
-            solver::unit_hash(i, 1),
-            solver::unit_hash(i, 2),
+            bevy_cloth::lab::unit_hash(i, 0),
+            bevy_cloth::lab::unit_hash(i, 1),
+            bevy_cloth::lab::unit_hash(i, 2),
         ) * (spacing * fraction);
         p.position[i] += offset;
         p.previous[i] = p.position[i];

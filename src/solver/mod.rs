@@ -38,12 +38,18 @@ pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};
 pub use drivers::interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
-pub use many::{begin_cloths, begin_together, run_cloths, substep_together};
+pub(crate) use many::{begin_cloths, run_cloths};
+pub use many::{begin_together, substep_together};
 pub use models::{patches, shape_matching};
-pub use parallel::{for_each_indexed, pool as task_pool, set_parallel, threads};
+pub(crate) use parallel::for_each_indexed;
+pub use parallel::{set_parallel, threads};
+// Used by the lab through `crate::lab`: hidden from the docs.
+#[doc(hidden)]
+pub use parallel::pool as task_pool;
 pub use self_contact::{collide_cloths, exchange_cloths};
 pub use state::Particles;
 pub use steps::{StageTimes, StepReport};
+#[doc(hidden)]
 pub use substeps::unit_hash;
 pub use topology::{SpringKind, Springs};
 

@@ -103,7 +103,7 @@ fn main() -> ExitCode {
         }
         Err(e) => {
             // One line naming the problem, as for every other bad input.
-            let line = bevy_cloth::error::one_line(&e.render().to_string());
+            let line = bevy_cloth::lab::one_line(&e.render().to_string());
             eprintln!("error: {line}");
             return ExitCode::from(2);
         }
