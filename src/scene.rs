@@ -352,6 +352,24 @@ impl ClothScene {
         Some((path, leaf(field), e.to_string()))
     }
 
+    /// More cloths or colliders than [`MAX_SCENE_ITEMS`](crate::limits::MAX_SCENE_ITEMS):
+    /// which, and the message.
+    fn too_many(&self) -> Option<(&'static str, String)> {
+        let max = crate::limits::MAX_SCENE_ITEMS;
+        [
+            ("cloths", self.cloths.len()),
+            ("colliders", self.colliders.len()),
+        ]
+        .into_iter()
+        .find(|&(_, count)| count > max)
+        .map(|(key, count)| {
+            (
+                key,
+                format!("{count} {key}: at most {max} (limits::MAX_SCENE_ITEMS)"),
+            )
+        })
+    }
+
     fn validate(&self, text: &str, file: &Path) -> Result<(), SceneError> {
         let invalid = |field: String, key: &str, message: String, after: usize| {
             // Point at the line of the offending key, searching from the cloth's entry.
@@ -374,6 +392,9 @@ impl ClothScene {
                 format!("must be in (0, 1] s, got {}", self.timestep),
                 0,
             ));
+        }
+        if let Some((key, message)) = self.too_many() {
+            return Err(invalid(key.into(), key, message, 0));
         }
         if let Err(e) = self.environment.validate() {
             let field = error_field(&e);

@@ -1,8 +1,12 @@
 //! Scene files: the shipped ones load; malformed ones name the file, line and field.
 
+mod common;
+
 use std::path::Path;
 
-use bevy::prelude::{GlobalTransform, Vec3};
+use common::app;
+
+use bevy::prelude::{Fixed, GlobalTransform, Name, Time, Vec3};
 use bevy_cloth::params::{
     Integrator, Model, ModelKind, PatchTargets, Substeps, WindField, XpbdParams,
 };
@@ -66,6 +70,22 @@ fn bad_values_name_the_field_and_line() {
     assert!(e.to_string().contains("2×2"), "{e}");
     let dt = "(timestep: 0.0, cloths: [])";
     assert!(matches!(parse(dt), Err(SceneError::Invalid { .. })));
+    // More colliders than limits::MAX_SCENE_ITEMS: refused by count, before anything is
+    // placed.
+    let ground = "(collider: (shape: Plane)),";
+    let many = format!(
+        "(cloths: [], colliders: [{}])",
+        ground.repeat(bevy_cloth::limits::MAX_SCENE_ITEMS + 1)
+    );
+    match parse(&many).unwrap_err() {
+        SceneError::Invalid { field, message, .. } => {
+            assert_eq!(field, "colliders");
+            assert!(message.contains("MAX_SCENE_ITEMS"), "{message}");
+        }
+        other => panic!("{other:?}"),
+    }
+    let enough = format!("(cloths: [], colliders: [{}])", ground.repeat(3));
+    assert!(parse(&enough).is_ok());
 }
 
 #[test]
@@ -307,4 +327,49 @@ fn the_readme_quick_start_is_the_quickstart_example() {
         code.trim_start(),
         "README.md's quick start differs from the example"
     );
+}
+
+#[test]
+fn a_scene_spawns_its_cloths_colliders_and_world() {
+    let mut scene = ClothScene::load("assets/scenes/tshirt.ron").unwrap();
+    // Made for another timestep than the app's 16 ms.
+    scene.timestep = 0.01;
+    let mut app = app();
+    let spawned = scene.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    assert_eq!(spawned.cloths.len(), scene.cloths.len());
+    assert_eq!(spawned.colliders.len(), scene.colliders.len());
+    // The garment loads through the asset server, in the background.
+    let start = std::time::Instant::now();
+    while start.elapsed().as_secs() < 10
+        && !spawned
+            .cloths
+            .iter()
+            .all(|&e| app.world().get::<ClothSimulation>(e).is_some())
+    {
+        app.update();
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    for (entry, &entity) in scene.cloths.iter().zip(&spawned.cloths) {
+        let sim = app.world().get::<ClothSimulation>(entity).expect("built");
+        assert!(sim.solver.particle_count() > 0);
+        assert_eq!(
+            app.world().get::<Name>(entity).map(|n| n.as_str()),
+            Some(entry.name.as_str())
+        );
+    }
+    for (entry, &entity) in scene.colliders.iter().zip(&spawned.colliders) {
+        assert_eq!(
+            app.world().get::<ClothCollider>(entity),
+            Some(&entry.collider)
+        );
+    }
+    assert_eq!(
+        app.world().resource::<ClothEnvironment>().0,
+        scene.environment
+    );
+    // Spawning a scene leaves the game's clock alone (a scene made for another timestep
+    // once overwrote it).
+    let fixed = app.world().resource::<Time<Fixed>>().timestep();
+    assert_eq!(fixed, std::time::Duration::from_millis(16));
 }

@@ -1,6 +1,6 @@
 //! The source works' keyboard controls for the simulation (Sladović 2014 §3.1 and its
-//! appendix; Maslova §2.1), as an opt-in plugin for demos and tools: a game keeps its keys
-//! unless it adds it.
+//! appendix; Maslova §2.1), as the examples' plugin: a game has its own keys (this is
+//! example code, through the crate's public API; copy what you like).
 //!
 //! | key | action |
 //! | --- | --- |
@@ -18,7 +18,7 @@
 use bevy::math::{Quat, Vec3};
 use bevy::prelude::*;
 
-use crate::ecs::cloth::{ClothEnvironment, ClothPause, ClothSimulation};
+use bevy_cloth::prelude::*;
 
 /// Adds the keyboard controls. Needs a `ButtonInput<KeyCode>` resource (from
 /// `InputPlugin`, part of `DefaultPlugins`).

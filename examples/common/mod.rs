@@ -11,6 +11,7 @@ use bevy_egui::EguiPlugin;
 use bevy_panorbit_camera::{PanOrbitCamera, PanOrbitCameraPlugin};
 use clap::Parser;
 
+pub mod controls;
 pub mod inspector;
 pub mod tools;
 
@@ -66,7 +67,7 @@ pub fn app_with(title: &str, args: ExampleArgs, cloth: ClothPlugin) -> App {
         EguiPlugin::default(),
         PanOrbitCameraPlugin,
         cloth,
-        ClothControlsPlugin,
+        controls::ClothControlsPlugin,
         inspector::InspectorPlugin,
         ScreenshotPlugin,
     ))
@@ -128,7 +129,10 @@ impl ExampleArgs {
                 let _ = e.print();
                 std::process::exit(0);
             }
-            fail(&bevy_cloth::error::one_line(&e.render().to_string()))
+            // clap's first line names the problem (a usage block follows).
+            let message = e.render().to_string();
+            let first = message.lines().next().unwrap_or_default();
+            fail(first.trim_start_matches("error: "))
         });
         let env_frames = std::env::var("CLOTH_FRAMES")
             .ok()

@@ -1,6 +1,5 @@
 //! The Bevy layer, one file per feature: the cloth components, `ClothPlugin` with its
-//! system sets and systems, the render mesh written in place, and the opt-in keyboard
-//! controls. It owns each solver inside a component and knows nothing of how a layout is
+//! system sets and systems, the render mesh written in place. It owns each solver inside a component and knows nothing of how a layout is
 //! made. Its public items are re-exported at the crate's root.
 
 pub(crate) mod attach;
@@ -9,7 +8,6 @@ pub mod avian;
 pub(crate) mod build;
 pub(crate) mod cloth;
 pub(crate) mod colliders;
-pub(crate) mod controls;
 pub(crate) mod events;
 pub(crate) mod lod;
 pub(crate) mod mesh;
@@ -27,7 +25,6 @@ pub use cloth::{
 pub use colliders::{
     ClothCollider, ClothColliderSpan, ClothCollidersPlugin, ColliderKind, TELEPORT_SPEED,
 };
-pub use controls::{ClothControls, ClothControlsPlugin};
 pub use events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
 pub use lod::{ClothLod, ClothLodPlugin};
 pub use mesh::ClothMeshPlugin;

@@ -160,9 +160,25 @@ pub(crate) fn begin_steps(
     }
 }
 
-/// The plugin's own systems in the [`ClothSubstep`] schedule (`substep_schedule`'s four, one
-/// per stage).
-const OWN_SUBSTEP_SYSTEMS: usize = 4;
+/// Whether every system of the [`ClothSubstep`] schedule is one of the plugin's own four
+/// (`substep_schedule`'s, one per stage), told by their types: then the stages can run
+/// in one pass over the cloths. `false` before the schedule has first run (it is not
+/// initialised until then), which runs the schedule: always right, only slower.
+fn only_own_substep_systems(schedule: &Schedule) -> bool {
+    static OWN: std::sync::OnceLock<[std::any::TypeId; 4]> = std::sync::OnceLock::new();
+    let own = OWN.get_or_init(|| {
+        let id = |system: &dyn System<In = (), Out = ()>| system.system_type();
+        [
+            id(&IntoSystem::into_system(accumulate_forces)),
+            id(&IntoSystem::into_system(integrate)),
+            id(&IntoSystem::into_system(fit_targets)),
+            id(&IntoSystem::into_system(constrain)),
+        ]
+    });
+    schedule
+        .systems()
+        .is_ok_and(|mut systems| systems.all(|(_, system)| own.contains(&system.system_type())))
+}
 
 /// Runs the step's substeps. When a game has put systems between the stages
 /// ([`ClothSubstepSystems`]), every substep runs the [`ClothSubstep`] schedule, each
@@ -179,9 +195,9 @@ pub(crate) fn run_substeps(
         return;
     }
     let schedules = world.resource::<Schedules>();
-    let others = schedules
+    let others = !schedules
         .get(ClothSubstep)
-        .is_none_or(|s| s.systems_len() != OWN_SUBSTEP_SYSTEMS);
+        .is_some_and(only_own_substep_systems);
     if others {
         for index in 0..count {
             world.resource_mut::<ClothSubstepPlan>().index = index;

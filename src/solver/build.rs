@@ -92,7 +92,7 @@ impl ClothSolver {
     pub(super) fn particle_mass(&self, i: usize) -> f32 {
         match &self.params.fabric {
             Some(fabric) => fabric.areal_density * self.structure.area[i],
-            None => self.params.node_mass * self.particles.lump[i],
+            None => self.params.node_mass * self.particles.represents[i],
         }
     }
 

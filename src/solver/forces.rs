@@ -4,7 +4,7 @@
 use bevy::math::Vec3;
 
 use super::parallel;
-use super::state::ParticlePiece;
+use super::state::ParticleChunk;
 use super::{ClothSolver, Particles, SpringKind, Springs};
 use crate::params::{Air, Environment};
 
@@ -24,24 +24,24 @@ impl ClothSolver {
         let has_wind = !held && env.wind.strength > 0.0 && env.wind.direction != Vec3::ZERO;
         let wind = env.wind.at_time(self.clock.time);
         let n = self.particles.len();
-        let kernel = |ParticlePiece {
+        let kernel = |ParticleChunk {
                           force,
                           mass,
-                          lump,
+                          represents,
                           position,
                           ..
                       }| {
             let n = force.len();
-            let (f, mass, lump) = (&mut force[..n], &mass[..n], &lump[..n]);
+            let (f, mass, represents) = (&mut force[..n], &mass[..n], &represents[..n]);
             let x = &position[..n];
             for i in 0..n {
                 f[i] = mass[i] * g;
                 if has_wind {
-                    f[i] += wind.vector_at(x[i]) * lump[i];
+                    f[i] += wind.vector_at(x[i]) * represents[i];
                 }
             }
         };
-        parallel::for_each(n, self.particles.pieces(), kernel);
+        parallel::for_each(n, self.particles.chunks(), kernel);
         if let Some(air) = env.air.as_ref().filter(|_| !held) {
             self.air_forces(air);
         }

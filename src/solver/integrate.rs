@@ -4,14 +4,14 @@
 use bevy::math::Vec3;
 
 use super::parallel;
-use super::state::ParticlePiece;
+use super::state::ParticleChunk;
 use super::{ClothSolver, Particles};
 use crate::params::Integrator;
 
 impl ClothSolver {
     /// Advances every free particle by one substep `h` from its force, by the
     /// integrator the parameters choose, with linear drag `drag` (N·s/m per particle,
-    /// scaled by its lump) taken implicitly.
+    /// scaled by its represents) taken implicitly.
     pub(super) fn integrate_particles(&mut self, drag: f32) {
         let h = self.clock.h;
         match self.params.integrator {
@@ -45,8 +45,8 @@ impl ClothSolver {
 /// any drag, mass and step (explicit `v' = v + h (a − c v/m)` diverges once `h c/m > 2`:
 /// at Maslova's lightest material, 0.001 g, with 0.005 N·s/m drag, from h = 0.4 ms).
 #[inline]
-fn drag_factor(h: f32, drag: f32, lump: f32, inv_mass: f32) -> f32 {
-    1.0 / (1.0 + h * drag * lump * inv_mass)
+fn drag_factor(h: f32, drag: f32, represents: f32, inv_mass: f32) -> f32 {
+    1.0 / (1.0 + h * drag * represents * inv_mass)
 }
 
 /// One Verlet substep of every free particle, in pieces over the compute pool, with
@@ -61,26 +61,31 @@ pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
     // when added, and the plain form then recomputes `x − x_prev = 0`: at 512
     // substeps of 16 ms a curtain at y = 2 m never started to fall (g Δt² = 1e-8
     // m against 1.2e-7 m). What rounding drops is carried to the next substep.
-    let kernel = |ParticlePiece {
+    let kernel = |ParticleChunk {
                       position,
                       previous,
                       residue,
                       velocity,
                       force,
                       inv_mass,
-                      lump,
+                      represents,
                       ..
                   }| {
         let n = position.len();
         let (x, previous, residue) = (&mut position[..n], &mut previous[..n], &mut residue[..n]);
-        let (v, f, w, lump) = (&mut velocity[..n], &force[..n], &inv_mass[..n], &lump[..n]);
+        let (v, f, w, represents) = (
+            &mut velocity[..n],
+            &force[..n],
+            &inv_mass[..n],
+            &represents[..n],
+        );
         for i in 0..n {
             if w[i] == 0.0 {
                 continue;
             }
             // `h v' = (h v + h² a) / (1 + h c/m)`, Verlet's `h v` being `x − x_prev`.
             let step = ((x[i] - previous[i]) + residue[i] + f[i] * (w[i] * h2))
-                * drag_factor(h, drag, lump[i], w[i]);
+                * drag_factor(h, drag, represents[i], w[i]);
             let next = x[i] + step;
             residue[i] = step - (next - x[i]);
             previous[i] = x[i];
@@ -88,7 +93,7 @@ pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
             v[i] = step / h;
         }
     };
-    parallel::for_each(n, p.pieces(), kernel);
+    parallel::for_each(n, p.chunks(), kernel);
 }
 
 /// `x + r += delta`, keeping in `r` what rounding `x` lost (Kahan's compensated sum;
@@ -108,24 +113,29 @@ pub(super) fn compensated_add(x: &mut Vec3, r: &mut Vec3, delta: Vec3) {
 pub(crate) fn symplectic_euler<const COMPENSATED: bool>(p: &mut Particles, h: f32, drag: f32) {
     let n = p.len();
     // Sladović 2014 eq. 21–22: the new velocity first, then the position from it.
-    let kernel = |ParticlePiece {
+    let kernel = |ParticleChunk {
                       position,
                       previous,
                       velocity,
                       residue,
                       force,
                       inv_mass,
-                      lump,
+                      represents,
                       ..
                   }| {
         let n = position.len();
         let (x, previous, v) = (&mut position[..n], &mut previous[..n], &mut velocity[..n]);
-        let (f, w, lump, residue) = (&force[..n], &inv_mass[..n], &lump[..n], &mut residue[..n]);
+        let (f, w, represents, residue) = (
+            &force[..n],
+            &inv_mass[..n],
+            &represents[..n],
+            &mut residue[..n],
+        );
         for i in 0..n {
             if w[i] == 0.0 {
                 continue;
             }
-            v[i] = (v[i] + f[i] * (w[i] * h)) * drag_factor(h, drag, lump[i], w[i]);
+            v[i] = (v[i] + f[i] * (w[i] * h)) * drag_factor(h, drag, represents[i], w[i]);
             previous[i] = x[i];
             if COMPENSATED {
                 compensated_add(&mut x[i], &mut residue[i], v[i] * h);
@@ -134,7 +144,7 @@ pub(crate) fn symplectic_euler<const COMPENSATED: bool>(p: &mut Particles, h: f3
             }
         }
     };
-    parallel::for_each(n, p.pieces(), kernel);
+    parallel::for_each(n, p.chunks(), kernel);
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@ use bevy::tasks::{ComputeTaskPool, TaskPool, TaskPoolBuilder};
 /// of it, small enough that two threads share the work evenly (measured on the 65,536
 /// curtain, 4 limiter sweeps on two cores: 60 ns per particle-substep at 2,048 against
 /// 70 at 1,024 and 80–89 at 16,384; `lab/examples/prof.rs`).
-pub(super) const PIECE: usize = 2048;
+pub(super) const CHUNK: usize = 2048;
 
 /// Below this many elements a kernel runs on the calling thread (no task bookkeeping,
 /// no allocation). A fork-join on the pool costs about 10 µs here when its thread has
@@ -22,7 +22,7 @@ pub(super) const PIECE: usize = 2048;
 /// light ones (integration: 3–8 against 3 ns), but a whole step was slower with those
 /// kept on one thread below 65,536 (16,384: 5.6–6.0 against 5.0 ms per step; 32,768:
 /// 8.8–9.6 against 7.9–8.0, `cloth bench --models 1`).
-pub(super) const PARALLEL_FROM: usize = 8 * PIECE;
+pub(super) const PARALLEL_FROM: usize = 8 * CHUNK;
 
 /// XPBD's kernels on a grid (its colours, the velocity store, the tethers) go to the pool
 /// from this many particles: a substep is about 20 of them, each a fork-join, and below
@@ -102,9 +102,9 @@ pub(super) fn for_each_from<T: Send>(
 /// and the plugin's mesh write-back.
 pub fn for_each_indexed<T: Send>(out: &mut [T], f: impl Fn(usize, &mut T) + Sync) {
     let len = out.len();
-    for_each(len, out.chunks_mut(PIECE).enumerate(), |(piece, out)| {
+    for_each(len, out.chunks_mut(CHUNK).enumerate(), |(piece, out)| {
         for (k, o) in out.iter_mut().enumerate() {
-            f(piece * PIECE + k, o);
+            f(piece * CHUNK + k, o);
         }
     });
 }

@@ -22,7 +22,7 @@ pub struct Particles {
     pub force: Vec<Vec3>,
     /// How many particles' worth each node is (1 for a particle; a part centre of the
     /// patch model counts its particles): scales mass, wind and drag.
-    pub lump: Vec<f32>,
+    pub represents: Vec<f32>,
 }
 
 impl Particles {
@@ -36,7 +36,7 @@ impl Particles {
             mass: vec![0.0; n],
             inv_mass: vec![0.0; n],
             force: vec![Vec3::ZERO; n],
-            lump: vec![1.0; n],
+            represents: vec![1.0; n],
         }
     }
 
@@ -65,9 +65,9 @@ impl Particles {
     }
 }
 
-/// One piece of [`Particles`]' lanes (up to [`PIECE`](super::parallel::PIECE) particles
+/// One piece of [`Particles`]' lanes (up to [`CHUNK`](super::parallel::CHUNK) particles
 /// from the same start), named, for the kernels that run piece by piece.
-pub(super) struct ParticlePiece<'a> {
+pub(super) struct ParticleChunk<'a> {
     pub position: &'a mut [Vec3],
     pub previous: &'a mut [Vec3],
     pub velocity: &'a mut [Vec3],
@@ -75,29 +75,32 @@ pub(super) struct ParticlePiece<'a> {
     pub force: &'a mut [Vec3],
     pub mass: &'a [f32],
     pub inv_mass: &'a [f32],
-    pub lump: &'a [f32],
+    pub represents: &'a [f32],
 }
 
 impl Particles {
-    /// The lanes cut into pieces of [`PIECE`](super::parallel::PIECE) particles, each
+    /// The lanes cut into chunks of [`CHUNK`](super::parallel::CHUNK) particles, each
     /// piece's lanes under their names.
-    pub(super) fn pieces(&mut self) -> impl Iterator<Item = ParticlePiece<'_>> {
-        use super::parallel::PIECE;
+    pub(super) fn chunks(&mut self) -> impl Iterator<Item = ParticleChunk<'_>> {
+        use super::parallel::CHUNK;
         let moving = self
             .position
-            .chunks_mut(PIECE)
-            .zip(self.previous.chunks_mut(PIECE))
-            .zip(self.velocity.chunks_mut(PIECE))
-            .zip(self.residue.chunks_mut(PIECE))
-            .zip(self.force.chunks_mut(PIECE));
+            .chunks_mut(CHUNK)
+            .zip(self.previous.chunks_mut(CHUNK))
+            .zip(self.velocity.chunks_mut(CHUNK))
+            .zip(self.residue.chunks_mut(CHUNK))
+            .zip(self.force.chunks_mut(CHUNK));
         let fixed = self
             .mass
-            .chunks(PIECE)
-            .zip(self.inv_mass.chunks(PIECE))
-            .zip(self.lump.chunks(PIECE));
+            .chunks(CHUNK)
+            .zip(self.inv_mass.chunks(CHUNK))
+            .zip(self.represents.chunks(CHUNK));
         moving.zip(fixed).map(
-            |(((((position, previous), velocity), residue), force), ((mass, inv_mass), lump))| {
-                ParticlePiece {
+            |(
+                ((((position, previous), velocity), residue), force),
+                ((mass, inv_mass), represents),
+            )| {
+                ParticleChunk {
                     position,
                     previous,
                     velocity,
@@ -105,7 +108,7 @@ impl Particles {
                     force,
                     mass,
                     inv_mass,
-                    lump,
+                    represents,
                 }
             },
         )

@@ -1,8 +1,10 @@
 //! What several test files share (each uses part of it).
 #![allow(dead_code)]
 
-use bevy::math::Vec3A;
+use bevy::math::{Affine3A, Vec3A};
+use bevy::mesh::{Mesh, VertexAttributeValues};
 use bevy::prelude::*;
+use bevy_cloth::params::{Environment, Integrator, Model, SpringFamily, SpringParams, Substeps};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, SpringKind};
 
@@ -119,4 +121,132 @@ pub fn segment_hits_triangle(p: Vec3A, q: Vec3A, a: Vec3A, b: Vec3A, c: Vec3A) -
     }
     let t = e2.dot(qv) / det;
     (0.0..=1.0).contains(&t)
+}
+
+// ----- headless apps -----------------------------------------------------------------
+
+pub fn app() -> App {
+    bevy_cloth::headless::headless_app()
+}
+
+/// Default parameters: automatic substeps keep them stable.
+pub fn quiet_params() -> ClothParams {
+    ClothParams::default()
+}
+
+pub fn sim_time(app: &App, e: Entity) -> f32 {
+    app.world().get::<ClothSimulation>(e).unwrap().solver.time()
+}
+
+/// A 5×4 cloth 2 m up, after two updates: its entity and the mesh the plugin made.
+pub fn spawn_small_cloth(app: &mut App) -> (Entity, Handle<Mesh>) {
+    let e = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(5, 4, 0.1).with_params(quiet_params()),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+        ))
+        .id();
+    app.update();
+    app.update();
+    let handle = app
+        .world()
+        .get::<Mesh3d>(e)
+        .expect("the plugin adds a mesh")
+        .0
+        .clone();
+    (e, handle)
+}
+
+/// The positions in a mesh.
+pub fn mesh_positions(app: &App, handle: &Handle<Mesh>) -> Vec<[f32; 3]> {
+    let mesh = app.world().resource::<Assets<Mesh>>().get(handle).unwrap();
+    match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
+        Some(VertexAttributeValues::Float32x3(p)) => p.clone(),
+        _ => panic!("no positions"),
+    }
+}
+
+// ----- solvers ---------------------------------------------------------------------
+
+pub const DT: f32 = 0.016;
+
+pub fn no_springs() -> SpringParams {
+    SpringParams {
+        structural: SpringFamily::off(100.0),
+        shear: SpringFamily::off(50.0),
+        bend: SpringFamily::off(50.0),
+        bend_diagonal: SpringFamily::off(25.0),
+        seam: SpringFamily::off(100.0),
+        ..SpringParams::default()
+    }
+}
+
+/// Parameters with every dissipative or corrective term off.
+pub fn conservative(integrator: Integrator) -> ClothParams {
+    ClothParams {
+        model: Model::MassSpring,
+        node_mass: 1e-3,
+        springs: SpringParams::from_structural(50.0),
+        drag: 0.0,
+        integrator,
+        substeps: Substeps::Auto { max: 8192 },
+        strain_limit: None,
+        strain_limit_iterations: 0,
+        strain_limit_tolerance: None,
+        tear_ratio: None,
+        self_collision: Default::default(),
+        fabric: None,
+    }
+}
+
+pub fn no_wind() -> Environment {
+    Environment::default()
+}
+
+/// Four unpinned particles with no springs: each falls freely, one substep per step.
+pub fn free_particles(integrator: Integrator) -> ClothSolver {
+    free_particles_at(integrator, 1, Affine3A::IDENTITY)
+}
+
+/// Four unconnected particles placed by `frame`, stepped in `substeps` substeps.
+pub fn free_particles_at(integrator: Integrator, substeps: u32, frame: Affine3A) -> ClothSolver {
+    let params = ClothParams {
+        springs: no_springs(),
+        substeps: Substeps::Fixed(substeps),
+        ..conservative(integrator)
+    };
+    let shape = ClothShape::Grid {
+        width: 2,
+        height: 2,
+        spacing: 0.1,
+    };
+    shape
+        .build_solver(&ClothPins::None, &params, frame)
+        .unwrap()
+}
+
+/// A cloth held at two corners, released horizontal so it swings.
+pub fn swinging_cloth(params: &ClothParams) -> ClothSolver {
+    let frame = Affine3A::from_rotation_translation(
+        Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+        Vec3::new(0.0, 1.0, 0.0),
+    );
+    ClothShape::Grid {
+        width: 8,
+        height: 8,
+        spacing: 0.1,
+    }
+    .build_solver(&ClothPins::TopCorners, params, frame)
+    .unwrap()
+}
+
+pub fn corner_hung_grid_with(width: u32, height: u32, params: &ClothParams) -> ClothSolver {
+    ClothShape::Grid {
+        width,
+        height,
+        spacing: 0.02,
+    }
+    .build_solver(&ClothPins::TopCorners, params, Affine3A::IDENTITY)
+    .unwrap()
 }

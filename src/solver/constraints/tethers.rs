@@ -20,7 +20,7 @@ use std::collections::BinaryHeap;
 
 use bevy::math::Vec3;
 
-use crate::solver::parallel::{self, PIECE, XPBD_PARALLEL_FROM};
+use crate::solver::parallel::{self, CHUNK, XPBD_PARALLEL_FROM};
 use crate::solver::{Particles, SpringKind, Springs};
 
 /// At most this many groups of pins get their own tethers; a cloth held by more (a cape
@@ -156,13 +156,13 @@ impl Tethers {
         for g in 0..self.anchor.len() / n {
             let range = g * n..(g + 1) * n;
             let tethers = self.anchor[range.clone()]
-                .chunks(PIECE)
-                .zip(self.reach[range].chunks(PIECE));
+                .chunks(CHUNK)
+                .zip(self.reach[range].chunks(CHUNK));
             let pieces = p
                 .position
-                .chunks_mut(PIECE)
-                .zip(p.velocity.chunks_mut(PIECE))
-                .zip(p.inv_mass.chunks(PIECE))
+                .chunks_mut(CHUNK)
+                .zip(p.velocity.chunks_mut(CHUNK))
+                .zip(p.inv_mass.chunks(CHUNK))
                 .zip(tethers);
             parallel::for_each_from(
                 XPBD_PARALLEL_FROM,

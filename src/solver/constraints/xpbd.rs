@@ -26,7 +26,7 @@ use std::ops::Range;
 use bevy::math::Vec3;
 
 use crate::solver::chains::Chains;
-use crate::solver::parallel::{self, PIECE};
+use crate::solver::parallel::{self, CHUNK};
 use crate::solver::tethers::Tethers;
 use crate::solver::{Particles, SpringKind, Springs};
 
@@ -175,7 +175,7 @@ impl Constraints {
     /// change from the predicted position as velocity over `h`. `families` by
     /// [`SpringKind`].
     ///
-    /// A colour's pieces (`PIECE` constraints each, sorted by first particle) reach the
+    /// A colour's pieces (`CHUNK` constraints each, sorted by first particle) reach the
     /// particles between their first particle and their last: where those windows of
     /// pieces two apart do not overlap (grids), the even pieces run side by side on the
     /// compute pool, each on its own slice of the particles, then the odd ones; other
@@ -243,9 +243,9 @@ fn store_velocity(p: &mut Particles, predicted: &[Vec3], h: f32) {
     let n = p.len();
     let pieces = p
         .velocity
-        .chunks_mut(PIECE)
-        .zip(p.position.chunks(PIECE))
-        .zip(predicted.chunks(PIECE));
+        .chunks_mut(CHUNK)
+        .zip(p.position.chunks(CHUNK))
+        .zip(predicted.chunks(CHUNK));
     parallel::for_each(n, pieces, |((velocity, x), predicted)| {
         for ((v, x), predicted) in velocity.iter_mut().zip(x).zip(predicted) {
             *v += (*x - *predicted) / h;
@@ -347,7 +347,7 @@ pub(in crate::solver) fn correction<const DAMPED: bool, const LIMITED: bool>(
 #[derive(Clone, Debug)]
 struct Colour {
     kind: u8,
-    /// Constraint ranges of `PIECE` (the last shorter).
+    /// Constraint ranges of `CHUNK` (the last shorter).
     pieces: Vec<Range<usize>>,
     /// For each piece, the first and last particle it reaches.
     windows: Vec<(usize, usize)>,
@@ -360,8 +360,8 @@ impl Colour {
     fn new(kind: u8, range: Range<usize>, a: &[u32], b: &[u32]) -> Self {
         let pieces: Vec<Range<usize>> = range
             .clone()
-            .step_by(PIECE)
-            .map(|from| from..(from + PIECE).min(range.end))
+            .step_by(CHUNK)
+            .map(|from| from..(from + CHUNK).min(range.end))
             .collect();
         let windows: Vec<(usize, usize)> = pieces
             .iter()

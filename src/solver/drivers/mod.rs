@@ -29,14 +29,14 @@ pub(super) struct Drivers {
     pub frame: Affine3A,
     pub grab: Option<Grab>,
     /// Motion constraints (empty: none).
-    pub motion: Motion,
+    pub motion: MotionConstraints,
 }
 
 /// Motion constraints: each particle with a finite `radius` kept within it of its
 /// target, which goes from `from` to `to` over the step as pins do. A radius of 0 makes
 /// the particle an attached pin instead (exactly at its target); `f32::INFINITY`, free.
 #[derive(Clone, Debug, Default)]
-pub(super) struct Motion {
+pub(super) struct MotionConstraints {
     pub from: Vec<Vec3>,
     pub to: Vec<Vec3>,
     pub radius: Vec<f32>,
@@ -47,7 +47,7 @@ pub(super) struct Motion {
     pub slot: Vec<u32>,
 }
 
-impl Motion {
+impl MotionConstraints {
     /// Starts a step: the targets go from where the last step's ended to those given.
     fn begin_step(&mut self) {
         if self.next.len() != self.to.len() {
@@ -86,7 +86,7 @@ impl Drivers {
             pins: pins.to_vec(),
             frame,
             grab: None,
-            motion: Motion::default(),
+            motion: MotionConstraints::default(),
         }
     }
 
@@ -273,7 +273,7 @@ impl ClothSolver {
                 self.detach(i as u32);
             }
         }
-        self.drivers.motion = Motion::default();
+        self.drivers.motion = MotionConstraints::default();
     }
 
     /// The particles held from outside ([`ClothSolver::attach`]), in order.

@@ -1,6 +1,6 @@
 //! The hybrid patch model (Sladović 2014 §3.4): the grid is split into parts of w×h particles;
 //! the parts' centres of mass form a mass-spring lattice (a [`ClothSolver`] of its own, each
-//! node a lump of its particles) that feels gravity, wind, drag and the part springs; the
+//! node a represents of its particles) that feels gravity, wind, drag and the part springs; the
 //! particles follow targets interpolated between neighbouring part centres.
 //!
 //! Coupling rule (the thesis warns that parts fly apart when the two are not matched):
@@ -16,7 +16,7 @@
 //! is that particle, so its centre is pinned outright; with the seed's targets, or a
 //! cloth one part across, a pin fixes its part, as in the thesis (see `Patches::new`).
 
-use crate::solver::parallel::{self, PIECE};
+use crate::solver::parallel::{self, CHUNK};
 use bevy::math::{Affine3A, Vec3};
 
 use crate::error::ClothError;
@@ -274,7 +274,7 @@ impl Patches {
             &lattice_params(params, patch, 1),
             frame,
         )?;
-        parts.particles.lump = split.lumps;
+        parts.particles.represents = split.lumps;
         scale_for_aspect(&mut parts.structure.springs, nx, part_size);
         parts.reset();
         let targets: Vec<Vec3> = local_rest
@@ -374,9 +374,9 @@ impl Patches {
             let c = &self.parts.particles.position;
             let pieces = self
                 .targets
-                .chunks_mut(PIECE)
-                .zip(self.target_velocity.chunks_mut(PIECE))
-                .zip(self.stencil.chunks(PIECE));
+                .chunks_mut(CHUNK)
+                .zip(self.target_velocity.chunks_mut(CHUNK))
+                .zip(self.stencil.chunks(CHUNK));
             parallel::for_each(x.len(), pieces, |((targets, velocities), stencils)| {
                 for ((target, v), stencil) in targets.iter_mut().zip(velocities).zip(stencils) {
                     let new = bilinear_at(c, stencil);

@@ -34,7 +34,7 @@ use std::ops::Range;
 use bevy::math::Vec3;
 
 use crate::solver::integrate::compensated_add;
-use crate::solver::parallel::{self, PIECE};
+use crate::solver::parallel::{self, CHUNK};
 use crate::solver::xpbd::Family;
 use crate::solver::{Particles, SpringKind, Springs};
 
@@ -68,7 +68,7 @@ struct ChainSet {
     spring: Vec<u32>,
     /// Each particle's slot in this set (`NONE` when no chain of the set reaches it).
     slot_of: Vec<u32>,
-    /// The tiles in pieces of about [`PIECE`] slots, for the compute pool.
+    /// The tiles in pieces of about [`CHUNK`] slots, for the compute pool.
     pieces: Vec<Range<usize>>,
 }
 
@@ -289,13 +289,13 @@ impl ChainSet {
                 slot_of[i as usize] = slot as u32;
             }
         }
-        // Pieces of whole tiles, about PIECE slots each.
+        // Pieces of whole tiles, about CHUNK slots each.
         let rows = particle.len() / LANES;
         let mut pieces = Vec::new();
         let mut from = 0;
         for t in 0..tiles.len() {
             let end = tiles.get(t + 1).map_or(rows, |tile| tile.0);
-            if (end - tiles[from].0) * LANES >= PIECE {
+            if (end - tiles[from].0) * LANES >= CHUNK {
                 pieces.push(from..t + 1);
                 from = t + 1;
             }
@@ -366,10 +366,10 @@ impl ChainSet {
         let rows = &self.rows;
         let pieces = p
             .position
-            .chunks_mut(PIECE)
-            .zip(p.velocity.chunks_mut(PIECE))
-            .zip(p.residue.chunks_mut(PIECE))
-            .zip(self.slot_of.chunks(PIECE));
+            .chunks_mut(CHUNK)
+            .zip(p.velocity.chunks_mut(CHUNK))
+            .zip(p.residue.chunks_mut(CHUNK))
+            .zip(self.slot_of.chunks(CHUNK));
         parallel::for_each(self.slot_of.len(), pieces, |(((x, v), r), slot_of)| {
             for (((x, v), r), &s) in x.iter_mut().zip(v).zip(r).zip(slot_of) {
                 if s == NONE {

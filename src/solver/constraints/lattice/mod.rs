@@ -20,7 +20,7 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
-use crate::solver::parallel::{self, PIECE};
+use crate::solver::parallel::{self, CHUNK};
 use crate::solver::{Particles, SpringKind, Springs};
 
 mod xpbd;
@@ -73,10 +73,10 @@ impl Lanes {
     fn load(&mut self, v: &[Vec3]) {
         let [x, y, z] = &mut self.0;
         let pieces = x
-            .chunks_mut(PIECE)
-            .zip(y.chunks_mut(PIECE))
-            .zip(z.chunks_mut(PIECE))
-            .zip(v.chunks(PIECE));
+            .chunks_mut(CHUNK)
+            .zip(y.chunks_mut(CHUNK))
+            .zip(z.chunks_mut(CHUNK))
+            .zip(v.chunks(CHUNK));
         parallel::for_each(v.len(), pieces, |(((x, y), z), v)| {
             for (((x, y), z), v) in x.iter_mut().zip(y.iter_mut()).zip(z.iter_mut()).zip(v) {
                 (*x, *y, *z) = (v.x, v.y, v.z);
@@ -181,7 +181,7 @@ impl SpringPass<'_> {
             // The springs that start or end in this piece: from `lo` to `hi`.
             let m = n - o.step;
             let lo = from.saturating_sub(o.step).min(m);
-            let hi = (from + PIECE).min(m).max(lo);
+            let hi = (from + CHUNK).min(m).max(lo);
             let springs = [&mut hx[..hi - lo], &mut hy[..hi - lo], &mut hz[..hi - lo]];
             spring_piece(o, k, self.damping, lo, self.x, self.v, springs);
             let springs = [&hx[..hi - lo], &hy[..hi - lo], &hz[..hi - lo]];
@@ -206,7 +206,7 @@ pub(in crate::solver) struct Stencil {
     /// Each offset's stiffness in this substep (0: its family is off).
     stiffness: Vec<f32>,
     /// Each piece's spring forces of one offset at a time: the springs that start or
-    /// end in the piece (`PIECE + max_step` per piece), so a piece's forces stay in its
+    /// end in the piece (`CHUNK + max_step` per piece), so a piece's forces stay in its
     /// core's cache and no piece writes another's.
     halo: Lanes,
     /// The largest offset `b − a`.
@@ -269,7 +269,7 @@ impl Stencil {
         let max_step = offsets.iter().map(|o| o.step).max().unwrap_or(0);
         let mut stencil = Self {
             stiffness: vec![0.0; offsets.len()],
-            halo: Lanes::new(n.div_ceil(PIECE) * (PIECE + max_step)),
+            halo: Lanes::new(n.div_ceil(CHUNK) * (CHUNK + max_step)),
             max_step,
             width,
             offsets,
@@ -329,14 +329,14 @@ impl Stencil {
             v: &self.v,
             n,
         };
-        let halo = PIECE + self.max_step;
+        let halo = CHUNK + self.max_step;
         let [fx, fy, fz] = &mut self.f.0;
         let [hx, hy, hz] = &mut self.halo.0;
         let pieces = fx
-            .chunks_mut(PIECE)
-            .zip(fy.chunks_mut(PIECE))
-            .zip(fz.chunks_mut(PIECE))
-            .zip(p.force.chunks_mut(PIECE))
+            .chunks_mut(CHUNK)
+            .zip(fy.chunks_mut(CHUNK))
+            .zip(fz.chunks_mut(CHUNK))
+            .zip(p.force.chunks_mut(CHUNK))
             .zip(
                 hx.chunks_mut(halo)
                     .zip(hy.chunks_mut(halo))
@@ -347,7 +347,7 @@ impl Stencil {
             n,
             pieces,
             |(i, ((((fx, fy), fz), force), ((hx, hy), hz)))| {
-                pass.piece(i * PIECE, [fx, fy, fz], [hx, hy, hz], force);
+                pass.piece(i * CHUNK, [fx, fy, fz], [hx, hy, hz], force);
             },
         );
     }
@@ -387,15 +387,15 @@ impl Stencil {
         // study's reference stopped converging in h).
         // The sums are zeroed as they are read, ready for the next call.
         let ([x, y, z], [dx, dy, dz]) = (&self.x.0, &mut self.dx.0);
-        let lanes = x.chunks(PIECE).zip(y.chunks(PIECE)).zip(z.chunks(PIECE));
+        let lanes = x.chunks(CHUNK).zip(y.chunks(CHUNK)).zip(z.chunks(CHUNK));
         let sums = dx
-            .chunks_mut(PIECE)
-            .zip(dy.chunks_mut(PIECE))
-            .zip(dz.chunks_mut(PIECE));
+            .chunks_mut(CHUNK)
+            .zip(dy.chunks_mut(CHUNK))
+            .zip(dz.chunks_mut(CHUNK));
         let pieces = p
             .position
-            .chunks_mut(PIECE)
-            .zip(p.velocity.chunks_mut(PIECE))
+            .chunks_mut(CHUNK)
+            .zip(p.velocity.chunks_mut(CHUNK))
             .zip(lanes.zip(sums));
         parallel::for_each(
             x.len(),
@@ -545,7 +545,7 @@ impl Projection {
         width: usize,
     ) -> bool {
         let n = x[0].len();
-        let group = width * (PIECE / width).max(1);
+        let group = width * (CHUNK / width).max(1);
         let pieces = chunks6(x, dx, 0..n, group).enumerate();
         parallel::any(n, pieces, |(i, (x, dx))| {
             let from = i * group;
@@ -593,7 +593,7 @@ impl Projection {
             return false; // too few rows for a band from this parity
         }
         let end = from + (n - from) / band * band; // whole bands only
-        let group = band * (PIECE / band).max(1);
+        let group = band * (CHUNK / band).max(1);
         let pieces = chunks6(x, dx, from..end, group).enumerate();
         let (right, left) = right_and_left(diagonals);
         parallel::any(n, pieces, |(i, (x, dx))| {

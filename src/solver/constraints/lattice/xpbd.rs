@@ -17,7 +17,7 @@
 
 use bevy::math::Vec3;
 
-use super::{Offset, PIECE, Stencil, parallel};
+use super::{CHUNK, Offset, Stencil, parallel};
 use crate::solver::parallel::XPBD_PARALLEL_FROM;
 
 use crate::solver::Particles;
@@ -88,7 +88,7 @@ fn colour<const DAMPED: bool, const LIMITED: bool>(
     let rows = n / w;
     let dy = shared.offset.dy;
     if dy == 0 {
-        let group = w * (PIECE / w).max(1);
+        let group = w * (CHUNK / w).max(1);
         let pieces = chunks3(x, 0..n, group).enumerate();
         parallel::for_each_from(XPBD_PARALLEL_FROM, n, pieces, |(k, lanes)| {
             along::<DAMPED, LIMITED>(lanes, k * group / w, shared, class);
@@ -99,7 +99,7 @@ fn colour<const DAMPED: bool, const LIMITED: bool>(
     if rows <= first + dy {
         return; // no row of this class has a row `dy` below it
     }
-    let bands = band * (PIECE / (band * w)).max(1);
+    let bands = band * (CHUNK / (band * w)).max(1);
     let pieces = chunks3(x, first * w..n, bands * w).enumerate();
     parallel::for_each_from(XPBD_PARALLEL_FROM, n, pieces, |(k, lanes)| {
         let top = first + k * bands;
@@ -335,11 +335,11 @@ fn chunks3(
 fn store(x: &[Vec<f32>; 3], p: &mut Particles, h: f32) {
     let n = p.len();
     let [x0, x1, x2] = x;
-    let lanes = x0.chunks(PIECE).zip(x1.chunks(PIECE)).zip(x2.chunks(PIECE));
+    let lanes = x0.chunks(CHUNK).zip(x1.chunks(CHUNK)).zip(x2.chunks(CHUNK));
     let pieces = p
         .position
-        .chunks_mut(PIECE)
-        .zip(p.velocity.chunks_mut(PIECE))
+        .chunks_mut(CHUNK)
+        .zip(p.velocity.chunks_mut(CHUNK))
         .zip(lanes);
     parallel::for_each_from(
         XPBD_PARALLEL_FROM,

@@ -55,7 +55,7 @@ use grid::Grid;
 use bevy::math::{Vec3, Vec3A};
 
 use crate::params::SelfCollision;
-use crate::solver::parallel::{self, PIECE};
+use crate::solver::parallel::{self, CHUNK};
 use crate::solver::{Particles, SpringKind, Springs};
 
 /// The self-collision stage's state (see the module doc).
@@ -330,14 +330,14 @@ impl SelfContact {
         if !self.grid.cell.is_finite() {
             return; // a particle at infinity: nothing to list by (the step is undone)
         }
-        // Pieces of about `LIST_PIECE` particles, cut at cell boundaries (a piece of
+        // Pieces of about `LIST_CHUNK` particles, cut at cell boundaries (a piece of
         // cells would hold most of the cloth where it lies in a band of the grid).
         let (cells, n) = (self.grid.len(), p.len());
         let mut bounds = std::mem::take(&mut self.piece_cells);
         bounds.clear();
-        bounds.extend((0..n.div_ceil(LIST_PIECE)).map(|k| {
+        bounds.extend((0..n.div_ceil(LIST_CHUNK)).map(|k| {
             self.cell_start
-                .partition_point(|&s| (s as usize) <= k * LIST_PIECE)
+                .partition_point(|&s| (s as usize) <= k * LIST_CHUNK)
                 .saturating_sub(1)
         }));
         bounds.push(cells);
@@ -348,7 +348,7 @@ impl SelfContact {
         let r2 = radius * radius;
         let r2_folded = (radius * FOLDED / LIST_RADIUS).powi(2);
         let work = found.iter_mut().zip(bounds.windows(2));
-        parallel::for_each_from(2 * LIST_PIECE, n, work, |(pairs, cells)| {
+        parallel::for_each_from(2 * LIST_CHUNK, n, work, |(pairs, cells)| {
             pairs.clear();
             MARK.with_borrow_mut(|mark| {
                 if mark.len() < p.len() {
@@ -559,10 +559,10 @@ impl SelfContact {
     fn clamp(&mut self, p: &mut Particles, h: f32) {
         let n = p.len();
         self.sums.clear();
-        self.sums.resize(n.div_ceil(PIECE), (Vec3::ZERO, 0));
+        self.sums.resize(n.div_ceil(CHUNK), (Vec3::ZERO, 0));
         let (x, previous, w) = (&p.position, &p.previous, &p.inv_mass);
         parallel::for_each(n, self.sums.iter_mut().enumerate(), |(k, (sum, free))| {
-            for i in k * PIECE..((k + 1) * PIECE).min(n) {
+            for i in k * CHUNK..((k + 1) * CHUNK).min(n) {
                 if w[i] != 0.0 {
                     *sum += x[i] - previous[i];
                     *free += 1;
@@ -575,7 +575,7 @@ impl SelfContact {
             .fold((Vec3::ZERO, 0), |(s, f), &(ps, pf)| (s + ps, f + pf));
         let mean = sum / free.max(1) as f32;
         let reach = self.reach;
-        parallel::for_each(n, p.pieces(), |piece| {
+        parallel::for_each(n, p.chunks(), |piece| {
             for k in 0..piece.position.len() {
                 if piece.inv_mass[k] == 0.0 {
                     continue;
@@ -626,7 +626,7 @@ const TWO_SPRINGS: u32 = 1 << 31;
 
 /// Particles a piece of the listing (it is one fork-join a step: smaller pieces than
 /// the substeps' kernels share two threads more evenly).
-const LIST_PIECE: usize = 512;
+const LIST_CHUNK: usize = 512;
 
 thread_local! {
     /// Each thread's marks of one particle's rest neighbours while its candidates are

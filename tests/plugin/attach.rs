@@ -1,0 +1,194 @@
+//! Headless App tests of attachments: a cloth on a moving entity, a garment on a hanger
+//! by its runs, local offsets.
+
+use bevy::prelude::*;
+use bevy_cloth::prelude::*;
+
+use crate::common::*;
+
+#[test]
+fn an_attached_cloth_follows_its_moving_entity_with_no_lag_beyond_a_step() {
+    // A cape-like cloth hanging from a "shoulder" entity that walks along x and turns:
+    // its two top corners, attached, are where the entity puts them at the end of every
+    // step (the solver reaches the target over the step's substeps, as pins do).
+    let mut app = app();
+    let shoulder = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
+        .id();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+            ClothAttachments(vec![
+                ClothAttachment::indices(shoulder, vec![0]),
+                ClothAttachment::nearest(shoulder, Vec3::new(0.175, 0.0, 0.0), 1),
+            ]),
+        ))
+        .id();
+    // Built in the first frame (by command), attached from the second.
+    app.update();
+    app.update();
+    let held: Vec<(u32, Vec3)> = app
+        .world()
+        .get::<ClothAttachments>(cloth)
+        .unwrap()
+        .0
+        .iter()
+        .flat_map(|a| a.held().to_vec())
+        .collect();
+    assert_eq!(held.iter().map(|h| h.0).collect::<Vec<_>>(), [0, 7]);
+    for frame in 1..=60 {
+        {
+            let mut t = app.world_mut().get_mut::<Transform>(shoulder).unwrap();
+            t.translation.x += 0.02;
+            t.rotate_y(0.01);
+        }
+        app.update();
+        let t = *app.world().get::<Transform>(shoulder).unwrap();
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        for &(i, local) in &held {
+            let want = t.transform_point(local);
+            let got = sim.solver.positions()[i as usize];
+            assert!(
+                got.distance(want) < 1e-5,
+                "frame {frame}: particle {i} at {got}, the shoulder puts it at {want}"
+            );
+        }
+        // The rest of the cloth hangs below and follows (a sheet 0.25 m long).
+        let lowest = sim
+            .solver
+            .positions()
+            .iter()
+            .map(|p| p.y)
+            .fold(f32::MAX, f32::min);
+        assert!(
+            lowest < 2.0 && lowest > 1.6,
+            "frame {frame}: lowest {lowest}"
+        );
+        assert!(sim.solver.is_stable());
+    }
+    // The entity gone: the cloth is let go and falls.
+    app.world_mut().despawn(shoulder);
+    for _ in 0..30 {
+        app.update();
+    }
+    let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+    assert!(sim.solver.attached().is_empty());
+    assert!(sim.solver.positions()[0].y < 1.0);
+}
+
+#[test]
+fn a_garment_hangs_from_its_named_runs_on_a_moving_hanger() {
+    // The T-shirt held by its file's two shoulder runs to a "hanger" entity that moves
+    // and turns: every run particle is where the hanger puts it each frame, and the shirt
+    // hangs below; a run that does not exist attaches nothing (and the cloth runs on).
+    let mut app = app();
+    let hanger = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 1.5, 0.0))
+        .id();
+    let shirt = app
+        .world_mut()
+        .spawn((
+            Cloth::garment("patterns/tshirt.ron"),
+            Transform::from_xyz(0.0, 1.5, 0.0),
+            ClothAttachments(vec![
+                ClothAttachment::run(hanger, "right shoulder"),
+                ClothAttachment::run(hanger, "left shoulder"),
+                ClothAttachment::run(hanger, "collar"),
+            ]),
+        ))
+        .id();
+    // The garment loads through the asset server: a few frames until it is built and held.
+    let mut held = Vec::new();
+    for _ in 0..200 {
+        app.update();
+        held = app
+            .world()
+            .get::<ClothAttachments>(shirt)
+            .map_or(Vec::new(), |a| {
+                a.0.iter().flat_map(|a| a.held().to_vec()).collect()
+            });
+        if !held.is_empty() {
+            break;
+        }
+    }
+    assert_eq!(held.len(), 12, "two runs of 6 nodes, none for `collar`");
+    for frame in 1..=90 {
+        {
+            let mut t = app.world_mut().get_mut::<Transform>(hanger).unwrap();
+            t.translation.x += 0.01;
+            t.rotate_y(0.01);
+        }
+        app.update();
+        let t = *app.world().get::<Transform>(hanger).unwrap();
+        let sim = app.world().get::<ClothSimulation>(shirt).unwrap();
+        for &(i, local) in &held {
+            let got = sim.solver.positions()[i as usize];
+            let want = t.transform_point(local);
+            assert!(
+                got.distance(want) < 1e-5,
+                "frame {frame}: particle {i} at {got}, the hanger puts it at {want}"
+            );
+        }
+        assert!(sim.solver.is_stable());
+    }
+    // After the sewing (1 s, no gravity) the shirt drops and hangs from the shoulders.
+    let sim = app.world().get::<ClothSimulation>(shirt).unwrap();
+    let lowest = sim
+        .solver
+        .positions()
+        .iter()
+        .map(|x| x.y)
+        .fold(f32::MAX, f32::min);
+    assert!(
+        lowest < 1.5 - 0.6,
+        "hangs below the hanger: lowest {lowest}"
+    );
+}
+
+#[test]
+fn particles_attached_at_local_offsets_go_there_and_follow() {
+    // Two corners of a cloth held at points given in a bar entity's frame (not where they
+    // start): they are pulled there in the first step and then follow the bar.
+    let mut app = app();
+    let bar = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.5, 2.0, 0.0))
+        .id();
+    let offsets = vec![
+        (0, Vec3::new(-0.3, 0.0, 0.1)),
+        (7, Vec3::new(0.3, 0.0, 0.1)),
+    ];
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
+            Transform::from_xyz(0.0, 1.8, 0.0),
+            ClothAttachments(vec![ClothAttachment::at(bar, offsets.clone())]),
+        ))
+        .id();
+    app.update();
+    for frame in 0..40 {
+        {
+            let mut t = app.world_mut().get_mut::<Transform>(bar).unwrap();
+            t.translation.z -= 0.01;
+            t.rotate_y(0.02);
+        }
+        app.update();
+        if frame == 0 {
+            continue; // the first step after the cloth is built attaches them
+        }
+        let t = *app.world().get::<Transform>(bar).unwrap();
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        for &(i, local) in &offsets {
+            let (got, want) = (sim.solver.positions()[i as usize], t.transform_point(local));
+            assert!(
+                got.distance(want) < 1e-5,
+                "frame {frame}: particle {i} at {got}, wanted {want}"
+            );
+        }
+    }
+}

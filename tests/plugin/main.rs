@@ -1,0 +1,11 @@
+//! Headless App tests of `ClothPlugin` (MinimalPlugins, manual time, no window), one file per feature, in one test binary (one link of Bevy).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod attach;
+mod building;
+mod colliders;
+mod drawing;
+mod keys;
+mod stepping;

@@ -1,0 +1,9 @@
+//! `ClothSolver` tests, one file per concern, in one test binary.
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod analytic;
+mod kernels;
+mod stability;
+mod structure;
