@@ -206,13 +206,18 @@ impl Default for Fabric {
 #[serde(untagged)]
 enum FabricSpec {
     Named(String),
-    #[serde(rename_all = "snake_case")]
-    Measured {
-        areal_density: f32,
-        stretch: f32,
-        shear: f32,
-        bending: f32,
-    },
+    Measured(MeasuredFabric),
+}
+
+/// A fabric's numbers in a scene file, every one of them and no other key (a misspelt
+/// key is refused, not dropped).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeasuredFabric {
+    areal_density: f32,
+    stretch: f32,
+    shear: f32,
+    bending: f32,
 }
 
 impl TryFrom<FabricSpec> for Fabric {
@@ -221,12 +226,12 @@ impl TryFrom<FabricSpec> for Fabric {
     fn try_from(spec: FabricSpec) -> Result<Self, ClothError> {
         match spec {
             FabricSpec::Named(name) => Fabric::named(&name),
-            FabricSpec::Measured {
+            FabricSpec::Measured(MeasuredFabric {
                 areal_density,
                 stretch,
                 shear,
                 bending,
-            } => Ok(Fabric {
+            }) => Ok(Fabric {
                 areal_density,
                 stretch,
                 shear,

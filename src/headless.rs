@@ -159,7 +159,10 @@ impl SceneRun {
 
 /// The app without a window: `MinimalPlugins`, assets (from
 /// [`crate::layout::garment::asset_root`]), meshes and `ClothPlugin`, with time advanced by
-/// exactly one 16 ms fixed step per `update`.
+/// exactly one 16 ms fixed step per `update`. It has no `LogPlugin`: the crate's warnings
+/// and refusals (an invalid cloth, a collider left out) print nothing until you add one
+/// (`app.add_plugins(bevy::log::LogPlugin::default())`); `ClothInvalid` and the
+/// `ClothBecameInvalid` event say the same to code.
 pub fn headless_app() -> App {
     headless_app_in(crate::layout::garment::asset_root().to_string_lossy())
 }

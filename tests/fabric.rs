@@ -19,6 +19,9 @@ fn a_preset_is_named_in_a_scene_file_and_an_unknown_one_is_refused() {
     )
     .unwrap();
     assert_eq!(numbers.fabric.unwrap().bending, 1e-5);
+    // A misspelt key is refused, not dropped.
+    let misspelt = "(fabric: Some((areal_density: 0.2, stretch: 500.0, shear: 20.0, bending: 1e-5, bendng: 1.0)))";
+    assert!(ron::from_str::<ClothParams>(misspelt).is_err());
     for (name, fabric) in Fabric::PRESETS {
         fabric.validate().unwrap();
         assert_eq!(Fabric::named(name).unwrap(), fabric);

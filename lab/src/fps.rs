@@ -15,7 +15,7 @@ use bevy_cloth::headless::headless_app;
 use bevy_cloth::prelude::{Cloth, ClothSimulation};
 
 /// Maslova's table 4.1: masses and the frames per second it reported.
-pub const SEED_002_FPS: [(usize, f64); 10] = [
+pub const MASLOVA_FPS: [(usize, f64); 10] = [
     (100, 60.0),
     (300, 50.0),
     (500, 31.0),
@@ -117,7 +117,7 @@ pub fn app_frame(
         ms_per_frame: ms,
         fps: ms.map(|ms| 1e3 / ms),
         failed_at_frame,
-        seed_fps: SEED_002_FPS
+        seed_fps: MASLOVA_FPS
             .iter()
             .find(|(c, _)| *c == count)
             .map(|(_, f)| *f),

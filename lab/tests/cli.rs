@@ -158,6 +158,15 @@ fn bad_input_exits_2_with_one_line_naming_the_problem() {
             vec!["bench".into(), "--chart".into(), "bench.jpg".into()],
             "must end in .png",
         ),
+        // Refused at once, before the runs: a chart in a folder that is not there.
+        (
+            vec![
+                "peers".into(),
+                "--chart".into(),
+                "no/such/folder/peers.png".into(),
+            ],
+            "no folder no/such/folder",
+        ),
         (
             vec!["accuracy".into(), "--scenes".into(), "curtain,sail".into()],
             "no scene `sail`",

@@ -7,7 +7,7 @@ use std::path::Path;
 
 use bevy_cloth::params::Integrator;
 use bevy_cloth_lab::accuracy::Row;
-use bevy_cloth_lab::fps::{AppFrame, SEED_002_FPS};
+use bevy_cloth_lab::fps::{AppFrame, MASLOVA_FPS};
 use bevy_cloth_lab::peers::PeerRow;
 use bevy_cloth_lab::stability::{Cell, MODELS, NONLINEAR_MODELS, Regime};
 use bevy_cloth_lab::{BENCH_MODELS, BenchCell, SEED_COUNTS, SEED_MS};
@@ -67,6 +67,19 @@ pub fn check_path(png: &Path) -> Result<()> {
         return Err(format!(
             "--chart {}: the file must end in .png (an .svg is written beside it)",
             png.display()
+        ));
+    }
+    // Refused before the measurement, not after it: a folder, or a file in a folder
+    // that is not there.
+    if png.is_dir() {
+        return Err(format!("--chart {}: a folder, not a file", png.display()));
+    }
+    let folder = png.parent().filter(|p| !p.as_os_str().is_empty());
+    if let Some(folder) = folder.filter(|f| !f.is_dir()) {
+        return Err(format!(
+            "--chart {}: no folder {} to write it in",
+            png.display(),
+            folder.display()
         ));
     }
     Ok(())
@@ -192,7 +205,7 @@ impl Chart for Bench<'_> {
             .filter_map(|c| c.ms_per_step)
             .chain(SEED_MS.iter().flatten().copied())
             .chain(app.iter().filter_map(|a| a.ms_per_frame))
-            .chain(SEED_002_FPS.iter().map(|(_, f)| 1e3 / f));
+            .chain(MASLOVA_FPS.iter().map(|(_, f)| 1e3 / f));
         let xs = (SEED_COUNTS[0] as f64 / 1.5)..(SEED_COUNTS[SEED_COUNTS.len() - 1] as f64 * 1.5);
         let mut chart = ChartBuilder::on(area)
             .caption(
@@ -247,7 +260,7 @@ impl Chart for Bench<'_> {
         }
         draw_app_lines(&mut chart, app)?;
         chart
-            .draw_series(SEED_002_FPS.iter().map(|&(c, f)| {
+            .draw_series(MASLOVA_FPS.iter().map(|&(c, f)| {
                 EmptyElement::at((c as f64, 1e3 / f))
                     + Rectangle::new([(-5, -5), (5, 5)], BLACK.stroke_width(2))
             }))

@@ -80,6 +80,13 @@ fn linear_cells(
         for integrator in Integrator::ALL {
             for auto in [false, true] {
                 let (mut failed, mut total) = (0, 0);
+                // Said before the map too: a slow model's map takes minutes (a progress
+                // bar draws only on a terminal).
+                let count = STIFFNESS.len() * MASS.len() * TIMESTEP.len();
+                let on = if auto { "on" } else { "off" };
+                bar.suspend(|| {
+                    eprintln!("{model}, {integrator:?}, auto substeps {on}: {count} cells…")
+                });
                 for &k in &STIFFNESS {
                     for &m in &MASS {
                         for &dt in &TIMESTEP {
