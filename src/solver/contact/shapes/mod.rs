@@ -354,12 +354,9 @@ mod tests {
         (shape.into(), points, Box::new(inside))
     }
 
-    /// Each shape's signed distance against brute force: the distance to the nearest of
-    /// dense samples of its surface (never less than the true distance, at most the
-    /// sampling's spacing more), signed by the membership test. 300 points in and around
-    /// each shape.
-    #[test]
-    fn distances_match_brute_force_sampling_of_the_surface() {
+    /// The shapes tested, about the point returned: a turned box, cylinder and torus, and
+    /// a tilted capsule.
+    fn cases() -> (Vec3, [Case; 4]) {
         let turn = Quat::from_euler(bevy::math::EulerRot::XYZ, 0.3, -0.5, 0.8);
         let c = Vec3::new(0.2, 1.0, -0.3);
         let cases = [
@@ -368,6 +365,16 @@ mod tests {
             capsule_case(Vec3::new(-0.3, 0.9, 0.1), Vec3::new(0.4, 1.2, -0.2), 0.2),
             torus_case(c, turn * Vec3::Z, 0.4, 0.1),
         ];
+        (c, cases)
+    }
+
+    /// Each shape's signed distance against brute force: the distance to the nearest of
+    /// dense samples of its surface (never less than the true distance, at most the
+    /// sampling's spacing more), signed by the membership test. 300 points in and around
+    /// each shape.
+    #[test]
+    fn distances_match_brute_force_sampling_of_the_surface() {
+        let (c, cases) = cases();
         for (shape, surface, inside) in cases {
             for i in 0..300 {
                 let q = Vec3::new(unit_hash(i, 0), unit_hash(i, 1), unit_hash(i, 2));
@@ -391,14 +398,8 @@ mod tests {
     /// by a motion and back is where it was.
     #[test]
     fn extents_hold_the_surface_and_placements_invert() {
-        let turn = Quat::from_euler(bevy::math::EulerRot::XYZ, 0.3, -0.5, 0.8);
-        let c = Vec3::new(0.2, 1.0, -0.3);
-        let cases = [
-            box_case(c, turn, Vec3::new(0.4, 0.25, 0.3)),
-            cylinder_case(c, turn * Vec3::Y, 0.3, 0.25),
-            capsule_case(Vec3::new(-0.3, 0.9, 0.1), Vec3::new(0.4, 1.2, -0.2), 0.2),
-            torus_case(c, turn * Vec3::Z, 0.4, 0.1),
-        ];
+        let (c, cases) = cases();
+        let turn = Quat::from_euler(bevy::math::EulerRot::ZYX, -0.7, 0.4, 1.1);
         let pivot = Vec3::new(0.5, 0.0, 0.2);
         let there = Placement::about(pivot, turn, Vec3::new(1.0, 2.0, 3.0));
         let back = Placement::about(Vec3::new(1.0, 2.0, 3.0), turn.inverse(), pivot);
