@@ -33,6 +33,9 @@ pub(crate) struct RunArgs {
     /// Keeps every kernel on one thread (the results are the same bits; for comparing).
     #[arg(long = "one-thread")]
     pub(crate) one_thread: bool,
+    /// No progress bar and no summary line on stderr (the JSON on stdout stays).
+    #[arg(long)]
+    pub(crate) quiet: bool,
 }
 
 pub(crate) fn run(args: RunArgs) -> Result<(), String> {
@@ -69,7 +72,14 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
         d.frame(0, 0.0, &run.cloths)?;
     }
     let mut dump_error = None;
+    // On a terminal only (indicatif hides it elsewhere), and not with --quiet.
+    let bar = if args.quiet {
+        indicatif::ProgressBar::hidden()
+    } else {
+        progress(steps, "steps")
+    };
     let summary = run.run(steps, |step, cloths| {
+        bar.set_position(step as u64);
         if let Some(d) = &mut dump
             && step % every == 0
             && dump_error.is_none()
@@ -78,6 +88,7 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
             dump_error = Some(e);
         }
     });
+    bar.finish_and_clear();
     if let Some(e) = dump_error {
         return Err(e);
     }
@@ -93,9 +104,31 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
             cloth.name, cloth.particles, cloth.substeps
         );
     }
+    if !args.quiet {
+        say_summary(scene_path, &summary);
+    }
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
     println!("{json}");
     Ok(())
+}
+
+/// The run for a person, on stderr: steps, simulated time, the median step, and per cloth
+/// its particles, substeps, largest strain and whether it stayed stable.
+fn say_summary(scene: &str, summary: &bevy_cloth::headless::RunSummary) {
+    eprintln!(
+        "{scene}: {} steps ({:.2} s simulated), {:.3} ms a step (median)",
+        summary.steps, summary.simulated_seconds, summary.median_ms_per_step
+    );
+    for c in &summary.cloths {
+        eprintln!(
+            "  {}: {} particles, {} substeps a step, largest strain {:.2}%, {}",
+            if c.name.is_empty() { "cloth" } else { &c.name },
+            c.particles,
+            c.substeps,
+            c.max_strain * 100.0,
+            if c.stable { "stable" } else { "NOT stable" }
+        );
+    }
 }
 
 /// Particle positions every K steps: JSON (one document), CSV (one row per particle) or
