@@ -285,3 +285,30 @@ fn an_app_without_level_of_detail_keeps_the_cloths_model() {
         sim.solver.time()
     );
 }
+
+/// A cloth the patch model refuses — self-collision on, or a fabric in physical units —
+/// keeps its own model however far the camera is, and is never refused for it.
+#[test]
+fn a_cloth_the_patch_model_refuses_keeps_its_model_far_away() {
+    let self_colliding = ClothParams {
+        self_collision: SelfCollision::on(),
+        ..ClothParams::default()
+    };
+    let denim = ClothParams {
+        fabric: Some(Fabric::DENIM),
+        ..ClothParams::default()
+    };
+    for params in [self_colliding, denim] {
+        let (mut app, cloth, camera) = scene(1.5);
+        app.world_mut().get_mut::<Cloth>(cloth).unwrap().params = params;
+        move_camera(&mut app, camera, 30.0);
+        for _ in 0..30 {
+            app.update();
+        }
+        assert_eq!(level(&app, cloth), 0);
+        assert!(app.world().get::<ClothInvalid>(cloth).is_none(), "refused");
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        assert_eq!(sim.solver.params().model, Model::MassSpring);
+        assert!(sim.solver.patches().is_none());
+    }
+}

@@ -4,7 +4,7 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
 use crate::ecs::cloth::{Cloth, ClothSimulation};
-use crate::params::{Model, PatchParams};
+use crate::params::{ClothParams, Model, PatchParams};
 
 /// Level of detail: the cloth's model follows its size on screen. At level 0
 /// the cloth runs its own model; below each threshold it switches to the patch model with
@@ -100,7 +100,23 @@ fn choose_levels(
         };
         let lod = lod.bypass_change_detection();
         lod.screen_fraction = fraction;
-        let level = lod.next_level(lod.level, fraction);
+        let coarse = |level: usize| {
+            Model::Patches(PatchParams {
+                part_width: ClothLod::PART_SIZES[level - 1],
+                part_height: ClothLod::PART_SIZES[level - 1],
+                ..PatchParams::default()
+            })
+        };
+        let mut level = lod.next_level(lod.level, fraction);
+        // A cloth the patch model refuses (self-collision, a fabric in physical units)
+        // keeps its own model at any distance: its own checks decide.
+        let params = ClothParams {
+            model: coarse(level.max(1)),
+            ..cloth.params
+        };
+        if level > 0 && lod.level == 0 && params.validate().is_err() {
+            level = 0;
+        }
         if level == lod.level {
             continue;
         }
@@ -110,11 +126,7 @@ fn choose_levels(
         lod.level = level;
         cloth.params.model = match level {
             0 => lod.full.take().unwrap_or(cloth.params.model),
-            l => Model::Patches(PatchParams {
-                part_width: ClothLod::PART_SIZES[l - 1],
-                part_height: ClothLod::PART_SIZES[l - 1],
-                ..PatchParams::default()
-            }),
+            l => coarse(l),
         };
     }
 }
