@@ -308,6 +308,12 @@ fn a_box_collider_reads_from_a_scene_and_scales_with_its_transform() {
     assert!(e.to_string().contains("half_height"), "{e}");
 }
 
+/// The first ```rust block of `text` from byte `from` on.
+fn rust_block(text: &str, from: usize) -> &str {
+    let start = from + text[from..].find("```rust\n").expect("a Rust block") + "```rust\n".len();
+    &text[start..start + text[start..].find("```").expect("a closed block")]
+}
+
 /// The README's quick start is `examples/quickstart.rs` (which `cargo test` compiles),
 /// without the example's doc comment.
 #[test]
@@ -320,13 +326,34 @@ fn the_readme_quick_start_is_the_quickstart_example() {
         .map(|l| format!("{l}\n"))
         .collect();
     let readme = std::fs::read_to_string(format!("{root}/README.md")).unwrap();
-    let start = readme.find("```rust\n").expect("a Rust block") + "```rust\n".len();
-    let block = &readme[start..start + readme[start..].find("```").unwrap()];
     assert_eq!(
-        block,
+        rust_block(&readme, 0),
         code.trim_start(),
         "README.md's quick start differs from the example"
     );
+}
+
+/// The recipes in `docs/recipes.md` are the examples' code: every block marked
+/// `<!-- file: PATH -->` is that whole file, so what the page shows compiles and runs.
+#[test]
+fn every_recipe_block_is_its_example_file() {
+    let root = env!("CARGO_MANIFEST_DIR");
+    let page = std::fs::read_to_string(format!("{root}/docs/recipes.md")).unwrap();
+    let marks: Vec<usize> = page.match_indices("<!-- file: ").map(|(i, _)| i).collect();
+    assert!(!marks.is_empty(), "no recipe block is marked with its file");
+    for at in marks {
+        let path = page[at + "<!-- file: ".len()..]
+            .split(" -->")
+            .next()
+            .unwrap();
+        let file = std::fs::read_to_string(format!("{root}/{path}"))
+            .unwrap_or_else(|e| panic!("{path}: {e}"));
+        assert_eq!(
+            rust_block(&page, at),
+            file,
+            "docs/recipes.md's block for {path}"
+        );
+    }
 }
 
 #[test]
