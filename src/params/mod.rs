@@ -354,8 +354,8 @@ impl ClothParams {
 /// Refuses `params` on a cloth of `particles` when a step's fixed work is over
 /// [`MAX_WORK_PER_STEP`](crate::limits::MAX_WORK_PER_STEP) (particles × fixed substeps) or
 /// [`MAX_SWEEP_WORK_PER_STEP`](crate::limits::MAX_SWEEP_WORK_PER_STEP) (× fixed limiter
-/// sweeps). Automatic substeps are capped at the budget instead (see
-/// [`auto_substeps_cap`](crate::limits::auto_substeps_cap)).
+/// sweeps). Automatic substeps are capped at the budget instead (the step reports
+/// `under_resolved`).
 pub fn check_work(particles: usize, params: &ClothParams) -> Result<(), ClothError> {
     let n = particles as u64;
     let Substeps::Fixed(substeps) = params.substeps else {
