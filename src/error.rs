@@ -1,5 +1,7 @@
 //! Typed errors for bad input: they name what is wrong and never panic.
 
+use std::borrow::Cow;
+
 use bevy::reflect::Reflect;
 use thiserror::Error;
 
@@ -16,8 +18,8 @@ pub enum ClothError {
         field: &'static str,
         /// The value given.
         value: f32,
-        /// What is allowed.
-        expected: &'static str,
+        /// What is allowed (a limit's value taken from its constant in `limits`).
+        expected: Cow<'static, str>,
     },
     /// A grid needs at least 2×2 particles to have a spring and a face.
     #[error("a grid cloth needs at least 2×2 particles, got {width}×{height}")]

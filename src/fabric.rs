@@ -182,7 +182,10 @@ impl Fabric {
                 field,
                 value,
                 value > 0.0 && value <= crate::limits::MAX_STIFFNESS,
-                "a stiffness above 0, at most 1e9 N/m",
+                format!(
+                    "a stiffness above 0, at most {:e} N/m (limits::MAX_STIFFNESS)",
+                    crate::limits::MAX_STIFFNESS
+                ),
             )?;
         }
         check(

@@ -309,7 +309,7 @@ impl ClothScene {
     /// The first cloth or collider placed out of range (not finite, or farther than
     /// `limits::MAX_POSITION`): its field, the key to point at, the message and the
     /// section it is in.
-    fn misplaced(&self) -> Option<(String, &'static str, &'static str, &'static str)> {
+    fn misplaced(&self) -> Option<(String, &'static str, String, &'static str)> {
         let placed = |p: Vec3| p.is_finite() && p.length() <= crate::limits::MAX_POSITION;
         let angle = |a: f32| a.is_finite() && a.abs() <= crate::limits::MAX_POSITION;
         for (i, entry) in self.cloths.iter().enumerate() {
@@ -319,13 +319,19 @@ impl ClothScene {
                 ("pitch_degrees", angle(entry.pitch_degrees)),
             ];
             if let Some((key, _)) = checks.iter().find(|(_, ok)| !ok) {
-                let message = "must be finite and within 1e5 (limits::MAX_POSITION)";
+                let message = format!(
+                    "must be finite and within {max:e} (limits::MAX_POSITION)",
+                    max = crate::limits::MAX_POSITION
+                );
                 return Some((format!("cloths[{i}].{key}"), key, message, "cloths"));
             }
         }
         for (i, entry) in self.colliders.iter().enumerate() {
             if !placed(entry.translation) || !placed(entry.rotation_degrees) {
-                let message = "translation and rotation_degrees must be finite and within 1e5 (limits::MAX_POSITION)";
+                let message = format!(
+                    "translation and rotation_degrees must be finite and within {max:e} (limits::MAX_POSITION)",
+                    max = crate::limits::MAX_POSITION
+                );
                 let field = format!("colliders[{i}].translation");
                 return Some((field, "translation", message, "colliders"));
             }
@@ -407,7 +413,7 @@ impl ClothScene {
         }
         if let Some((field, key, message, section)) = self.misplaced() {
             let after = text.find(section).unwrap_or(0);
-            return Err(invalid(field, key, message.into(), after));
+            return Err(invalid(field, key, message, after));
         }
         let mut search_from = text.find("cloths").unwrap_or(0);
         for (i, entry) in self.cloths.iter().enumerate() {

@@ -157,9 +157,15 @@ impl ColliderKind {
                     "radius",
                     radius,
                     false,
-                    "a radius from 0 (excluded) to 1e5 m",
+                    format!(
+                        "a radius from 0 (excluded) to {max:e} m",
+                        max = crate::limits::MAX_POSITION
+                    ),
                 )?;
-                let expected = "a half-length from 0 to 1e5 m";
+                let expected = format!(
+                    "a half-length from 0 to {max:e} m",
+                    max = crate::limits::MAX_POSITION
+                );
                 check_size("half_length", half_length, true, expected)
             }
             ColliderKind::Cuboid { half_extents } => {
@@ -182,7 +188,15 @@ impl ColliderKind {
                 let ok = length.is_finite() && length > 1e-6;
                 crate::params::check("normal", length, ok, "a finite, non-zero normal")?;
                 let ok = distance.abs() <= crate::limits::MAX_POSITION;
-                crate::params::check("distance", distance, ok, "a distance within ±1e5 m")
+                crate::params::check(
+                    "distance",
+                    distance,
+                    ok,
+                    format!(
+                        "a distance within ±{max:e} m",
+                        max = crate::limits::MAX_POSITION
+                    ),
+                )
             }
         }
     }
@@ -332,9 +346,15 @@ impl ClothCollider {
             "thickness",
             self.thickness,
             true,
-            "a thickness from 0 to 1e5 m",
+            format!(
+                "a thickness from 0 to {max:e} m",
+                max = crate::limits::MAX_POSITION
+            ),
         )?;
-        let expected = "a friction coefficient from 0 to 1e5";
+        let expected = format!(
+            "a friction coefficient from 0 to {max:e}",
+            max = crate::limits::MAX_POSITION
+        );
         check_size("friction", self.friction, true, expected)
     }
 

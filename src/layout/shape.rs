@@ -122,7 +122,7 @@ impl ClothShape {
                 return Err(ClothError::InvalidParameter {
                     field: "shape.spacing",
                     value: spacing,
-                    expected: "a distance from 0 (excluded) to 10 m (limits::MAX_SPACING)",
+                    expected: "a distance from 0 (excluded) to 10 m (limits::MAX_SPACING)".into(),
                 });
             }
         }
@@ -132,7 +132,7 @@ impl ClothShape {
             return Err(ClothError::InvalidParameter {
                 field: "shape.resolution",
                 value: resolution as f32,
-                expected: "a resolution of 1 to 64",
+                expected: "a resolution of 1 to 64".into(),
             });
         }
         Ok(())

@@ -1,5 +1,6 @@
 //! The world a cloth moves in: gravity, wind and air.
 
+use crate::limits::{MAX_GRAVITY, MAX_WIND};
 use bevy::math::Vec3;
 use bevy::reflect::Reflect;
 use serde::{Deserialize, Serialize};
@@ -226,7 +227,7 @@ impl Environment {
             "gravity",
             g.length(),
             g.is_finite() && g.length() <= crate::limits::MAX_GRAVITY,
-            "a finite vector of at most 1,000 m/s² (limits::MAX_GRAVITY)",
+            format!("a finite vector of at most {MAX_GRAVITY} m/s² (limits::MAX_GRAVITY)"),
         )?;
         let w = &self.wind;
         check(
@@ -239,7 +240,7 @@ impl Environment {
             "wind.strength",
             w.strength,
             (0.0..=crate::limits::MAX_WIND).contains(&w.strength),
-            "a strength from 0 to 1,000 N (limits::MAX_WIND)",
+            format!("a strength from 0 to {MAX_WIND} N (limits::MAX_WIND)"),
         )?;
         self.air.as_ref().map_or(Ok(()), Air::validate)
     }

@@ -151,7 +151,7 @@ pub(crate) fn check(
     field: &'static str,
     value: f32,
     ok: bool,
-    expected: &'static str,
+    expected: impl Into<std::borrow::Cow<'static, str>>,
 ) -> Result<(), ClothError> {
     if ok && value.is_finite() {
         Ok(())
@@ -159,7 +159,7 @@ pub(crate) fn check(
         Err(ClothError::InvalidParameter {
             field,
             value,
-            expected,
+            expected: expected.into(),
         })
     }
 }
@@ -188,14 +188,16 @@ impl ClothParams {
             "node_mass",
             self.node_mass,
             (MIN_NODE_MASS..=MAX_NODE_MASS).contains(&self.node_mass),
-            "a mass from 1e-9 to 1,000 kg (limits::MIN_NODE_MASS, MAX_NODE_MASS)",
+            format!(
+                "a mass from {MIN_NODE_MASS:e} to {MAX_NODE_MASS} kg (limits::MIN_NODE_MASS, MAX_NODE_MASS)"
+            ),
         )?;
         self.validate_springs()?;
         check(
             "drag",
             self.drag,
             (0.0..=MAX_DAMPING).contains(&self.drag),
-            "a drag from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
+            format!("a drag from 0 to {MAX_DAMPING:e} N·s/m (limits::MAX_DAMPING)"),
         )?;
         self.validate_stepping()?;
         if let Some(ratio) = self.tear_ratio {
@@ -241,14 +243,16 @@ impl ClothParams {
                 field,
                 family.stiffness,
                 (0.0..=MAX_STIFFNESS).contains(&family.stiffness),
-                "a stiffness from 0 to 1e9 N/m (limits::MAX_STIFFNESS; inf only for XPBD)",
+                format!(
+                    "a stiffness from 0 to {MAX_STIFFNESS:e} N/m (limits::MAX_STIFFNESS; inf only for XPBD)"
+                ),
             )?;
         }
         check(
             "springs.damping",
             s.damping,
             (0.0..=MAX_DAMPING).contains(&s.damping),
-            "a damping from 0 to 1e6 N·s/m (limits::MAX_DAMPING)",
+            format!("a damping from 0 to {MAX_DAMPING:e} N·s/m (limits::MAX_DAMPING)"),
         )?;
         check(
             "springs.seam_rest_length",
@@ -272,28 +276,28 @@ impl ClothParams {
                 return Err(ClothError::InvalidParameter {
                     field: "substeps",
                     value: 0.0,
-                    expected: "at least 1 substep",
+                    expected: "at least 1 substep".into(),
                 });
             }
             Substeps::Auto { max: 0 } => {
                 return Err(ClothError::InvalidParameter {
                     field: "substeps.max",
                     value: 0.0,
-                    expected: "at least 1 substep",
+                    expected: "at least 1 substep".into(),
                 });
             }
             Substeps::Fixed(n) if n > MAX_SUBSTEPS => {
                 return Err(ClothError::InvalidParameter {
                     field: "substeps",
                     value: n as f32,
-                    expected: "at most 65,536 substeps (limits::MAX_SUBSTEPS)",
+                    expected: "at most 65,536 substeps (limits::MAX_SUBSTEPS)".into(),
                 });
             }
             Substeps::Auto { max } if max > MAX_SUBSTEPS => {
                 return Err(ClothError::InvalidParameter {
                     field: "substeps.max",
                     value: max as f32,
-                    expected: "at most 65,536 substeps (limits::MAX_SUBSTEPS)",
+                    expected: "at most 65,536 substeps (limits::MAX_SUBSTEPS)".into(),
                 });
             }
             _ => {}
@@ -302,7 +306,7 @@ impl ClothParams {
             return Err(ClothError::InvalidParameter {
                 field: "strain_limit_iterations",
                 value: self.strain_limit_iterations as f32,
-                expected: "at most 1,024 sweeps (limits::MAX_LIMITER_SWEEPS)",
+                expected: "at most 1,024 sweeps (limits::MAX_LIMITER_SWEEPS)".into(),
             });
         }
         if let Some(limit) = self.strain_limit {

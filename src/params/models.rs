@@ -90,7 +90,7 @@ impl ShapeMatchingParams {
             "model.stiffness",
             self.stiffness,
             (0.0..=MAX_STIFFNESS).contains(&self.stiffness),
-            "a stiffness from 0 to 1e9 (limits::MAX_STIFFNESS)",
+            format!("a stiffness from 0 to {MAX_STIFFNESS:e} (limits::MAX_STIFFNESS)"),
         )?;
         if self.update == GoalUpdate::Velocity {
             check(
@@ -105,7 +105,7 @@ impl ShapeMatchingParams {
             "model.damping",
             self.damping,
             (0.0..=MAX_DAMPING).contains(&self.damping),
-            "a damping from 0 to 1e6 (limits::MAX_DAMPING)",
+            format!("a damping from 0 to {MAX_DAMPING:e} (limits::MAX_DAMPING)"),
         )?;
         check(
             "model.beta",
@@ -117,7 +117,7 @@ impl ShapeMatchingParams {
             return Err(ClothError::InvalidParameter {
                 field: "model.clusters",
                 value: self.clusters as f32,
-                expected: "1 to 64 clusters per side",
+                expected: "1 to 64 clusters per side".into(),
             });
         }
         Ok(())
@@ -202,7 +202,7 @@ impl PatchParams {
                 return Err(ClothError::InvalidParameter {
                     field,
                     value: size as f32,
-                    expected: "a part size of 1 to 16 particles",
+                    expected: "a part size of 1 to 16 particles".into(),
                 });
             }
         }
@@ -210,20 +210,20 @@ impl PatchParams {
             "model.stiffness",
             self.stiffness,
             self.stiffness > 0.0 && self.stiffness <= MAX_STIFFNESS,
-            "a stiffness from 0 (excluded) to 1e9 (limits::MAX_STIFFNESS)",
+            format!("a stiffness from 0 (excluded) to {MAX_STIFFNESS:e} (limits::MAX_STIFFNESS)"),
         )?;
         check_exponent(self.exponent)?;
         check(
             "model.particle_damping_ratio",
             self.particle_damping_ratio,
             (0.0..=MAX_DAMPING).contains(&self.particle_damping_ratio),
-            "a ratio from 0 to 1e6 (limits::MAX_DAMPING)",
+            format!("a ratio from 0 to {MAX_DAMPING:e} (limits::MAX_DAMPING)"),
         )?;
         check(
             "model.part_damping",
             self.part_damping,
             (0.0..=MAX_DAMPING).contains(&self.part_damping),
-            "a damping from 0 to 1e6 (limits::MAX_DAMPING)",
+            format!("a damping from 0 to {MAX_DAMPING:e} (limits::MAX_DAMPING)"),
         )?;
         Ok(())
     }

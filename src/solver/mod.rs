@@ -255,6 +255,7 @@ pub(crate) fn check_fabric_masses(params: &ClothParams, area: &[f32]) -> Result<
         field: "fabric.areal_density",
         value: fabric.areal_density,
         expected: "a density whose lightest particle weighs at least 1e-9 kg \
-                   (limits::MIN_NODE_MASS) at this cloth's spacing",
+                   (limits::MIN_NODE_MASS) at this cloth's spacing"
+            .into(),
     })
 }

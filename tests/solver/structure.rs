@@ -416,3 +416,24 @@ fn an_attached_particle_reaches_its_target_every_step_and_falls_when_let_go() {
         assert!(cloth.attach(1, Vec3::splat(f32::NAN)).is_err());
     }
 }
+
+/// A refusal states its limit from the constant in `limits`, so the message and the
+/// check cannot drift apart.
+#[test]
+fn a_refusal_states_its_limit_from_the_constant() {
+    use bevy_cloth::limits::{MAX_NODE_MASS, MAX_POSITION, MIN_NODE_MASS};
+    let light = ClothParams {
+        node_mass: -1.0,
+        ..ClothParams::default()
+    };
+    let e = light.validate().unwrap_err().to_string();
+    assert!(e.contains(&format!("{MIN_NODE_MASS:e}")), "{e}");
+    assert!(e.contains(&MAX_NODE_MASS.to_string()), "{e}");
+    let far = ClothCollider::sphere(2.0 * MAX_POSITION)
+        .validate()
+        .unwrap_err();
+    assert!(
+        far.to_string().contains(&format!("{MAX_POSITION:e}")),
+        "{far}"
+    );
+}

@@ -357,8 +357,9 @@ fn check_header(
             return Err(error(
                 &format!("\"{}\"", piece.name),
                 format!(
-                    "piece `{}`: translation and yaw_degrees must be finite and within 1e5 (limits::MAX_POSITION)",
-                    piece.name
+                    "piece `{}`: translation and yaw_degrees must be finite and within {:e} (limits::MAX_POSITION)",
+                    piece.name,
+                    crate::limits::MAX_POSITION
                 ),
             ));
         }

@@ -163,7 +163,11 @@ impl ClothSolver {
             return Err(ClothError::InvalidParameter {
                 field: "attachment target",
                 value: target.length(),
-                expected: "a finite point within 1e5 m (limits::MAX_POSITION)",
+                expected: format!(
+                    "a finite point within {:e} m (limits::MAX_POSITION)",
+                    crate::limits::MAX_POSITION
+                )
+                .into(),
             });
         }
         if let Some(k) = slot {
@@ -222,14 +226,14 @@ impl ClothSolver {
             return Err(ClothError::InvalidParameter {
                 field: "motion constraints",
                 value: targets.len().max(max_distance.len()) as f32,
-                expected: "one target and one distance per particle",
+                expected: "one target and one distance per particle".into(),
             });
         }
         if let Some(&r) = max_distance.iter().find(|r| r.is_nan() || **r < 0.0) {
             return Err(ClothError::InvalidParameter {
                 field: "motion constraint distance",
                 value: r,
-                expected: "a distance ≥ 0 m (f32::INFINITY: free)",
+                expected: "a distance ≥ 0 m (f32::INFINITY: free)".into(),
             });
         }
         let was = std::mem::take(&mut self.drivers.motion.radius);

@@ -59,7 +59,7 @@ impl Shape for Capsule {
     fn validate(&self) -> Result<(), ClothError> {
         check_point("a", self.a)?;
         check_point("b", self.b)?;
-        check_size("radius", self.radius, false, "a radius from 0 (excluded) to 1e5 m")
+        check_size("radius", self.radius, false, format!("a radius from 0 (excluded) to {max:e} m", max = crate::limits::MAX_POSITION))
     }
 }
 

@@ -82,9 +82,9 @@ impl Shape for Cuboid {
     fn validate(&self) -> Result<(), ClothError> {
         check_point("center", self.center)?;
         let h = self.half_extents;
-        let expected = "a half-extent from 0 (excluded) to 1e5 m";
-        check_size("half_extents.x", h.x, false, expected)?;
-        check_size("half_extents.y", h.y, false, expected)?;
+        let expected = format!("a half-extent from 0 (excluded) to {max:e} m", max = crate::limits::MAX_POSITION);
+        check_size("half_extents.x", h.x, false, expected.clone())?;
+        check_size("half_extents.y", h.y, false, expected.clone())?;
         check_size("half_extents.z", h.z, false, expected)
     }
 }

@@ -67,12 +67,12 @@ impl Shape for Cylinder {
 
     fn validate(&self) -> Result<(), ClothError> {
         check_point("center", self.center)?;
-        check_size("radius", self.radius, false, "a radius from 0 (excluded) to 1e5 m")?;
+        check_size("radius", self.radius, false, format!("a radius from 0 (excluded) to {max:e} m", max = crate::limits::MAX_POSITION))?;
         check_size(
             "half_height",
             self.half_height,
             false,
-            "a half-height from 0 (excluded) to 1e5 m",
+            format!("a half-height from 0 (excluded) to {max:e} m", max = crate::limits::MAX_POSITION),
         )
     }
 }

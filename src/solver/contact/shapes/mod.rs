@@ -151,7 +151,7 @@ pub(crate) fn check_size(
     field: &'static str,
     value: f32,
     zero_allowed: bool,
-    expected: &'static str,
+    expected: impl Into<std::borrow::Cow<'static, str>>,
 ) -> Result<(), ClothError> {
     let low = if zero_allowed {
         value >= 0.0
@@ -167,7 +167,15 @@ pub(crate) fn check_size(
 pub(crate) fn check_point(field: &'static str, x: Vec3) -> Result<(), ClothError> {
     let far = x.abs().max_element();
     let ok = far <= crate::limits::MAX_POSITION;
-    crate::params::check(field, far, ok, "a point within 1e5 m of the origin")
+    crate::params::check(
+        field,
+        far,
+        ok,
+        format!(
+            "a point within {max:e} m of the origin",
+            max = crate::limits::MAX_POSITION
+        ),
+    )
 }
 
 /// Registers the shapes: one line each, `Variant(module)`, its doc comment above it. The

@@ -39,6 +39,6 @@ impl Shape for Sphere {
 
     fn validate(&self) -> Result<(), ClothError> {
         check_point("center", self.center)?;
-        check_size("radius", self.radius, false, "a radius from 0 (excluded) to 1e5 m")
+        check_size("radius", self.radius, false, format!("a radius from 0 (excluded) to {max:e} m", max = crate::limits::MAX_POSITION))
     }
 }

@@ -53,8 +53,8 @@ impl Shape for Torus {
 
     fn validate(&self) -> Result<(), ClothError> {
         check_point("center", self.center)?;
-        let expected = "a radius from 0 (excluded) to 1e5 m";
-        check_size("major_radius", self.major_radius, false, expected)?;
+        let expected = format!("a radius from 0 (excluded) to {max:e} m", max = crate::limits::MAX_POSITION);
+        check_size("major_radius", self.major_radius, false, expected.clone())?;
         check_size("minor_radius", self.minor_radius, false, expected)
     }
 }
