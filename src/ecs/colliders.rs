@@ -153,15 +153,9 @@ impl ColliderKind {
                 radius,
                 half_length,
             } => {
-                check_size(
-                    "radius",
-                    radius,
-                    false,
-                    format!(
-                        "a radius from 0 (excluded) to {max:e} m",
-                        max = crate::limits::MAX_POSITION
-                    ),
-                )?;
+                // Its radius as a ball's.
+                let center = Vec3::ZERO;
+                Sphere { center, radius }.validate()?;
                 let expected = format!(
                     "a half-length from 0 to {max:e} m",
                     max = crate::limits::MAX_POSITION
