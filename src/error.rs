@@ -62,6 +62,16 @@ pub enum ClothError {
         /// How many particles the cloth has.
         count: usize,
     },
+    /// An attachment that holds none of the cloth's particles (every index past the cloth,
+    /// no garment run of its name, or a count of 0): the cloth would fall instead of
+    /// hanging, so it is not simulated until its attachments change.
+    #[error("`ClothAttachments[{attachment}].particles`: {reason}; the cloth is not simulated until its attachments change")]
+    AttachmentHoldsNothing {
+        /// The attachment's place in `ClothAttachments`.
+        attachment: usize,
+        /// What it asked for, and what the cloth has.
+        reason: String,
+    },
     /// A mesh given as a cloth has no usable triangles or positions.
     #[error("the mesh cannot be a cloth: {reason}")]
     BadMesh {

@@ -65,7 +65,7 @@ pub mod prelude {
     pub use crate::ecs::avian::ClothAvianPlugin;
     pub use crate::ecs::{
         AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBecameInvalid,
-        ClothBuilt, ClothCollider, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
+        ClothBuilt, ClothCollider, ClothColliderBecameInvalid, ClothColliderInvalid, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
         ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
         ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
         ClothTorn, ClothWake,

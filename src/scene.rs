@@ -564,7 +564,7 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         ModelLacks { feature, .. } if feature.starts_with("fabric") => "fabric",
         ModelLacks { .. } => "self_collision",
         UnknownFabric { .. } | FabricNeedsSurface => "fabric",
-        NotMeasurable { .. } | NonFinite { .. } => "cloths",
+        NotMeasurable { .. } | NonFinite { .. } | AttachmentHoldsNothing { .. } => "cloths",
     }
 }
 

@@ -4,7 +4,8 @@
 use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
-use crate::ecs::cloth::ClothSimulation;
+use crate::ecs::cloth::{ClothInvalid, ClothSimulation, pause_invalid};
+use crate::error::ClothError;
 use crate::solver;
 
 /// Attaches particles of this cloth to other entities (a cape to a character's
@@ -32,7 +33,8 @@ pub struct ClothAttachment {
 #[derive(Clone, Debug, PartialEq, Reflect)]
 #[reflect(Debug, PartialEq)]
 pub enum AttachParticles {
-    /// By index (`j·width + i` for a grid); indices past the cloth are skipped.
+    /// By index (`j·width + i` for a grid); indices past the cloth are left out (with a
+    /// warning); if none is inside it, the cloth is not simulated ([`ClothError::AttachmentHoldsNothing`]).
     Indices(Vec<u32>),
     /// The `count` particles nearest `point`, a point in the target's frame (a shoulder).
     Nearest {
@@ -50,7 +52,7 @@ pub enum AttachParticles {
 
 impl ClothAttachment {
     /// The garment run `name` (its file's `runs`) held to `target`; a cloth without such a
-    /// run logs an error and attaches nothing.
+    /// run is not simulated ([`ClothError::AttachmentHoldsNothing`]).
     pub fn run(target: Entity, name: impl Into<String>) -> Self {
         Self {
             target,
@@ -60,7 +62,8 @@ impl ClothAttachment {
     }
 
     /// Each particle held to `target` at its point in `target`'s frame (a local offset),
-    /// wherever the particle starts; indices past the cloth are skipped.
+    /// wherever the particle starts; indices past the cloth are left out as for
+    /// [`AttachParticles::Indices`].
     pub fn at(target: Entity, points: Vec<(u32, Vec3)>) -> Self {
         Self {
             target,
@@ -97,15 +100,26 @@ impl ClothAttachment {
 /// Holds each [`ClothAttachments`] cloth's particles at their entities' global
 /// transforms for this step (the solver reaches them over its substeps). The particles and
 /// their points in the target's frame are chosen the first time (and again when the cloth
-/// is rebuilt); a target without a transform (despawned) lets its particles go.
+/// is rebuilt); a target without a transform (despawned) lets its particles go. An
+/// attachment that holds none of the cloth's particles stops the cloth
+/// ([`ClothError::AttachmentHoldsNothing`]) until its attachments change.
+#[allow(clippy::type_complexity)]
 fn attach_cloths(
+    mut commands: Commands,
     transforms: TransformHelper,
-    mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothAttachments)>,
+    mut cloths: Query<
+        (Entity, &mut ClothSimulation, &mut ClothAttachments, Option<&Name>),
+        Without<ClothInvalid>,
+    >,
 ) {
-    for (entity, mut sim, mut attachments) in &mut cloths {
+    for (entity, mut sim, mut attachments, name) in &mut cloths {
         let rebuilt = sim.is_added();
         let solver = &mut sim.solver;
-        for attachment in &mut attachments.0 {
+        let who = Who(entity, name);
+        // The chosen particles are the plugin's bookkeeping, not a change of the user's
+        // attachments (which lifts a refusal, `retry_attachments`).
+        let attachments = attachments.bypass_change_detection();
+        for (k, attachment) in attachments.0.iter_mut().enumerate() {
             if rebuilt {
                 attachment.held = None;
             }
@@ -115,32 +129,69 @@ fn attach_cloths(
                 }
                 continue;
             };
-            let held = attachment
-                .held
-                .get_or_insert_with(|| choose_held(entity, &attachment.particles, solver, &frame));
-            let attached = held
+            if attachment.held.is_none() {
+                match choose_held(who, &attachment.particles, solver, &frame) {
+                    Ok(held) => attachment.held = Some(held),
+                    Err(reason) => {
+                        let error = ClothError::AttachmentHoldsNothing {
+                            attachment: k,
+                            reason,
+                        };
+                        pause_invalid(&mut commands, entity, error);
+                        break;
+                    }
+                }
+            }
+            let attached = attachment
+                .held()
                 .iter()
                 .try_for_each(|&(i, local)| solver.attach(i, frame.transform_point(local)));
             if let Err(e) = attached {
-                warn!("cloth attachment: {e}; choosing its particles again");
+                warn!("{who}: attachment {k}: {e}; choosing its particles again");
                 attachment.held = None;
             }
         }
     }
 }
 
+/// A cloth stopped by an attachment that held nothing runs again once its attachments
+/// change (they are chosen afresh on the next step).
+fn retry_attachments(
+    mut commands: Commands,
+    cloths: Query<(Entity, &ClothInvalid), Changed<ClothAttachments>>,
+) {
+    for (entity, invalid) in &cloths {
+        if matches!(invalid.0, ClothError::AttachmentHoldsNothing { .. }) {
+            commands.entity(entity).remove::<ClothInvalid>();
+        }
+    }
+}
+
+/// A cloth as a person reads it in a log line: its `Name` and entity, or the entity alone.
+#[derive(Clone, Copy)]
+struct Who<'a>(Entity, Option<&'a Name>);
+
+impl std::fmt::Display for Who<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.1 {
+            Some(name) => write!(f, "cloth `{name}` ({})", self.0),
+            None => write!(f, "cloth {}", self.0),
+        }
+    }
+}
+
 /// The particles an attachment holds and each one's point in the target's frame (`frame`
-/// where the target is now): given, or where the particle is now.
+/// where the target is now): given, or where the particle is now; or why it holds none.
 fn choose_held(
-    cloth: Entity,
+    who: Who,
     particles: &AttachParticles,
     solver: &solver::ClothSolver,
     frame: &GlobalTransform,
-) -> Vec<(u32, Vec3)> {
+) -> Result<Vec<(u32, Vec3)>, String> {
     let x = solver.positions();
     let to_local = frame.affine().inverse();
     let here = |i: u32| (i, to_local.transform_point3(x[i as usize]));
-    let kept = |held: Vec<(u32, Vec3)>, given: usize| left_out(cloth, held, given, x.len());
+    let kept = |held: Vec<(u32, Vec3)>, given: usize| left_out(who, held, given, x.len());
     match particles {
         AttachParticles::At(points) => kept(
             points
@@ -159,6 +210,9 @@ fn choose_held(
             list.len(),
         ),
         AttachParticles::Nearest { point, count } => {
+            if *count == 0 {
+                return Err("it asks for the 0 particles nearest a point".into());
+            }
             let at = frame.transform_point(*point);
             let mut order: Vec<u32> = (0..x.len() as u32).collect();
             order.sort_by(|&a, &b| {
@@ -167,35 +221,39 @@ fn choose_held(
                     .total_cmp(&x[b as usize].distance_squared(at))
             });
             order.truncate(*count as usize);
-            order.into_iter().map(here).collect()
+            Ok(order.into_iter().map(here).collect())
         }
         AttachParticles::Run(name) => match solver.run(name) {
-            Some(run) => run.iter().copied().map(here).collect(),
-            None => {
-                error!("cloth {cloth}: no run named `{name}` to attach");
-                Vec::new()
-            }
+            Some(run) if !run.is_empty() => Ok(run.iter().copied().map(here).collect()),
+            _ => Err(format!("the cloth has no garment run named `{name}`")),
         },
     }
 }
 
 /// `held`, the particles of `given` that the cloth (of `count` particles) has: the others
-/// are left out, and said so (a cloth whose every attached index lay outside it fell
-/// without a word).
-fn left_out(cloth: Entity, held: Vec<(u32, Vec3)>, given: usize, count: usize) -> Vec<(u32, Vec3)> {
+/// are left out with a warning; none held at all is an error (a cloth whose every
+/// attached index lay outside it fell without a word).
+fn left_out(
+    who: Who,
+    held: Vec<(u32, Vec3)>,
+    given: usize,
+    count: usize,
+) -> Result<Vec<(u32, Vec3)>, String> {
+    if held.is_empty() {
+        return Err(format!(
+            "none of its {given} particles is among the cloth's {count} (indices 0 to {}) \
+             with a finite point",
+            count.saturating_sub(1)
+        ));
+    }
     if held.len() < given {
-        let nothing = if held.is_empty() {
-            "; it holds nothing"
-        } else {
-            ""
-        };
         warn!(
-            "cloth {cloth}: {} of the attachment's {given} particles are not among its {count} \
-             (or their points are not finite) and are left out{nothing}",
+            "{who}: {} of the attachment's {given} particles are not among its {count} \
+             (or their points are not finite) and are left out",
             given - held.len(),
         );
     }
-    held
+    Ok(held)
 }
 
 /// Attachments ([`ClothAttachments`]): particles held at points of other entities,
@@ -210,7 +268,9 @@ impl Plugin for ClothAttachPlugin {
             .register_type::<AttachParticles>()
             .add_systems(
                 schedule,
-                attach_cloths.in_set(crate::ecs::plugin::ClothPrepareSystems::Attach),
+                (retry_attachments, attach_cloths)
+                    .chain()
+                    .in_set(crate::ecs::plugin::ClothPrepareSystems::Attach),
             );
     }
 }

@@ -215,9 +215,10 @@ impl Default for ClothInterpolation {
     }
 }
 
-/// Why a cloth is not simulated, or a collider left out: the plugin puts this on a cloth
-/// whose description is invalid, or a [`ClothCollider`](crate::ClothCollider) whose sizes
-/// are (and logs it), and removes it once the description is fixed.
+/// Why a cloth is not simulated: the plugin puts this on a cloth whose description (or
+/// an attachment) is invalid, or whose step went non-finite, logs it, and removes it
+/// once the cause is fixed. (A refused collider gets
+/// [`ClothColliderInvalid`](crate::ClothColliderInvalid) instead.)
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
 #[reflect(Component, Debug, PartialEq)]
 pub struct ClothInvalid(pub ClothError);

@@ -5,7 +5,8 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 use serde::{Deserialize, Serialize};
 
-use crate::ecs::cloth::{ClothInvalid, ClothSimulation, Layers};
+use crate::ecs::cloth::{ClothSimulation, Layers};
+use crate::ecs::events::ClothColliderBecameInvalid;
 use crate::error::ClothError;
 use crate::solver;
 use crate::solver::shapes::check_size;
@@ -482,7 +483,7 @@ impl ClothColliderSpan {
 pub(crate) fn place_colliders(
     time: Res<Time>,
     transforms: TransformHelper,
-    colliders: Query<(Entity, &ClothCollider, Option<&ClothColliderSpan>), Without<ClothInvalid>>,
+    colliders: Query<(Entity, &ClothCollider, Option<&ClothColliderSpan>), Without<ClothColliderInvalid>>,
     mut placed: ResMut<PlacedColliders>,
 ) {
     let placed = &mut *placed;
@@ -539,30 +540,48 @@ pub(crate) fn give_colliders(
     }
 }
 
+/// Why a [`ClothCollider`] is left out of every cloth's step (a size out of range, such as
+/// a negative radius): the plugin puts this on the collider's entity, triggers
+/// [`ClothColliderBecameInvalid`] on it and logs it once, and removes it once the collider
+/// is fixed.
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Debug, PartialEq)]
+pub struct ClothColliderInvalid(pub ClothError);
+
 /// Checks each collider added or changed ([`ClothCollider::validate`]): one with a size
-/// out of range (a negative radius) is logged with its name, marked [`ClothInvalid`] and
-/// left out of every cloth's step until it is fixed (sizes were clamped to 0 in silence).
+/// out of range is marked [`ClothColliderInvalid`] and left out of every cloth's step
+/// until it is fixed (sizes were clamped to 0 in silence).
 #[allow(clippy::type_complexity)]
 fn check_colliders(
     mut commands: Commands,
     colliders: Query<
-        (Entity, &ClothCollider, Option<&Name>, Has<ClothInvalid>),
+        (Entity, &ClothCollider, Has<ClothColliderInvalid>),
         Changed<ClothCollider>,
     >,
 ) {
-    for (entity, collider, name, invalid) in &colliders {
+    for (entity, collider, invalid) in &colliders {
         match collider.validate() {
             Ok(()) if invalid => {
-                commands.entity(entity).remove::<ClothInvalid>();
+                commands.entity(entity).remove::<ClothColliderInvalid>();
             }
             Ok(()) => {}
             Err(error) => {
-                let who = name.map_or_else(|| entity.to_string(), |n| format!("`{n}` ({entity})"));
-                error!("collider {who} is left out: {error}");
-                commands.entity(entity).insert(ClothInvalid(error));
+                commands
+                    .entity(entity)
+                    .insert(ClothColliderInvalid(error.clone()));
+                commands.trigger(ClothColliderBecameInvalid { entity, error });
             }
         }
     }
+}
+
+/// Logs why a collider is left out, naming it by its `Name` when it has one.
+fn log_invalid_collider(invalid: On<ClothColliderBecameInvalid>, names: Query<&Name>) {
+    let entity = invalid.entity;
+    let who = names
+        .get(entity)
+        .map_or_else(|_| entity.to_string(), |n| format!("`{n}` ({entity})"));
+    error!("collider {who} is left out: {}", invalid.error);
 }
 
 /// Colliders ([`ClothCollider`]): checked when added or changed, placed from their
@@ -575,7 +594,10 @@ impl Plugin for ClothCollidersPlugin {
         app.register_type::<ClothCollider>()
             .register_type::<ColliderKind>()
             .register_type::<ClothColliderSpan>()
+            .register_type::<ClothColliderInvalid>()
+            .register_type::<ClothColliderBecameInvalid>()
             .init_resource::<PlacedColliders>()
+            .add_observer(log_invalid_collider)
             .add_systems(
                 schedule,
                 (check_colliders, place_colliders, give_colliders)

@@ -62,6 +62,19 @@ pub struct ClothBecameInvalid {
     pub error: ClothError,
 }
 
+/// A [`ClothCollider`](crate::ClothCollider) was refused (a size out of range): it is left
+/// out of every cloth's step, and its entity has
+/// [`ClothColliderInvalid`](crate::ClothColliderInvalid) with the same error until it is
+/// fixed.
+#[derive(EntityEvent, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Debug, PartialEq)]
+pub struct ClothColliderBecameInvalid {
+    /// The collider's entity.
+    pub entity: Entity,
+    /// Why.
+    pub error: ClothError,
+}
+
 /// The cloth's solver and mesh were built: the first time, and again after a change of
 /// its shape or pins, or a reload of its garment file (its particles are new).
 #[derive(EntityEvent, Clone, Copy, Debug, PartialEq, Eq, Reflect)]

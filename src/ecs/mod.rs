@@ -23,9 +23,13 @@ pub use cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
 };
 pub use colliders::{
-    ClothCollider, ClothColliderSpan, ClothCollidersPlugin, ColliderKind, TELEPORT_SPEED,
+    ClothCollider, ClothColliderInvalid, ClothColliderSpan, ClothCollidersPlugin, ColliderKind,
+    TELEPORT_SPEED,
 };
-pub use events::{ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothFellAsleep, ClothTorn};
+pub use events::{
+    ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothColliderBecameInvalid, ClothFellAsleep,
+    ClothTorn,
+};
 pub use lod::{ClothLod, ClothLodPlugin};
 pub use mesh::ClothMeshPlugin;
 pub use plugin::{ClothCorePlugin, ClothPlugin, ClothPrepareSystems, ClothSystems};

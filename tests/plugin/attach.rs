@@ -83,7 +83,7 @@ fn an_attached_cloth_follows_its_moving_entity_with_no_lag_beyond_a_step() {
 fn a_garment_hangs_from_its_named_runs_on_a_moving_hanger() {
     // The T-shirt held by its file's two shoulder runs to a "hanger" entity that moves
     // and turns: every run particle is where the hanger puts it each frame, and the shirt
-    // hangs below; a run that does not exist attaches nothing (and the cloth runs on).
+    // hangs below.
     let mut app = app();
     let hanger = app
         .world_mut()
@@ -97,7 +97,6 @@ fn a_garment_hangs_from_its_named_runs_on_a_moving_hanger() {
             ClothAttachments(vec![
                 ClothAttachment::run(hanger, "right shoulder"),
                 ClothAttachment::run(hanger, "left shoulder"),
-                ClothAttachment::run(hanger, "collar"),
             ]),
         ))
         .id();
@@ -115,7 +114,7 @@ fn a_garment_hangs_from_its_named_runs_on_a_moving_hanger() {
             break;
         }
     }
-    assert_eq!(held.len(), 12, "two runs of 6 nodes, none for `collar`");
+    assert_eq!(held.len(), 12, "two runs of 6 nodes");
     for frame in 1..=90 {
         {
             let mut t = app.world_mut().get_mut::<Transform>(hanger).unwrap();
@@ -191,4 +190,61 @@ fn particles_attached_at_local_offsets_go_there_and_follow() {
             );
         }
     }
+}
+
+/// An attachment that holds none of its cloth's particles (every index past the cloth, or
+/// a garment run the cloth lacks) is not skipped in silence while the cloth falls: the
+/// cloth gets `ClothInvalid` naming the attachment, `ClothBecameInvalid` fires, and it does
+/// not move until its attachments change; fixed, it runs and holds.
+#[test]
+fn an_attachment_that_holds_nothing_stops_its_cloth_until_fixed() {
+    let mut app = app();
+    let body = app.world_mut().spawn(Transform::from_xyz(0.0, 2.0, 0.0)).id();
+    let refused = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let seen = refused.clone();
+    let cape = app
+        .world_mut()
+        .spawn((
+            Name::new("cape"),
+            Cloth::grid(4, 4, 0.1).with_pins(ClothPins::None),
+            ClothAttachments(vec![
+                ClothAttachment::indices(body, vec![0, 3]),
+                ClothAttachment::indices(body, vec![16, 400]),
+            ]),
+        ))
+        .observe(move |e: On<ClothBecameInvalid>| seen.lock().unwrap().push(e.error.clone()))
+        .id();
+    for _ in 0..10 {
+        app.update();
+    }
+    let invalid = app.world().get::<ClothInvalid>(cape).expect("refused");
+    assert!(
+        matches!(invalid.0, ClothError::AttachmentHoldsNothing { attachment: 1, .. }),
+        "{:?}",
+        invalid.0
+    );
+    let message = invalid.0.to_string();
+    assert!(message.contains("ClothAttachments[1]") && message.contains("16"), "{message}");
+    assert_eq!(refused.lock().unwrap().len(), 1, "one event, not one a step");
+    let sim = app.world().get::<ClothSimulation>(cape).unwrap();
+    assert_eq!(sim.solver.time(), 0.0, "a refused cloth does not step");
+    // Fixed: the second attachment holds the other top corner.
+    app.world_mut().get_mut::<ClothAttachments>(cape).unwrap().0[1] =
+        ClothAttachment::indices(body, vec![15]);
+    for _ in 0..10 {
+        app.update();
+    }
+    assert!(app.world().get::<ClothInvalid>(cape).is_none());
+    let sim = app.world().get::<ClothSimulation>(cape).unwrap();
+    assert!(sim.solver.time() > 0.0);
+    let attachments = app.world().get::<ClothAttachments>(cape).unwrap();
+    assert_eq!(attachments.0[0].held().len() + attachments.0[1].held().len(), 3);
+    // A garment run the cloth lacks is refused the same way.
+    app.world_mut().get_mut::<ClothAttachments>(cape).unwrap().0[0] =
+        ClothAttachment::run(body, "collar");
+    for _ in 0..3 {
+        app.update();
+    }
+    let invalid = app.world().get::<ClothInvalid>(cape).expect("refused");
+    assert!(invalid.0.to_string().contains("collar"), "{}", invalid.0);
 }

@@ -224,19 +224,26 @@ fn a_torus_collider_is_placed_by_its_transform_and_checked() {
 }
 
 /// A collider with a negative radius is not clamped to 0 in silence: it gets
-/// `ClothInvalid` naming the radius (and is logged) and is left out of the cloths' steps;
-/// fixed, it is a collider again.
+/// `ClothColliderInvalid` naming the radius, `ClothColliderBecameInvalid` fires once (and
+/// it is logged), and it is left out of the cloths' steps; fixed, it is a collider again.
 #[test]
 fn a_collider_of_negative_size_is_refused_until_fixed() {
     let mut app = app();
+    let events = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let seen = events.clone();
     let collider = app
         .world_mut()
         .spawn((ClothCollider::sphere(-1.0), Transform::default()))
+        .observe(move |_: On<ClothColliderBecameInvalid>| {
+            seen.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        })
         .id();
     for _ in 0..3 {
         app.update();
     }
-    let invalid = app.world().get::<ClothInvalid>(collider).expect("refused");
+    assert_eq!(events.load(std::sync::atomic::Ordering::Relaxed), 1);
+    assert!(app.world().get::<ClothInvalid>(collider).is_none(), "not a cloth");
+    let invalid = app.world().get::<ClothColliderInvalid>(collider).expect("refused");
     assert!(
         matches!(
             invalid.0,
@@ -252,5 +259,5 @@ fn a_collider_of_negative_size_is_refused_until_fixed() {
     for _ in 0..3 {
         app.update();
     }
-    assert!(app.world().get::<ClothInvalid>(collider).is_none());
+    assert!(app.world().get::<ClothColliderInvalid>(collider).is_none());
 }
