@@ -216,7 +216,6 @@ fn setup(
     let place = Transform::from_translation(start).with_rotation(Quat::from_rotation_y(heading));
     commands.spawn((
         Cloth::grid(CAPE_WIDTH, CAPE_HEIGHT, CAPE_SPACING)
-            .with_pins(ClothPins::None)
             // Denim in physical units (its mass, stretch, shear and bending from Wang et
             // al. 2011's measurements), on XPBD, which solves its stretch along the cape's
             // rows and columns: about 1.2 ms a step for a cape this size on one core

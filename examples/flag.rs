@@ -102,12 +102,10 @@ fn setup(
     let half = (WIDTH - 1) as f32 * SPACING * 0.5;
     let edge: Vec<u32> = (0..HEIGHT).map(|j| j * WIDTH).collect();
     commands.spawn((
-        Cloth::grid(WIDTH, HEIGHT, SPACING)
-            .with_pins(ClothPins::None)
-            .with_params(ClothParams {
-                node_mass: 3e-4,
-                ..default()
-            }),
+        Cloth::grid(WIDTH, HEIGHT, SPACING).with_params(ClothParams {
+            node_mass: 3e-4,
+            ..default()
+        }),
         Transform::from_xyz(1.0 + POLE_RADIUS + 0.015 + half, POLE_TOP - 0.02, 0.0),
         ClothAttachments(vec![ClothAttachment::indices(pole, edge)]),
         MeshMaterial3d(materials.add(StandardMaterial {

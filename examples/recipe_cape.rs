@@ -8,11 +8,6 @@ use bevy_cloth::prelude::*;
 fn main() {
     App::new()
         .add_plugins((DefaultPlugins, ClothPlugin::default()))
-        // Still air: drag and lift on every triangle, so the running cape streams back.
-        .insert_resource(ClothEnvironment(bevy_cloth::params::Environment {
-            air: Some(Air::default()),
-            ..default()
-        }))
         // The body moves in `FixedUpdate` and is drawn where the last step left it: so is
         // the cape, or its collar would trail the body by a step.
         .insert_resource(ClothInterpolation(false))
@@ -82,16 +77,15 @@ fn spawn_cape(commands: &mut Commands, body: Entity, at: &Transform) -> Entity {
         .collect();
     commands
         .spawn((
-            // The grid hangs in its XY plane from the middle of its top row; a grid pins its
-            // top corners to the world unless told otherwise: a cape has no world pins.
-            Cloth::grid(width, 17, spacing)
-                .with_pins(ClothPins::None)
-                .with_params(ClothParams {
-                    model: Model::Xpbd(XpbdParams::default()),
-                    fabric: Some(Fabric::DENIM),
-                    self_collision: SelfCollision::on(),
-                    ..default()
-                }),
+            // The grid hangs in its XY plane from the middle of its top row; being attached,
+            // it has no world pins. Denim meets still air (drag and lift on every
+            // triangle), so the running cape streams back.
+            Cloth::grid(width, 17, spacing).with_params(ClothParams {
+                model: Model::Xpbd(XpbdParams::default()),
+                fabric: Some(Fabric::DENIM),
+                self_collision: SelfCollision::on(),
+                ..default()
+            }),
             // The grid's origin (the middle of its top row) at the middle of the arc.
             at.mul_transform(Transform::from_translation(collar + Vec3::Z * radius)),
             ClothAttachments(vec![ClothAttachment::at(body, points)]),

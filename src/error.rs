@@ -65,7 +65,9 @@ pub enum ClothError {
     /// An attachment that holds none of the cloth's particles (every index past the cloth,
     /// no garment run of its name, or a count of 0): the cloth would fall instead of
     /// hanging, so it is not simulated until its attachments change.
-    #[error("`ClothAttachments[{attachment}].particles`: {reason}; the cloth is not simulated until its attachments change")]
+    #[error(
+        "`ClothAttachments[{attachment}].particles`: {reason}; the cloth is not simulated until its attachments change"
+    )]
     AttachmentHoldsNothing {
         /// The attachment's place in `ClothAttachments`.
         attachment: usize,

@@ -325,3 +325,52 @@ fn a_fabric_too_light_for_its_spacing_is_refused() {
     assert!(cloth.set_params(&params(1e-9)).is_err());
     assert_eq!(cloth.params().fabric.unwrap().areal_density, 0.324);
 }
+
+/// A cloth with a fabric meets still air when the environment has none: a level sheet of
+/// interlock with no `Environment::air` falls at the terminal velocity of still air, and
+/// in a vacuum (`still_air: false`) at g t; a cloth in the seeds' units (no fabric) meets
+/// no air either way.
+#[test]
+fn a_fabric_meets_still_air_unless_told_otherwise() {
+    let fall = |fabric: Option<Fabric>, still_air: bool| {
+        let params = ClothParams {
+            fabric,
+            still_air,
+            drag: 0.0,
+            ..ClothParams::default()
+        };
+        let shape = ClothShape::Grid {
+            width: 6,
+            height: 6,
+            spacing: 0.2,
+        };
+        let level = Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+        let mut cloth = shape
+            .build_solver(&ClothPins::None, &params, level)
+            .unwrap();
+        let env = Environment::default();
+        assert!(env.air.is_none());
+        for _ in 0..63 {
+            cloth.step(0.016, &env);
+        }
+        let v = cloth.particles().velocity.iter().map(|v| v.y).sum::<f32>();
+        -v / cloth.particles().len() as f32
+    };
+    let free = 9.81 * 63.0 * 0.016;
+    let terminal = (2.0 * Fabric::INTERLOCK.areal_density * 9.81 / (1.2 * 1.2)).sqrt();
+    let still = fall(Some(Fabric::INTERLOCK), true);
+    assert!(
+        (still / terminal - 1.0).abs() < 0.02,
+        "{still} against terminal {terminal}"
+    );
+    let vacuum = fall(Some(Fabric::INTERLOCK), false);
+    assert!(
+        (vacuum / free - 1.0).abs() < 0.01,
+        "{vacuum} against g t = {free}"
+    );
+    let seeds = fall(None, true);
+    assert!(
+        (seeds / free - 1.0).abs() < 0.01,
+        "{seeds} against g t = {free}"
+    );
+}

@@ -150,6 +150,7 @@ pub fn params(
         tear_ratio: None,
         self_collision: Default::default(),
         fabric: None,
+        still_air: false,
     })
 }
 

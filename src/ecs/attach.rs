@@ -108,7 +108,12 @@ fn attach_cloths(
     mut commands: Commands,
     transforms: TransformHelper,
     mut cloths: Query<
-        (Entity, &mut ClothSimulation, &mut ClothAttachments, Option<&Name>),
+        (
+            Entity,
+            &mut ClothSimulation,
+            &mut ClothAttachments,
+            Option<&Name>,
+        ),
         Without<ClothInvalid>,
     >,
 ) {

@@ -6,6 +6,7 @@ use bevy::asset::{AssetLoadError, LoadState};
 use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
+use crate::ecs::attach::ClothAttachments;
 use crate::ecs::cloth::{Cloth, ClothInvalid, ClothSimulation, pause_invalid};
 use crate::ecs::events::ClothBuilt;
 use bevy::mesh::skinning::SkinnedMesh;
@@ -245,7 +246,8 @@ fn layout_source<'a>(
 }
 
 /// Every cloth, with what building it reads: its simulation, mesh, source mesh, garment,
-/// whether it was refused, and its skin, body and painted max distance.
+/// whether it was refused, whether it is attached (no default pins), and its skin, body
+/// and painted max distance.
 type ClothsToBuild<'w, 's> = Query<
     'w,
     's,
@@ -256,7 +258,7 @@ type ClothsToBuild<'w, 's> = Query<
         Option<&'static Mesh3d>,
         Option<&'static ClothSourceMesh>,
         Option<&'static mut ClothGarment>,
-        Has<ClothInvalid>,
+        (Has<ClothInvalid>, Has<ClothAttachments>),
         (
             Option<&'static SkinnedMesh>,
             Option<&'static ClothBody>,
@@ -275,7 +277,8 @@ pub(crate) fn build_cloths(
     transforms: TransformHelper,
     mut cloths: ClothsToBuild,
 ) {
-    for (entity, cloth, sim, mesh3d, source, mut garment, invalid, (skin, body, max)) in &mut cloths
+    for (entity, cloth, sim, mesh3d, source, mut garment, (invalid, attached), (skin, body, max)) in
+        &mut cloths
     {
         let frame = transforms
             .compute_global_transform(entity)
@@ -287,11 +290,18 @@ pub(crate) fn build_cloths(
             .as_mut()
             .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed))
             | max.as_ref().is_some_and(|m| m.is_changed());
+        // The pins it has: `Auto` pins nothing on an attached cloth.
+        let pins = cloth.pins.when_attached(attached);
+        let forced = forced || sim.as_ref().is_some_and(|s| s.built_from.1 != pins);
         if !wants_build(&mut commands, entity, &cloth, sim, frame, forced, invalid) {
             continue;
         }
+        let cloth = &Cloth {
+            pins,
+            ..Cloth::clone(&cloth)
+        };
         let (layout_source, source_handle) = match layout_source(
-            &cloth,
+            cloth,
             (source, mesh3d, garment.as_deref()),
             &meshes,
             (&mut commands, entity),
@@ -308,10 +318,10 @@ pub(crate) fn build_cloths(
             skin: skin.or(body.and_then(|b| b.skin.as_ref().map(|s| &s.mesh))),
             max: max.as_deref(),
         };
-        match build_one(&cloth, frame, layout_source, body_source) {
+        match build_one(cloth, frame, layout_source, body_source) {
             Ok(Some(built)) => {
                 let source = source_handle;
-                insert_built(&mut commands, entity, &cloth, built, &mut meshes, source);
+                insert_built(&mut commands, entity, cloth, built, &mut meshes, source);
             }
             Ok(None) => {}
             Err(e) => invalidate(&mut commands, entity, e),
@@ -321,7 +331,8 @@ pub(crate) fn build_cloths(
 
 /// Whether a cloth must be built (again): always when it has no simulation, unless it was
 /// refused and has not changed since; for one simulated, when its shape or pins changed
-/// (or `forced`: its garment reloaded, its max distance repainted). A simulated cloth
+/// (or `forced`: its garment reloaded, its max distance repainted, an attachment added to
+/// or taken from a cloth of default pins). A simulated cloth
 /// follows its `frame` here, and a change of its params alone is applied in place.
 fn wants_build(
     commands: &mut Commands,
@@ -340,7 +351,8 @@ fn wants_build(
     if !changed {
         return false;
     }
-    if sim.built_from == (cloth.shape.clone(), cloth.pins.clone()) && !forced {
+    // A change of pins that matters is `forced` (the caller compares the pins it has).
+    if sim.built_from.0 == cloth.shape && !forced {
         apply_params(commands, entity, &mut sim, &cloth.params, invalid);
         return false;
     }

@@ -38,7 +38,9 @@ pub struct Cloth {
 }
 
 impl Cloth {
-    /// A `width × height` grid with `spacing` m between neighbours, pinned at its top corners.
+    /// A `width × height` grid with `spacing` m between neighbours, hanging in its local XY
+    /// plane from its origin, pinned at its top corners unless it has
+    /// [`ClothAttachments`](crate::ClothAttachments) ([`ClothPins::Auto`]).
     pub fn grid(width: u32, height: u32, spacing: f32) -> Self {
         Self {
             shape: ClothShape::Grid {

@@ -483,7 +483,10 @@ impl ClothColliderSpan {
 pub(crate) fn place_colliders(
     time: Res<Time>,
     transforms: TransformHelper,
-    colliders: Query<(Entity, &ClothCollider, Option<&ClothColliderSpan>), Without<ClothColliderInvalid>>,
+    colliders: Query<
+        (Entity, &ClothCollider, Option<&ClothColliderSpan>),
+        Without<ClothColliderInvalid>,
+    >,
     mut placed: ResMut<PlacedColliders>,
 ) {
     let placed = &mut *placed;
@@ -554,10 +557,7 @@ pub struct ClothColliderInvalid(pub ClothError);
 #[allow(clippy::type_complexity)]
 fn check_colliders(
     mut commands: Commands,
-    colliders: Query<
-        (Entity, &ClothCollider, Has<ClothColliderInvalid>),
-        Changed<ClothCollider>,
-    >,
+    colliders: Query<(Entity, &ClothCollider, Has<ClothColliderInvalid>), Changed<ClothCollider>>,
 ) {
     for (entity, collider, invalid) in &colliders {
         match collider.validate() {

@@ -148,8 +148,13 @@ pub enum ClothPins {
     /// The whole top row of a grid (j = 0).
     TopRow,
     /// The two top corners of a grid (Sladović 2014 fig. 5).
-    #[default]
     TopCorners,
+    /// The default: the top corners, as [`ClothPins::TopCorners`], unless the cloth's
+    /// entity has [`ClothAttachments`](crate::ClothAttachments), then nothing (a cape held
+    /// by its body is not also nailed to the world). Give the pins explicitly to keep
+    /// both.
+    #[default]
+    Auto,
     /// Particles by index: `j·width + i` for a grid; for a cloth made of a mesh, the
     /// mesh's own vertex indices, each pinning the particle its vertex was welded into
     /// (the copies of a vertex along a UV seam are one particle).
@@ -157,6 +162,16 @@ pub enum ClothPins {
 }
 
 impl ClothPins {
+    /// The pins a cloth has: [`ClothPins::Auto`] is nothing when the cloth is `attached`
+    /// to another entity and its top corners otherwise; the others are themselves.
+    pub fn when_attached(&self, attached: bool) -> ClothPins {
+        match self {
+            ClothPins::Auto if attached => ClothPins::None,
+            ClothPins::Auto => ClothPins::TopCorners,
+            pins => pins.clone(),
+        }
+    }
+
     /// The pinned particle indices of `layout` (see [`ClothPins::resolve`]).
     pub fn resolve_for(&self, layout: &Layout) -> Result<Vec<u32>, ClothError> {
         self.resolve(&layout.positions, layout.grid.map(|g| g.0))
@@ -174,8 +189,8 @@ impl ClothPins {
         let indices: Vec<u32> = match (self, grid_width) {
             (ClothPins::None, _) => Vec::new(),
             (ClothPins::TopRow, Some(w)) => (0..w).collect(),
-            (ClothPins::TopCorners, Some(w)) => vec![0, w - 1],
-            (ClothPins::TopRow | ClothPins::TopCorners, None) => {
+            (ClothPins::TopCorners | ClothPins::Auto, Some(w)) => vec![0, w - 1],
+            (ClothPins::TopRow | ClothPins::TopCorners | ClothPins::Auto, None) => {
                 let top = positions
                     .iter()
                     .map(|p| p.y)
@@ -184,7 +199,7 @@ impl ClothPins {
                 let row: Vec<u32> = (0..count as u32)
                     .filter(|&i| positions[i as usize].y >= top - eps)
                     .collect();
-                if matches!(self, ClothPins::TopCorners) && row.len() > 2 {
+                if matches!(self, ClothPins::TopCorners | ClothPins::Auto) && row.len() > 2 {
                     let by_x = |a: &&u32, b: &&u32| {
                         positions[**a as usize]
                             .x

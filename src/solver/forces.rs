@@ -42,8 +42,12 @@ impl ClothSolver {
             }
         };
         parallel::for_each(n, self.particles.chunks(), kernel);
-        if let Some(air) = env.air.as_ref().filter(|_| !held) {
-            self.air_forces(air);
+        let still = self.params.fabric.is_some() && self.params.still_air;
+        match env.air {
+            _ if held => {}
+            Some(air) => self.air_forces(&air),
+            None if still => self.air_forces(&Air::default()),
+            None => {}
         }
     }
 

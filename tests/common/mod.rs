@@ -197,6 +197,7 @@ pub fn conservative(integrator: Integrator) -> ClothParams {
         tear_ratio: None,
         self_collision: Default::default(),
         fabric: None,
+        still_air: false,
     }
 }
 

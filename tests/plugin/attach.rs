@@ -199,7 +199,10 @@ fn particles_attached_at_local_offsets_go_there_and_follow() {
 #[test]
 fn an_attachment_that_holds_nothing_stops_its_cloth_until_fixed() {
     let mut app = app();
-    let body = app.world_mut().spawn(Transform::from_xyz(0.0, 2.0, 0.0)).id();
+    let body = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
+        .id();
     let refused = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let seen = refused.clone();
     let cape = app
@@ -219,13 +222,23 @@ fn an_attachment_that_holds_nothing_stops_its_cloth_until_fixed() {
     }
     let invalid = app.world().get::<ClothInvalid>(cape).expect("refused");
     assert!(
-        matches!(invalid.0, ClothError::AttachmentHoldsNothing { attachment: 1, .. }),
+        matches!(
+            invalid.0,
+            ClothError::AttachmentHoldsNothing { attachment: 1, .. }
+        ),
         "{:?}",
         invalid.0
     );
     let message = invalid.0.to_string();
-    assert!(message.contains("ClothAttachments[1]") && message.contains("16"), "{message}");
-    assert_eq!(refused.lock().unwrap().len(), 1, "one event, not one a step");
+    assert!(
+        message.contains("ClothAttachments[1]") && message.contains("16"),
+        "{message}"
+    );
+    assert_eq!(
+        refused.lock().unwrap().len(),
+        1,
+        "one event, not one a step"
+    );
     let sim = app.world().get::<ClothSimulation>(cape).unwrap();
     assert_eq!(sim.solver.time(), 0.0, "a refused cloth does not step");
     // Fixed: the second attachment holds the other top corner.
@@ -238,7 +251,10 @@ fn an_attachment_that_holds_nothing_stops_its_cloth_until_fixed() {
     let sim = app.world().get::<ClothSimulation>(cape).unwrap();
     assert!(sim.solver.time() > 0.0);
     let attachments = app.world().get::<ClothAttachments>(cape).unwrap();
-    assert_eq!(attachments.0[0].held().len() + attachments.0[1].held().len(), 3);
+    assert_eq!(
+        attachments.0[0].held().len() + attachments.0[1].held().len(),
+        3
+    );
     // A garment run the cloth lacks is refused the same way.
     app.world_mut().get_mut::<ClothAttachments>(cape).unwrap().0[0] =
         ClothAttachment::run(body, "collar");
@@ -247,4 +263,50 @@ fn an_attachment_that_holds_nothing_stops_its_cloth_until_fixed() {
     }
     let invalid = app.world().get::<ClothInvalid>(cape).expect("refused");
     assert!(invalid.0.to_string().contains("collar"), "{}", invalid.0);
+}
+
+/// A grid's default pins (`ClothPins::Auto`) hold its top corners only when nothing
+/// attaches it: a cape attached to a body is not also nailed to the world, an attachment
+/// added later lets go of the world, and pins given explicitly stay.
+#[test]
+fn an_attached_cloth_has_no_default_world_pins() {
+    let mut app = app();
+    let body = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
+        .id();
+    let attached = |i: u32| ClothAttachments(vec![ClothAttachment::indices(body, vec![i])]);
+    let cape = app
+        .world_mut()
+        .spawn((Cloth::grid(4, 4, 0.1), attached(1)))
+        .id();
+    let nailed = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(4, 4, 0.1).with_pins(ClothPins::TopCorners),
+            attached(1),
+        ))
+        .id();
+    let hung = app.world_mut().spawn(Cloth::grid(4, 4, 0.1)).id();
+    for _ in 0..3 {
+        app.update();
+    }
+    // The world's pins: the held particles less the attached ones.
+    let pins = |app: &App, e: Entity| {
+        let solver = &app.world().get::<ClothSimulation>(e).unwrap().solver;
+        let world = solver.pins().len() - solver.attached().len();
+        solver.pins()[..world].to_vec()
+    };
+    assert_eq!(pins(&app, cape), Vec::<u32>::new());
+    assert_eq!(pins(&app, nailed), vec![0, 3]);
+    assert_eq!(pins(&app, hung), vec![0, 3]);
+    app.world_mut().entity_mut(hung).insert(attached(2));
+    for _ in 0..3 {
+        app.update();
+    }
+    assert_eq!(pins(&app, hung), Vec::<u32>::new(), "attached later");
+    let held = app.world().get::<ClothAttachments>(hung).unwrap().0[0]
+        .held()
+        .to_vec();
+    assert_eq!(held.len(), 1);
 }
