@@ -242,8 +242,14 @@ fn a_collider_of_negative_size_is_refused_until_fixed() {
         app.update();
     }
     assert_eq!(events.load(std::sync::atomic::Ordering::Relaxed), 1);
-    assert!(app.world().get::<ClothInvalid>(collider).is_none(), "not a cloth");
-    let invalid = app.world().get::<ClothColliderInvalid>(collider).expect("refused");
+    assert!(
+        app.world().get::<ClothInvalid>(collider).is_none(),
+        "not a cloth"
+    );
+    let invalid = app
+        .world()
+        .get::<ClothColliderInvalid>(collider)
+        .expect("refused");
     assert!(
         matches!(
             invalid.0,
