@@ -107,6 +107,26 @@ pub(crate) fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// A file's name as an error message shows it: on one line ([`one_line`]).
+pub(crate) fn shown_path(path: &std::path::Path) -> String {
+    one_line(&path.display().to_string())
+}
+
+/// `text` with its control characters (a newline in a mistyped path or piece name)
+/// escaped, so an error message that quotes it stays on one line.
+pub(crate) fn one_line(text: &str) -> String {
+    text.chars()
+        .flat_map(|c| {
+            let escaped: Vec<char> = if c.is_control() {
+                c.escape_default().collect()
+            } else {
+                vec![c]
+            };
+            escaped
+        })
+        .collect()
+}
+
 /// [`read_file`] as UTF-8 text.
 pub(crate) fn read_text(path: &std::path::Path) -> std::io::Result<String> {
     String::from_utf8(read_file(path)?)

@@ -206,8 +206,16 @@ fn run_scene(scene: &ClothScene, case: &str) {
 
 #[test]
 fn mutated_scene_files_load_cleanly_or_fail_cleanly() {
-    let sources = ["curtain", "card", "tshirt", "curtains_lod"]
-        .map(|name| asset(&format!("scenes/{name}.ron")));
+    let sources = [
+        "curtain",
+        "card",
+        "tshirt",
+        "curtains_lod",
+        "fold",
+        "denim_curtain",
+        "stack",
+    ]
+    .map(|name| asset(&format!("scenes/{name}.ron")));
     let (mut errors, mut loaded) = (0, 0);
     for k in 0..cases() {
         let seed = first_seed() + k as u64;
@@ -325,7 +333,7 @@ fn mutated_garments_and_patterns_load_cleanly_or_fail_cleanly() {
 }
 
 /// Keys of every kind of field `--set` reaches.
-const KEYS: [&str; 24] = [
+const KEYS: [&str; 41] = [
     "timestep",
     "environment.gravity",
     "environment.wind.strength",
@@ -350,6 +358,23 @@ const KEYS: [&str; 24] = [
     "cloth.params.strain_limit_iterations",
     "cloth.params.tear_ratio",
     "cloths[7].params.drag",
+    "cloths[0].pitch_degrees",
+    "cloths[0].yaw_degrees",
+    "cloth.params.self_collision.enabled",
+    "cloth.params.self_collision.distance",
+    "cloth.params.self_collision.friction",
+    "cloth.params.fabric",
+    "cloth.params.still_air",
+    "cloth.params.model.0.max_stretch_error",
+    "cloth.params.model.0.tethers",
+    "cloth.params.model.0.solve",
+    "environment.air",
+    "environment.air.velocity",
+    "environment.air.density",
+    "environment.air.drag",
+    "environment.air.lift",
+    "environment.air.field",
+    "environment.gravity_enabled",
 ];
 
 /// Values for them: the extremes, and the words the keys take.
@@ -374,6 +399,17 @@ fn value(rng: &mut Rng) -> String {
         "8",
         "40",
         "0.001",
+        "1e-30",
+        "1e-9",
+        "denim",
+        "velvet",
+        "Some(\"tablecloth\")",
+        "Some((areal_density: 1e-9, stretch: 1, shear: 1, bending: 1))",
+        "Some((velocity: (0, 0, 3)))",
+        "Some(())",
+        "Lines",
+        "Sweep",
+        "Xpbd(())",
     ];
     if rng.below(2) == 0 {
         rng.pick(&EXTREMES).to_string()

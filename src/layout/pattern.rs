@@ -146,7 +146,7 @@ fn read_row(
 impl Pattern {
     /// Reads and parses a pattern file.
     pub fn load(path: &Path) -> Result<(Pattern, Vec<PatternWarning>), PatternError> {
-        let file = path.display().to_string();
+        let file = crate::limits::shown_path(path);
         let bytes = crate::limits::read_file(path).map_err(|e| PatternError {
             file: file.clone(),
             line: 1,

@@ -170,7 +170,7 @@ impl GarmentLayout {
     /// Reads a garment file and its patterns, rescaled to `resolution` (1 = as drawn; n
     /// divides the spacing by n and keeps the outline, see [`Pattern::rescale`]).
     pub fn load(path: &Path, resolution: u32) -> Result<GarmentLayout, ClothError> {
-        let name = path.display().to_string();
+        let name = crate::limits::shown_path(path);
         let text = crate::limits::read_text(path).map_err(|e| ClothError::Garment {
             file: name.clone(),
             line: 1,
