@@ -299,9 +299,10 @@ impl ClothScene {
                 "keys start with timestep, environment., cloth. or cloths[N].".into(),
             ));
         }
-        // Said once: the field and what is wrong (not the override again as a file).
+        // Said once: what is wrong, and the field only when it is not the key's own (not
+        // the override again as a file).
         self.validate("", Path::new(spec)).map_err(|e| match e {
-            SceneError::Invalid { field, message, .. } => fail(format!("`{field}` {message}")),
+            SceneError::Invalid { field, message, .. } => fail(refusal_of(key, &field, &message)),
             other => fail(other.to_string()),
         })
     }
@@ -545,6 +546,26 @@ fn set_by_name(
         return None;
     }
     Some(Ok(()))
+}
+
+/// The refusal of an override of `key` by `field`'s check: its `message` without the
+/// field it starts with, and the field only when it is another than the key's.
+fn refusal_of(key: &str, field: &str, message: &str) -> String {
+    let path = key
+        .strip_prefix("cloth.")
+        .or_else(|| key.split_once("].").map(|(_, path)| path))
+        .unwrap_or(key);
+    // `self_collision.distance` must be …: the field named again, inside backticks.
+    let message = message
+        .strip_prefix('`')
+        .and_then(|rest| rest.split_once("` "))
+        .filter(|(named, _)| field.ends_with(named))
+        .map_or(message, |(_, rest)| rest);
+    if field.ends_with(path) {
+        message.to_string()
+    } else {
+        format!("`{field}`: {message}")
+    }
 }
 
 fn error_field(e: &crate::error::ClothError) -> &'static str {

@@ -525,6 +525,33 @@ fn once_fatal_inputs() -> Vec<BadInput> {
             run("s.ron"),
             "particles × 60000 per step is over the limit",
         ),
+        (
+            vec![],
+            vec![
+                "run",
+                "{fold}",
+                "--steps",
+                "3",
+                "--set",
+                "cloth.params.self_collision.distance=1e-30",
+            ],
+            "self_collision.distance",
+        ),
+        (
+            vec![],
+            vec![
+                "peers",
+                "--sides",
+                "2",
+                "--frames",
+                "1",
+                "--solvers",
+                "sticks",
+                "--chart",
+                ".",
+            ],
+            "--chart",
+        ),
     ]
 }
 
@@ -534,6 +561,7 @@ fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
     // refused before anything of the asked size is allocated or looped over.
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
     let curtain = format!("{root}/assets/scenes/curtain.ron");
+    let fold = format!("{root}/assets/scenes/fold.ron");
     for (k, (files, args, needle)) in once_fatal_inputs().into_iter().enumerate() {
         let dir = temp(&format!("issue17_{k}"));
         std::fs::create_dir_all(&dir).unwrap();
@@ -543,7 +571,7 @@ fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
         }
         let args: Vec<String> = args
             .iter()
-            .map(|a| a.replace("{curtain}", &curtain))
+            .map(|a| a.replace("{curtain}", &curtain).replace("{fold}", &fold))
             .collect();
         let start = std::time::Instant::now();
         let out = Command::new("sh")
@@ -603,4 +631,137 @@ fn a_short_soak_finds_nothing() {
     assert!(summary["steps"].as_u64().unwrap() > 100, "{summary}");
     assert_eq!(summary["non_finite_steps"], 0, "{summary}");
     assert_eq!(summary["accepted_invalid_edits"], 0, "{summary}");
+}
+
+/// The verbs' value-taking flags, read from their own `--help`: `(verb, flags, whether it
+/// takes a scene)`.
+fn verbs_and_flags() -> Vec<(String, Vec<String>, bool)> {
+    let verbs = [
+        "run",
+        "bench",
+        "accuracy",
+        "stability",
+        "choose",
+        "soak",
+        "peers",
+        "cantilever",
+        "drape",
+        "charts",
+    ];
+    verbs
+        .iter()
+        .map(|verb| {
+            let help = cloth().args([verb, "--help"]).output().unwrap();
+            let help = String::from_utf8_lossy(&help.stdout).to_string();
+            let flags = help
+                .lines()
+                .filter_map(|line| {
+                    let word = line.trim_start().trim_start_matches("-h, ");
+                    let flag = word.split_whitespace().next()?;
+                    let takes_value = word.split_whitespace().nth(1)?.starts_with('<');
+                    (flag.starts_with("--") && takes_value).then(|| flag.to_string())
+                })
+                .collect();
+            (verb.to_string(), flags, help.contains("<SCENE>"))
+        })
+        .collect()
+}
+
+/// Every verb's every value-taking flag, fed values no flag accepts (negative, not a
+/// number, infinite, past every limit, not a number at all, empty, a path that cannot be
+/// written): each run ends in a refusal (exit 2, an `error:` line first) within its cap,
+/// or in a clean success, and never in a panic, an abort or a crash. A run still working
+/// at the cap (a value some flag accepts, so real work began) is stopped and counted.
+#[test]
+fn every_verbs_flags_refuse_bad_values_without_a_panic() {
+    let values = [
+        "-1",
+        "NaN",
+        "inf",
+        "1e30",
+        "18446744073709551616",
+        "abc",
+        "",
+        "1,,2",
+        "/nonexistent/dir/x.png",
+    ];
+    let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+    let curtain = format!("{root}/assets/scenes/curtain.ron");
+    let cap = std::time::Duration::from_secs(3);
+    let (mut refused, mut finished, mut working) = (0, 0, Vec::new());
+    let verbs = verbs_and_flags();
+    assert!(
+        verbs.iter().map(|v| v.1.len()).sum::<usize>() >= 30,
+        "{verbs:?}"
+    );
+    for (verb, flags, takes_scene) in &verbs {
+        for flag in flags {
+            for value in values {
+                let mut args = vec![verb.clone()];
+                if *takes_scene {
+                    args.push(curtain.clone());
+                }
+                args.extend([flag.clone(), value.to_string()]);
+                let mut child = cloth()
+                    .args(&args)
+                    .stdout(std::process::Stdio::null())
+                    .stderr(std::process::Stdio::piped())
+                    .spawn()
+                    .unwrap();
+                let start = std::time::Instant::now();
+                let status = loop {
+                    if let Some(status) = child.try_wait().unwrap() {
+                        break Some(status);
+                    }
+                    if start.elapsed() > cap {
+                        child.kill().unwrap();
+                        child.wait().unwrap();
+                        break None;
+                    }
+                    std::thread::sleep(std::time::Duration::from_millis(5));
+                };
+                let mut err = String::new();
+                std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+                assert!(!err.contains("panicked"), "{args:?}: {err}");
+                match status.map(|s| s.code()) {
+                    Some(Some(2)) => {
+                        assert!(err.starts_with("error:"), "{args:?}: {err}");
+                        refused += 1;
+                    }
+                    Some(Some(0)) => finished += 1,
+                    Some(code) => panic!("{args:?}: exit {code:?}: {err}"),
+                    None => working.push(args.join(" ")),
+                }
+            }
+        }
+    }
+    println!(
+        "{} runs: {refused} refused, {finished} finished, {} still working at {cap:?} (accepted): {working:?}",
+        refused + finished + working.len(),
+        working.len()
+    );
+    assert!(refused > 0);
+}
+
+/// A refused override names its key once (the spec), then what is wrong with the value.
+#[test]
+fn a_refused_set_says_its_key_once() {
+    for (spec, key) in [
+        ("cloth.params.drag=-1", "params.drag"),
+        (
+            "cloths[0].params.self_collision.distance=1e-30",
+            "self_collision.distance",
+        ),
+        ("environment.gravity=0,1e30,0", "gravity="),
+    ] {
+        let out = cloth()
+            .args(["run", "assets/scenes/curtain.ron", "--set", spec])
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{spec}: {err}");
+        assert_eq!(err.matches(key).count(), 1, "{spec}: {err}");
+        assert!(!err.contains('`'), "no field named again: {err}");
+        assert!(err.contains("must be"), "{spec}: {err}");
+    }
 }
