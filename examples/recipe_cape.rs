@@ -6,14 +6,17 @@ use bevy_cloth::params::{Model, XpbdParams};
 use bevy_cloth::prelude::*;
 
 fn main() {
-    App::new()
-        .add_plugins((DefaultPlugins, ClothPlugin::default()))
+    App::new().add_plugins((DefaultPlugins, recipe)).run();
+}
+
+/// The recipe as a plugin: the cloth plugin, the scene and the run.
+pub fn recipe(app: &mut App) {
+    app.add_plugins(ClothPlugin::default())
         // The body moves in `FixedUpdate` and is drawn where the last step left it: so is
         // the cape, or its collar would trail the body by a step.
         .insert_resource(ClothInterpolation(false))
         .add_systems(Startup, setup)
-        .add_systems(FixedUpdate, run_in_a_circle)
-        .run();
+        .add_systems(FixedUpdate, run_in_a_circle);
 }
 
 /// The runner: a capsule the cloth is kept out of.
