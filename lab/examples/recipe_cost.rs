@@ -24,12 +24,15 @@ mod skirt;
 #[path = "../../examples/recipe_tablecloth.rs"]
 mod tablecloth;
 
+/// A recipe: what its example adds to its app.
+type Recipe = fn(&mut App);
+
 const SETTLE: usize = 63;
 const MEASURED: usize = 250;
 
 /// A recipe's app without a window: what `DefaultPlugins` gives a recipe and a headless
 /// run needs (assets, meshes, materials, skins), time advanced by one 16 ms step an update.
-fn app(recipe: fn(&mut App)) -> App {
+fn app(recipe: Recipe) -> App {
     let mut app = App::new();
     app.add_plugins((MinimalPlugins, AssetPlugin::default(), TransformPlugin))
         .init_asset::<Mesh>()
@@ -50,7 +53,7 @@ struct Measured {
     max_strain: f32,
 }
 
-fn measure(recipe: fn(&mut App)) -> Measured {
+fn measure(recipe: Recipe) -> Measured {
     let mut app = app(recipe);
     let mut m = Measured {
         particles: 0,
@@ -87,7 +90,7 @@ fn quantile(sorted: &[f32], q: f32) -> f32 {
 }
 
 fn main() {
-    let recipes: [(&str, fn(&mut App)); 4] = [
+    let recipes: [(&str, Recipe); 4] = [
         ("cape (running)", cape::recipe),
         ("flag (3 m/s air)", flag::recipe),
         ("skirt (skinned)", skirt::recipe),
