@@ -3,7 +3,7 @@
 //! ends outside both whatever their order, and a ball fired through a curtain leaves no
 //! particle inside it. `cargo test --test contact`.
 
-use bevy::math::{Affine3A, Quat, Vec3};
+use bevy::math::{Affine3A, Quat, Vec2, Vec3};
 use bevy_cloth::params::{Environment, Model, Substeps, XpbdParams};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::{ClothSolver, Collider, ColliderShape, Layout, Motion};
@@ -106,8 +106,9 @@ fn weightless() -> Environment {
 
 #[test]
 fn a_particle_spawned_inside_a_sphere_is_moved_out_without_being_launched() {
-    // 5 cm inside a ball of radius 0.2 (0.055 m under the band it is kept at). Pushed out
+    // 5 cm inside a ball of radius 0.2 (5.5 cm under the band it is kept at). Pushed out
     // by the whole depth in one substep, its velocity used to be depth / h: 3.4 m/s here.
+    // Now it comes out at the cap (1 m/s: 1.6 cm a step) with no velocity left behind.
     for substeps in [1, 4] {
         let mut p = particle(Vec3::new(0.0, 0.15, 0.0), substeps);
         p.set_colliders([collider(ColliderShape::Sphere(
@@ -116,20 +117,23 @@ fn a_particle_spawned_inside_a_sphere_is_moved_out_without_being_launched() {
                 radius: 0.2,
             },
         ))]);
-        p.step(DT, &weightless());
-        let x = p.positions()[0];
-        let speed = p.particles().velocity[0].length();
-        eprintln!("{substeps} substeps: at {x}, {speed} m/s");
-        assert!(
-            x.length() >= 0.205 - 1e-5,
-            "still inside: {} from the centre",
-            x.length()
-        );
-        assert!(speed <= 1.0, "launched at {speed} m/s");
-        for _ in 0..10 {
+        let mut out_at = None;
+        for step in 1..=10 {
+            let before = p.positions()[0];
             p.step(DT, &weightless());
+            let x = p.positions()[0];
+            let speed = p.particles().velocity[0].length();
+            let moved = x.distance(before) / DT;
+            eprintln!(
+                "{substeps} substeps, step {step}: at {x}, {speed} m/s, moved at {moved} m/s"
+            );
+            assert!(speed <= 1e-3, "left with a velocity of {speed} m/s");
+            assert!(moved <= 1.0 + 1e-3, "moved out at {moved} m/s");
+            if out_at.is_none() && x.length() >= 0.205 - 1e-5 {
+                out_at = Some(step);
+            }
         }
-        assert!(p.particles().velocity[0].length() <= 1.0);
+        assert_eq!(out_at, Some(4), "out after ⌈5.5 cm / 1.6 cm⌉ steps");
     }
 }
 
@@ -339,4 +343,215 @@ fn a_cloth_dropped_onto_a_ring_drapes_over_it_with_no_particle_inside() {
     // Held by the ring (not fallen through), the middle hanging inside the hole.
     assert!(lowest > -0.6, "fell through: lowest at {lowest} m");
     assert!(middle.y < 0.0, "the middle did not sag: {middle}");
+}
+
+/// A 2 mm rope along z at `x`, with the contact tests' thickness.
+fn rope_at(x: f32) -> Collider {
+    collider(ColliderShape::Capsule(
+        bevy_cloth::solver::shapes::Capsule {
+            a: Vec3::new(x, 0.0, -1.0),
+            b: Vec3::new(x, 0.0, 1.0),
+            radius: 0.002,
+        },
+    ))
+}
+
+#[test]
+#[ignore = "target not met yet: XPBD's top rises 12 cm after it meets the rope (an incompressible sheet landing on its edge)"]
+fn a_cloth_falling_edge_first_onto_a_thin_rope_hangs_on_it_and_never_rises() {
+    // A 16 × 16 cloth (5 cm) hanging in its XY plane, unpinned, its top at 1 m, dropped
+    // onto a 2 mm rope that pierces its plane between two columns (x = 0.0125): only its
+    // row edges can meet it, edge-first, at 2.2 m/s. It must stay on the rope and not
+    // bounce: its top never more than 1 cm above where it was when it met the rope.
+    for (name, model, substeps) in [
+        (
+            "xpbd",
+            Model::Xpbd(XpbdParams::default()),
+            Substeps::default(),
+        ),
+        (
+            "xpbd, 1 substep",
+            Model::Xpbd(XpbdParams::default()),
+            Substeps::Fixed(1),
+        ),
+        ("mass-spring", Model::MassSpring, Substeps::default()),
+    ] {
+        let params = ClothParams {
+            model,
+            substeps,
+            ..ClothParams::default()
+        };
+        let frame = Affine3A::from_translation(Vec3::new(0.0, 1.0, 0.0));
+        let mut cloth = Cloth::grid(16, 16, 0.05)
+            .shape
+            .build_solver(&ClothPins::None, &params, frame)
+            .unwrap();
+        cloth.set_colliders([rope_at(0.0125)]);
+        let top = |c: &ClothSolver| c.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max);
+        let bottom = |c: &ClothSolver| c.positions().iter().map(|x| x.y).fold(f32::MAX, f32::min);
+        let (mut met, mut highest_after) = (None, f32::MIN);
+        for _ in 0..125 {
+            cloth.step(DT, &Environment::default());
+            if met.is_none() && bottom(&cloth) < 0.01 {
+                met = Some(top(&cloth));
+            }
+            if met.is_some() {
+                highest_after = highest_after.max(top(&cloth));
+            }
+        }
+        let met = met.expect("the cloth reached the rope");
+        let end = top(&cloth);
+        eprintln!(
+            "{name}: met the rope with its top at {met:.3}, rose to {highest_after:.3}, top at {end:.3} after 2 s"
+        );
+        assert!(end > -0.5, "{name}: fell through the rope (top at {end})");
+        assert!(
+            highest_after <= met + 0.01,
+            "{name}: bounced: its top rose to {highest_after} from {met}"
+        );
+        assert!(cloth.is_stable(), "{name}");
+    }
+}
+
+#[test]
+#[ignore = "target not met yet: mass-spring falls through the rope at 5 m/s"]
+fn a_level_cloth_dropped_onto_a_rope_at_5_m_s_hangs_over_it() {
+    // Level, 1.27 m above the rope: it meets it at 5 m/s, 8 cm a step.
+    for (name, model) in [
+        ("xpbd", Model::Xpbd(XpbdParams::default())),
+        ("mass-spring", Model::MassSpring),
+    ] {
+        let mut cloth = lying_cloth(model, 1, 1.28);
+        let params = ClothParams {
+            model,
+            ..ClothParams::default()
+        };
+        cloth.set_params(&params).unwrap();
+        cloth.set_colliders([rope_at(0.0)]);
+        for _ in 0..125 {
+            cloth.step(DT, &Environment::default());
+        }
+        let top = cloth
+            .positions()
+            .iter()
+            .map(|x| x.y)
+            .fold(f32::MIN, f32::max);
+        eprintln!("{name}: top at {top:.3} after 2 s");
+        assert!(top > -0.05, "{name}: fell through the rope (top at {top})");
+        assert!(cloth.is_stable(), "{name}");
+    }
+}
+
+/// The fastest particle's speed.
+fn fastest(cloth: &ClothSolver) -> f32 {
+    cloth
+        .particles()
+        .velocity
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f32::max)
+}
+
+#[test]
+#[ignore = "target not met yet: the cloth's constraints, fighting the ball's radial pushes, launch it (XPBD's automatic substeps climb to the cap)"]
+fn a_cloth_started_through_a_ball_is_moved_out_at_the_cap_speed() {
+    // Hung by its top row, a ball of radius 0.2 centred on its plane 0.65 m below the
+    // top: its lower rows start inside. Contact used to launch them at 12 m/s.
+    for (name, model) in [
+        ("xpbd", Model::Xpbd(XpbdParams::default())),
+        ("mass-spring", Model::MassSpring),
+    ] {
+        let params = ClothParams {
+            model,
+            ..ClothParams::default()
+        };
+        assert_eq!(params.max_depenetration_speed, 1.0);
+        let frame = Affine3A::from_translation(Vec3::new(0.0, 1.0, 0.0));
+        let mut cloth = Cloth::grid(16, 16, 0.05)
+            .shape
+            .build_solver(&ClothPins::TopRow, &params, frame)
+            .unwrap();
+        let (center, radius) = (Vec3::new(0.0, 0.35, 0.0), 0.2);
+        let mut ball = collider(ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
+            center,
+            radius,
+        }));
+        ball.friction = 0.0;
+        cloth.set_colliders([ball]);
+        let inside = |c: &ClothSolver| {
+            c.positions()
+                .iter()
+                .filter(|x| x.distance(center) < radius)
+                .count()
+        };
+        assert!(inside(&cloth) > 10);
+        let (mut out_at, mut fastest_seen) = (None, 0.0f32);
+        for step in 1..=63 {
+            cloth.step(DT, &Environment::default());
+            fastest_seen = fastest_seen.max(fastest(&cloth));
+            if out_at.is_none() && inside(&cloth) == 0 {
+                out_at = Some(step);
+            }
+        }
+        eprintln!(
+            "{name}: out of the ball after {out_at:?} steps, fastest particle {fastest_seen:.2} m/s"
+        );
+        assert!(
+            fastest_seen <= 1.05,
+            "{name}: launched at {fastest_seen} m/s"
+        );
+        let out_at = out_at.unwrap_or(usize::MAX);
+        assert!(
+            out_at as f32 * DT <= 0.5,
+            "{name}: still inside after {out_at} steps"
+        );
+        assert!(cloth.is_stable(), "{name}");
+    }
+}
+
+#[test]
+fn a_cape_spawned_5_cm_into_its_capsule_is_out_within_10_steps() {
+    // A cape's cloth spawned in a plane 5 cm inside a body's capsule (radius 0.3), free
+    // and weightless (what moves it is the contact alone): moved out at no more than the
+    // cap, out within 10 steps.
+    let params = ClothParams {
+        model: Model::Xpbd(XpbdParams::default()),
+        ..ClothParams::default()
+    };
+    let (width, spacing) = (14, 0.045);
+    // The grid hangs in a plane 0.25 m behind the axis: 5 cm inside the back.
+    let frame = Affine3A::from_translation(Vec3::new(0.0, 1.4, 0.25));
+    let mut cloth = Cloth::grid(width, 17, spacing)
+        .shape
+        .build_solver(&ClothPins::None, &params, frame)
+        .unwrap();
+    let body = collider(ColliderShape::Capsule(
+        bevy_cloth::solver::shapes::Capsule {
+            a: Vec3::new(0.0, 0.3, 0.0),
+            b: Vec3::new(0.0, 1.7, 0.0),
+            radius: 0.3,
+        },
+    ));
+    cloth.set_colliders([body]);
+    let inside = |c: &ClothSolver| {
+        c.positions()
+            .iter()
+            .filter(|x| Vec2::new(x.x, x.z).length() < 0.3 && (0.3..=1.7).contains(&x.y))
+            .count()
+    };
+    assert!(inside(&cloth) > 100);
+    let mut fastest_seen = 0.0f32;
+    for step in 1..=10 {
+        cloth.step(DT, &weightless());
+        fastest_seen = fastest_seen.max(fastest(&cloth));
+        eprintln!(
+            "step {step}: {} inside, fastest {:.2} m/s",
+            inside(&cloth),
+            fastest(&cloth)
+        );
+    }
+    assert_eq!(inside(&cloth), 0, "still inside after 10 steps");
+    // The target is the cap (1 m/s); measured 1.19 m/s as the cloth straightens after it
+    // is out (5.5 m/s before the cap and the fix of the approach's direction).
+    assert!(fastest_seen <= 1.25, "launched at {fastest_seen} m/s");
 }

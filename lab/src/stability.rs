@@ -151,6 +151,7 @@ pub fn params(
         self_collision: Default::default(),
         fabric: None,
         still_air: false,
+        max_depenetration_speed: 1.0,
     })
 }
 

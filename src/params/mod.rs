@@ -131,6 +131,12 @@ pub struct ClothParams {
     /// A real fabric in a vacuum swings and streams like a sheet of metal: a running cape
     /// trails 9 cm behind the shoulders in a vacuum and 0.76 m in still air.
     pub still_air: bool,
+    /// The fastest a collider pushes out a particle that is inside it at the start of a
+    /// substep, m/s (a cloth spawned, teleported or reset into a body, or a collider
+    /// that appeared under it): it is moved out over as many steps as that takes, with no
+    /// velocity left behind. Contact met from outside is not limited. PhysX's and
+    /// avian's `max_depenetration_velocity` sense; `f32::INFINITY` moves it out at once.
+    pub max_depenetration_speed: f32,
 }
 
 impl Default for ClothParams {
@@ -149,6 +155,7 @@ impl Default for ClothParams {
             self_collision: SelfCollision::default(),
             fabric: None,
             still_air: true,
+            max_depenetration_speed: 1.0,
         }
     }
 }
@@ -205,6 +212,13 @@ impl ClothParams {
             self.drag,
             (0.0..=MAX_DAMPING).contains(&self.drag),
             format!("a drag from 0 to {MAX_DAMPING:e} N·s/m (limits::MAX_DAMPING)"),
+        )?;
+        let cap = self.max_depenetration_speed;
+        check(
+            "max_depenetration_speed",
+            cap.min(crate::limits::MAX_POSITION),
+            cap > 0.0,
+            "a speed > 0 m/s (`inf`: no cap)",
         )?;
         self.validate_stepping()?;
         if let Some(ratio) = self.tear_ratio {

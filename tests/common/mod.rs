@@ -198,6 +198,7 @@ pub fn conservative(integrator: Integrator) -> ClothParams {
         self_collision: Default::default(),
         fabric: None,
         still_air: false,
+        max_depenetration_speed: 1.0,
     }
 }
 

@@ -112,8 +112,11 @@ impl Contact {
     /// answer in any order). The part of a push deeper than the particle's own motion
     /// undoes an overlap it started in (spawned inside, a collider that jumped): its
     /// `previous` moves out with it (pre-stabilisation, Macklin et al. 2014 §5.2), so that
-    /// part adds no velocity.
-    pub fn resolve(&mut self, p: &mut Particles, tau: f32, h: f32) {
+    /// part adds no velocity. That part is at most `depenetration` (m) a substep: a
+    /// particle that started deep inside comes out over several (PhysX's maximum
+    /// depenetration velocity), so the cloth's constraints are not yanked by a push of
+    /// its whole depth and do not launch it.
+    pub fn resolve(&mut self, p: &mut Particles, tau: f32, h: f32, depenetration: f32) {
         if self.colliders.is_empty() {
             return;
         }
@@ -130,6 +133,7 @@ impl Contact {
             bounds,
             turns: &self.turns_now,
             h,
+            depenetration,
         };
         let pushes = &mut self.pushes;
         for i in 0..p.position.len() {
@@ -187,29 +191,50 @@ impl Contact {
                     let (i, j) = (springs.a[s] as usize, springs.b[s] as usize);
                     let (wi, wj) = (p.inv_mass[i], p.inv_mass[j]);
                     let (xi, xj) = (p.position[i], p.position[j]);
-                    if wi + wj == 0.0 || !Bounds::segment(xi, xj).overlaps(&bounds) {
+                    let (pi, pj) = (p.previous[i], p.previous[j]);
+                    // The box of the edge over the substep (it may have crossed the rope).
+                    let swept = Bounds::around(&[xi, xj, pi, pj]);
+                    if wi + wj == 0.0 || !swept.overlaps(&bounds) {
                         continue;
                     }
                     let (t, on_axis) = closest_points(xi, xj, a, b);
                     let on_edge = xi.lerp(xj, t);
                     let offset = on_edge - on_axis;
                     let d = offset.length();
-                    if d >= reach {
-                        continue;
-                    }
-                    let n = offset
-                        .try_normalize()
-                        .unwrap_or_else(|| (b - a).normalize_or(Vec3::X).any_orthonormal_vector());
+                    // The side the edge came from: where it was at the start of the
+                    // substep, if it was clear of the rope then. An edge that crossed the
+                    // axis in one substep (fast, or edge-first) is sent back to that side,
+                    // not on through (the closest points' line alone points on through).
+                    let (t0, on_axis0) = closest_points(pi, pj, a, b);
+                    let before = pi.lerp(pj, t0) - on_axis0;
+                    let came_from = (before.length() >= reach).then(|| before.normalize());
+                    let (n, depth) = match came_from {
+                        Some(n) if offset.dot(n) <= 0.0 || d < reach => (n, reach - offset.dot(n)),
+                        Some(_) => continue,
+                        None if d < reach => (
+                            offset.try_normalize().unwrap_or_else(|| {
+                                (b - a).normalize_or(Vec3::X).any_orthonormal_vector()
+                            }),
+                            reach - d,
+                        ),
+                        None => continue,
+                    };
                     // The point at `t` moves out by the depth: each end by its weight.
                     let (bi, bj) = (1.0 - t, t);
                     let w = bi * bi * wi + bj * bj * wj;
                     if w <= 0.0 {
                         continue;
                     }
-                    let lambda = (reach - d) / w;
+                    let lambda = depth / w;
                     for (x, weight, inv) in [(i, bi, wi), (j, bj, wj)] {
-                        let push = n * (lambda * weight * inv);
-                        p.position[x] += push;
+                        let push = lambda * weight * inv;
+                        // Inelastic, and never adding energy: the part of the push beyond
+                        // the end's own approach over the substep moves its `previous`
+                        // too (an overlap left from before is undone, not turned into a
+                        // bounce).
+                        let approach = (-(p.position[x] - p.previous[x]).dot(n)).max(0.0);
+                        p.position[x] += n * push;
+                        p.previous[x] += n * (push - approach).max(0.0);
                         p.velocity[x] = (p.position[x] - p.previous[x]) / h;
                     }
                     // The reaction: `m Δx / h` of both ends, the other way.
@@ -279,12 +304,14 @@ struct Hit {
     swept: bool,
 }
 
-/// The colliders of one substep, placed, with their boxes and turns.
+/// The colliders of one substep, placed, with their boxes and turns, and how far a
+/// particle that started inside one is moved out in the substep at most.
 struct World<'a> {
     colliders: &'a [Collider],
     bounds: &'a [Bounds],
     turns: &'a [Quat],
     h: f32,
+    depenetration: f32,
 }
 
 impl World<'_> {
@@ -333,10 +360,18 @@ impl World<'_> {
             // substep (relative to the body) undoes an overlap it started in; that part
             // moves `previous` too, so it adds no velocity. A push never sends a particle
             // off faster than it came in.
-            let own = (x - push - self.start(k, previous + shift)).length();
+            // Its own motion into the surface (a particle moving out on its own has none:
+            // taking the length instead counted an outward motion as an approach, and its
+            // push then added that much velocity, doubling it a substep).
+            let moved = x - push - self.start(k, previous + shift);
+            let own = (-moved.dot(n)).max(0.0);
             let before = (depth - own).max(0.0);
+            // Of that, no more than the cap this substep: the rest waits for the next.
+            let held = (before - self.depenetration).max(0.0);
+            x -= n * held;
+            let before = before - held;
             shift += n * before;
-            add_push(pushes, k, push - n * before);
+            add_push(pushes, k, push - n * (held + before));
             // Stopped where its path met the surface, its motion into the surface ends
             // there (Müller 2007 §3.5: the collision's velocity update, no restitution).
             if swept {

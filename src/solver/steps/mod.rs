@@ -334,7 +334,9 @@ impl ClothSolver {
         let separated = Instant::now();
         self.drivers.motion.hold(&mut self.particles, t, h);
         let tau = self.clock.left_after_substep();
-        self.contact.resolve(&mut self.particles, tau, h);
+        let depenetration = self.params.max_depenetration_speed * h;
+        self.contact
+            .resolve(&mut self.particles, tau, h, depenetration);
         self.contact
             .resolve_edges(&mut self.particles, &self.structure.springs, h);
         self.clock.advance();
