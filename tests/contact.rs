@@ -356,77 +356,107 @@ fn rope_at(x: f32) -> Collider {
     ))
 }
 
+/// The highest the top of a 16 × 16 cloth (5 cm) dropped edge-first from a top at 1 m
+/// onto `below` rises after its bottom first comes within 1 cm of y = 0, above where the
+/// top was then; and the top after 2 s.
+fn edge_first_drop(model: Model, substeps: Substeps, below: Collider) -> (f32, f32) {
+    let params = ClothParams {
+        model,
+        substeps,
+        ..ClothParams::default()
+    };
+    // Tilted 2° out of its plane, as any real drop is: a sheet exactly upright balanced
+    // on its edge has no way to fall but in its own plane, pivoting about the rope.
+    let frame = Affine3A::from_rotation_translation(
+        Quat::from_rotation_x(2f32.to_radians()),
+        Vec3::new(0.0, 1.0, 0.0),
+    );
+    let mut cloth = Cloth::grid(16, 16, 0.05)
+        .shape
+        .build_solver(&ClothPins::None, &params, frame)
+        .unwrap();
+    cloth.set_colliders([below]);
+    let top = |c: &ClothSolver| c.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max);
+    let bottom = |c: &ClothSolver| c.positions().iter().map(|x| x.y).fold(f32::MAX, f32::min);
+    let (mut met, mut highest) = (None, f32::MIN);
+    for _ in 0..125 {
+        cloth.step(DT, &Environment::default());
+        if met.is_none() && bottom(&cloth) < 0.01 {
+            met = Some(top(&cloth));
+        }
+        if met.is_some() {
+            highest = highest.max(top(&cloth));
+        }
+    }
+    assert!(cloth.is_stable());
+    (highest - met.expect("the cloth reached y = 0"), top(&cloth))
+}
+
 #[test]
-#[ignore = "target not met yet: XPBD's top rises 12 cm after it meets the rope (an incompressible sheet landing on its edge)"]
-fn a_cloth_falling_edge_first_onto_a_thin_rope_hangs_on_it_and_never_rises() {
-    // A 16 × 16 cloth (5 cm) hanging in its XY plane, unpinned, its top at 1 m, dropped
-    // onto a 2 mm rope that pierces its plane between two columns (x = 0.0125): only its
-    // row edges can meet it, edge-first, at 2.2 m/s. It must stay on the rope and not
-    // bounce: its top never more than 1 cm above where it was when it met the rope.
-    for (name, model, substeps) in [
-        (
-            "xpbd",
-            Model::Xpbd(XpbdParams::default()),
-            Substeps::default(),
-        ),
+fn a_cloth_falling_edge_first_onto_a_thin_rope_hangs_on_it_and_the_rope_adds_no_bounce() {
+    // Onto a 2 mm rope that pierces its plane between two columns (x = 0.0125): only
+    // its row edges can meet it, edge-first, at 2.2 m/s. It must stay on the rope, and
+    // rise after meeting it no more than the same sheet does landing on a plate: the
+    // rope's contact adds no energy. (Dropped exactly upright, a sheet rebounds 11–16 cm
+    // off a plate too, its rows in compression; tilted 2°, it tips over and rises not at
+    // all, on the plate or on the rope.)
+    edge_first_onto_a_rope(&[(
+        "xpbd",
+        Model::Xpbd(XpbdParams::default()),
+        Substeps::default(),
+    )]);
+}
+
+#[test]
+#[ignore = "target not met yet: at 1 XPBD substep the draped cloth is pulled through the rope \
+            (top at -8.4 m after 2 s); mass-spring drapes, then slips off it (-2.1 m)"]
+fn a_cloth_falling_edge_first_onto_a_thin_rope_hangs_on_it_at_1_substep_and_on_mass_spring() {
+    edge_first_onto_a_rope(&[
         (
             "xpbd, 1 substep",
             Model::Xpbd(XpbdParams::default()),
             Substeps::Fixed(1),
         ),
         ("mass-spring", Model::MassSpring, Substeps::default()),
-    ] {
-        let params = ClothParams {
-            model,
-            substeps,
-            ..ClothParams::default()
-        };
-        let frame = Affine3A::from_translation(Vec3::new(0.0, 1.0, 0.0));
-        let mut cloth = Cloth::grid(16, 16, 0.05)
-            .shape
-            .build_solver(&ClothPins::None, &params, frame)
-            .unwrap();
-        cloth.set_colliders([rope_at(0.0125)]);
-        let top = |c: &ClothSolver| c.positions().iter().map(|x| x.y).fold(f32::MIN, f32::max);
-        let bottom = |c: &ClothSolver| c.positions().iter().map(|x| x.y).fold(f32::MAX, f32::min);
-        let (mut met, mut highest_after) = (None, f32::MIN);
-        for _ in 0..125 {
-            cloth.step(DT, &Environment::default());
-            if met.is_none() && bottom(&cloth) < 0.01 {
-                met = Some(top(&cloth));
-            }
-            if met.is_some() {
-                highest_after = highest_after.max(top(&cloth));
-            }
-        }
-        let met = met.expect("the cloth reached the rope");
-        let end = top(&cloth);
+    ]);
+}
+
+fn edge_first_onto_a_rope(cases: &[(&str, Model, Substeps)]) {
+    for &(name, model, substeps) in cases {
+        let (rise, end) = edge_first_drop(model, substeps, rope_at(0.0125));
+        let (plate_rise, _) = edge_first_drop(model, substeps, plate());
         eprintln!(
-            "{name}: met the rope with its top at {met:.3}, rose to {highest_after:.3}, top at {end:.3} after 2 s"
+            "{name}: rose {rise:.3} m after meeting the rope ({plate_rise:.3} on a plate), top at {end:.3} after 2 s"
         );
-        assert!(end > -0.5, "{name}: fell through the rope (top at {end})");
+        assert!(end > -0.5, "{name}: fell off the rope (top at {end})");
         assert!(
-            highest_after <= met + 0.01,
-            "{name}: bounced: its top rose to {highest_after} from {met}"
+            rise <= plate_rise.max(0.0) + 0.01,
+            "{name}: the rope made it bounce: rose {rise}, on a plate {plate_rise}"
         );
-        assert!(cloth.is_stable(), "{name}");
     }
 }
 
 #[test]
-#[ignore = "target not met yet: mass-spring falls through the rope at 5 m/s"]
 fn a_level_cloth_dropped_onto_a_rope_at_5_m_s_hangs_over_it() {
-    // Level, 1.27 m above the rope: it meets it at 5 m/s, 8 cm a step.
+    // Level, centred on the rope, 1.28 m above it: it meets it at 5 m/s, 8 cm a step,
+    // its row edges across the rope between two columns.
     for (name, model) in [
         ("xpbd", Model::Xpbd(XpbdParams::default())),
         ("mass-spring", Model::MassSpring),
     ] {
-        let mut cloth = lying_cloth(model, 1, 1.28);
         let params = ClothParams {
             model,
+            drag: 0.0,
             ..ClothParams::default()
         };
-        cloth.set_params(&params).unwrap();
+        let frame = Affine3A::from_rotation_translation(
+            Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
+            Vec3::new(0.0, 1.28, -0.375),
+        );
+        let mut cloth = Cloth::grid(16, 16, 0.05)
+            .shape
+            .build_solver(&ClothPins::None, &params, frame)
+            .unwrap();
         cloth.set_colliders([rope_at(0.0)]);
         for _ in 0..125 {
             cloth.step(DT, &Environment::default());

@@ -165,7 +165,8 @@ impl Contact {
     /// cylinders thinner than them, which slip between particles: each edge that comes
     /// within `radius + thickness` of such a collider's axis is pushed out along the
     /// closest points' line, the correction shared by its two particles by their
-    /// barycentric weight and inverse mass (the position-based edge constraint). A rope or
+    /// barycentric weight and inverse mass (the position-based edge constraint), back to
+    /// the side the edge came from, with Coulomb friction and no energy added. A rope or
     /// a pole across the cloth holds it. Runs after [`Contact::resolve`].
     pub fn resolve_edges(&mut self, p: &mut Particles, springs: &Springs, h: f32) {
         if self.thin.is_empty() {
@@ -202,22 +203,21 @@ impl Contact {
                     let offset = on_edge - on_axis;
                     let d = offset.length();
                     // The side the edge came from: where it was at the start of the
-                    // substep, if it was clear of the rope then. An edge that crossed the
-                    // axis in one substep (fast, or edge-first) is sent back to that side,
-                    // not on through (the closest points' line alone points on through).
+                    // substep (clear of the rope, or resting on it). An edge that crossed
+                    // the axis in one substep (fast, edge-first, or pulled through by its
+                    // springs) is sent back to that side, not on through (the closest
+                    // points' line alone points on through).
                     let (t0, on_axis0) = closest_points(pi, pj, a, b);
-                    let before = pi.lerp(pj, t0) - on_axis0;
-                    let came_from = (before.length() >= reach).then(|| before.normalize());
+                    let came_from = (pi.lerp(pj, t0) - on_axis0).try_normalize();
                     let (n, depth) = match came_from {
-                        Some(n) if offset.dot(n) <= 0.0 || d < reach => (n, reach - offset.dot(n)),
-                        Some(_) => continue,
-                        None if d < reach => (
-                            offset.try_normalize().unwrap_or_else(|| {
+                        Some(n) if offset.dot(n) < 0.0 => (n, reach - offset.dot(n)),
+                        _ if d >= reach => continue,
+                        _ => (
+                            offset.try_normalize().or(came_from).unwrap_or_else(|| {
                                 (b - a).normalize_or(Vec3::X).any_orthonormal_vector()
                             }),
                             reach - d,
                         ),
-                        None => continue,
                     };
                     // The point at `t` moves out by the depth: each end by its weight.
                     let (bi, bj) = (1.0 - t, t);
@@ -226,7 +226,15 @@ impl Contact {
                         continue;
                     }
                     let lambda = depth / w;
+                    // Coulomb friction at the edge's point, once, from this push: its
+                    // motion across the rope over the substep less up to `friction ×
+                    // depth` (as for particles, Müller 2007), shared as the push is.
+                    let moved = (xi - pi) * bi + (xj - pj) * bj;
+                    let across = moved - n * moved.dot(n);
+                    let (slide, grip) = (across.length(), c.friction * depth);
+                    let held = -across * if slide <= grip { 1.0 } else { grip / slide };
                     for (x, weight, inv) in [(i, bi, wi), (j, bj, wj)] {
+                        p.position[x] += held * (weight * inv / w);
                         let push = lambda * weight * inv;
                         // Inelastic, and never adding energy: the part of the push beyond
                         // the end's own approach over the substep moves its `previous`
@@ -238,7 +246,7 @@ impl Contact {
                         p.velocity[x] = (p.position[x] - p.previous[x]) / h;
                     }
                     // The reaction: `m Δx / h` of both ends, the other way.
-                    let impulse = n * (lambda * (bi + bj) / h);
+                    let impulse = (n * lambda + held / w) * ((bi + bj) / h);
                     self.collider_impulses[k].linear -= impulse;
                     self.collider_impulses[k].angular -= on_edge.cross(impulse);
                 }
