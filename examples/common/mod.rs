@@ -62,6 +62,11 @@ pub fn app(title: &str, args: ExampleArgs) -> App {
 /// [`app`] with the cloths stepped as `cloth` says.
 pub fn app_with(title: &str, args: ExampleArgs, cloth: ClothPlugin) -> App {
     let mut app = App::new();
+    if let Some(seconds) = args.frame_time {
+        app.insert_resource(bevy::time::TimeUpdateStrategy::ManualDuration(
+            std::time::Duration::from_secs_f32(seconds),
+        ));
+    }
     app.add_plugins((
         DefaultPlugins.set(window_plugin(title)),
         EguiPlugin::default(),
@@ -91,6 +96,10 @@ pub struct ExampleArgs {
     /// The camera's starting angle about the vertical, degrees (`--yaw`; 20 by default,
     /// 180 looks at the back).
     pub yaw_degrees: f32,
+    /// Seconds the app's clock advances a frame, whatever the frame took (`--frame-time`):
+    /// screenshots at set simulated times on a slow or loaded machine. `None`: the wall
+    /// clock.
+    pub frame_time: Option<f32>,
 }
 
 /// The options every bevy_cloth example takes.
@@ -111,6 +120,17 @@ struct Cli {
     /// The camera's starting angle about the vertical, degrees.
     #[arg(long, default_value_t = 20.0, allow_negative_numbers = true, value_parser = finite)]
     yaw: f32,
+    /// Advances the clock this many seconds a frame instead of by the wall clock (e.g.
+    /// 0.016667: screenshots at set simulated times however slow the frames are).
+    #[arg(long, value_name = "SECONDS", value_parser = frame_time)]
+    frame_time: Option<f32>,
+}
+
+fn frame_time(text: &str) -> Result<f32, String> {
+    text.parse::<f32>()
+        .ok()
+        .filter(|t| (1e-4..=1.0).contains(t))
+        .ok_or_else(|| format!("`{text}` is not a frame time from 0.0001 to 1 s"))
 }
 
 fn finite(text: &str) -> Result<f32, String> {
@@ -155,6 +175,7 @@ impl ExampleArgs {
             overrides: cli.set,
             screenshots,
             yaw_degrees: cli.yaw,
+            frame_time: cli.frame_time,
         }
     }
 
