@@ -183,73 +183,102 @@ impl Contact {
             let Some((a, b, reach)) = axis(c) else {
                 continue;
             };
-            let bounds = Bounds::segment(a, b).grown(reach);
+            let rope = Rope {
+                a,
+                b,
+                reach,
+                friction: c.friction,
+                bounds: Bounds::segment(a, b).grown(reach),
+            };
             for range in edges.iter() {
                 for s in range.clone() {
                     if !springs.alive[s] {
                         continue;
                     }
-                    let (i, j) = (springs.a[s] as usize, springs.b[s] as usize);
-                    let (wi, wj) = (p.inv_mass[i], p.inv_mass[j]);
-                    let (xi, xj) = (p.position[i], p.position[j]);
-                    let (pi, pj) = (p.previous[i], p.previous[j]);
-                    // The box of the edge over the substep (it may have crossed the rope).
-                    let swept = Bounds::around(&[xi, xj, pi, pj]);
-                    if wi + wj == 0.0 || !swept.overlaps(&bounds) {
-                        continue;
+                    let ends = (springs.a[s] as usize, springs.b[s] as usize);
+                    if let Some((impulse, at)) = rope.push_edge(p, ends, h) {
+                        self.collider_impulses[k].linear -= impulse;
+                        self.collider_impulses[k].angular -= at.cross(impulse);
                     }
-                    let (t, on_axis) = closest_points(xi, xj, a, b);
-                    let on_edge = xi.lerp(xj, t);
-                    let offset = on_edge - on_axis;
-                    let d = offset.length();
-                    // The side the edge came from: where it was at the start of the
-                    // substep (clear of the rope, or resting on it). An edge that crossed
-                    // the axis in one substep (fast, edge-first, or pulled through by its
-                    // springs) is sent back to that side, not on through (the closest
-                    // points' line alone points on through).
-                    let (t0, on_axis0) = closest_points(pi, pj, a, b);
-                    let came_from = (pi.lerp(pj, t0) - on_axis0).try_normalize();
-                    let (n, depth) = match came_from {
-                        Some(n) if offset.dot(n) < 0.0 => (n, reach - offset.dot(n)),
-                        _ if d >= reach => continue,
-                        _ => (
-                            offset.try_normalize().or(came_from).unwrap_or_else(|| {
-                                (b - a).normalize_or(Vec3::X).any_orthonormal_vector()
-                            }),
-                            reach - d,
-                        ),
-                    };
-                    // The point at `t` moves out by the depth: each end by its weight.
-                    let (bi, bj) = (1.0 - t, t);
-                    let w = bi * bi * wi + bj * bj * wj;
-                    if w <= 0.0 {
-                        continue;
-                    }
-                    let lambda = depth / w;
-                    // Coulomb friction at the edge's point, once, from this push: its
-                    // motion across the rope over the substep less up to `friction ×
-                    // depth` (as for particles, Müller 2007), shared as the push is.
-                    let moved = (xi - pi) * bi + (xj - pj) * bj;
-                    let across = moved - n * moved.dot(n);
-                    let (slide, grip) = (across.length(), c.friction * depth);
-                    let held = -across * if slide <= grip { 1.0 } else { grip / slide };
-                    for (x, weight, inv) in [(i, bi, wi), (j, bj, wj)] {
-                        p.position[x] += held * (weight * inv / w);
-                        let push = lambda * weight * inv;
-                        // Inelastic, and never adding energy: the part of the push beyond
-                        // the end's own approach over the substep moves its `previous`
-                        // too (an overlap left from before is undone, not turned into a
-                        // bounce).
-                        let approach = (-(p.position[x] - p.previous[x]).dot(n)).max(0.0);
-                        p.position[x] += n * push;
-                        p.previous[x] += n * (push - approach).max(0.0);
-                        p.velocity[x] = (p.position[x] - p.previous[x]) / h;
-                    }
-                    // The reaction: `m Δx / h` of both ends, the other way.
-                    let impulse = (n * lambda + held / w) * ((bi + bj) / h);
-                    self.collider_impulses[k].linear -= impulse;
-                    self.collider_impulses[k].angular -= on_edge.cross(impulse);
                 }
+            }
+        }
+    }
+}
+
+/// A thin collider as the edge pass meets it: its axis `a–b`, its reach (radius plus
+/// thickness), its friction and the box of everything within reach.
+struct Rope {
+    a: Vec3,
+    b: Vec3,
+    reach: f32,
+    friction: f32,
+    bounds: Bounds,
+}
+
+impl Rope {
+    /// Keeps the edge between particles `i` and `j` out of the rope (see
+    /// [`Contact::resolve_edges`]): the reaction the rope takes (`m Δx / h` of both ends)
+    /// and the point it acts at, or `None` when the edge does not touch it.
+    fn push_edge(&self, p: &mut Particles, (i, j): (usize, usize), h: f32) -> Option<(Vec3, Vec3)> {
+        let (wi, wj) = (p.inv_mass[i], p.inv_mass[j]);
+        let (xi, xj) = (p.position[i], p.position[j]);
+        let (pi, pj) = (p.previous[i], p.previous[j]);
+        // The box of the edge over the substep (it may have crossed the rope).
+        let swept = Bounds::around(&[xi, xj, pi, pj]);
+        if wi + wj == 0.0 || !swept.overlaps(&self.bounds) {
+            return None;
+        }
+        let (t, on_axis) = closest_points(xi, xj, self.a, self.b);
+        let on_edge = xi.lerp(xj, t);
+        let (t0, on_axis0) = closest_points(pi, pj, self.a, self.b);
+        let (n, depth) = self.out_of(on_edge - on_axis, pi.lerp(pj, t0) - on_axis0)?;
+        // The point at `t` moves out by the depth: each end by its weight.
+        let (bi, bj) = (1.0 - t, t);
+        let w = bi * bi * wi + bj * bj * wj;
+        if w <= 0.0 {
+            return None;
+        }
+        let lambda = depth / w;
+        // Coulomb friction at the edge's point, once, from this push: its motion across
+        // the rope over the substep less up to `friction × depth` (as for particles,
+        // Müller 2007), shared as the push is.
+        let moved = (xi - pi) * bi + (xj - pj) * bj;
+        let across = moved - n * moved.dot(n);
+        let (slide, grip) = (across.length(), self.friction * depth);
+        let held = -across * if slide <= grip { 1.0 } else { grip / slide };
+        for (x, weight, inv) in [(i, bi, wi), (j, bj, wj)] {
+            p.position[x] += held * (weight * inv / w);
+            let push = lambda * weight * inv;
+            // Inelastic, and never adding energy: the part of the push beyond the end's
+            // own approach over the substep moves its `previous` too (an overlap left
+            // from before is undone, not turned into a bounce).
+            let approach = (-(p.position[x] - p.previous[x]).dot(n)).max(0.0);
+            p.position[x] += n * push;
+            p.previous[x] += n * (push - approach).max(0.0);
+            p.velocity[x] = (p.position[x] - p.previous[x]) / h;
+        }
+        Some(((n * lambda + held / w) * ((bi + bj) / h), on_edge))
+    }
+
+    /// The way out and the depth of an edge point at `offset` from the axis that was at
+    /// `before` at the start of the substep, or `None` when it is clear. An edge that
+    /// crossed the axis in one substep (fast, edge-first, or pulled through by its
+    /// springs) is sent back to the side it came from (clear of the rope, or resting on
+    /// it), not on through, where the closest points' line alone would send it.
+    fn out_of(&self, offset: Vec3, before: Vec3) -> Option<(Vec3, f32)> {
+        let d = offset.length();
+        let came_from = before.try_normalize();
+        match came_from {
+            Some(n) if offset.dot(n) < 0.0 => Some((n, self.reach - offset.dot(n))),
+            _ if d >= self.reach => None,
+            _ => {
+                let n = offset.try_normalize().or(came_from).unwrap_or_else(|| {
+                    (self.b - self.a)
+                        .normalize_or(Vec3::X)
+                        .any_orthonormal_vector()
+                });
+                Some((n, self.reach - d))
             }
         }
     }
