@@ -155,7 +155,7 @@ pub enum ClothError {
     #[error("{0}")]
     Pattern(#[from] crate::layout::pattern::PatternError),
     /// A garment file is malformed, or its pieces and seams do not fit together.
-    #[error("{file}:{line}:{column}: {}", crate::limits::one_line(message))]
+    #[error("{file}:{line}:{column}: {}", crate::limits::escape_controls(message))]
     Garment {
         /// The garment file.
         file: String,

@@ -171,6 +171,14 @@ pub fn headless_app() -> App {
 /// where Bevy looks: see [`AssetPlugin::file_path`]). Bevy's `file_watcher` feature
 /// makes it hot-reload them.
 pub fn headless_app_in(assets: impl Into<String>) -> App {
+    let mut app = headless_base_in(assets);
+    app.add_plugins(ClothPlugin::default());
+    app
+}
+
+/// [`headless_app_in`] without `ClothPlugin`: for an app that adds the plugin itself, as
+/// a game or a recipe does (its fixed clock already at 16 ms).
+pub fn headless_base_in(assets: impl Into<String>) -> App {
     let mut app = App::new();
     app.add_plugins((
         MinimalPlugins,
@@ -178,12 +186,13 @@ pub fn headless_app_in(assets: impl Into<String>) -> App {
             file_path: assets.into(),
             ..default()
         },
-        ClothPlugin::default().with_timestep(Duration::from_millis(16)),
     ))
     .init_asset::<Mesh>()
     .init_asset::<bevy::mesh::skinning::SkinnedMeshInverseBindposes>()
-    .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
-        16,
-    )));
+    .insert_resource(Time::<Fixed>::from_duration(HEADLESS_STEP))
+    .insert_resource(TimeUpdateStrategy::ManualDuration(HEADLESS_STEP));
     app
 }
+
+/// The headless apps' frame and fixed step.
+const HEADLESS_STEP: Duration = Duration::from_millis(16);

@@ -107,24 +107,23 @@ pub(crate) fn read_file(path: &std::path::Path) -> std::io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
-/// A file's name as an error message shows it: on one line ([`one_line`]).
+/// A file's name as an error message shows it: on one line ([`escape_controls`]).
 pub(crate) fn shown_path(path: &std::path::Path) -> String {
-    one_line(&path.display().to_string())
+    escape_controls(&path.display().to_string())
 }
 
 /// `text` with its control characters (a newline in a mistyped path or piece name)
 /// escaped, so an error message that quotes it stays on one line.
-pub(crate) fn one_line(text: &str) -> String {
-    text.chars()
-        .flat_map(|c| {
-            let escaped: Vec<char> = if c.is_control() {
-                c.escape_default().collect()
-            } else {
-                vec![c]
-            };
-            escaped
-        })
-        .collect()
+pub(crate) fn escape_controls(text: &str) -> String {
+    let mut shown = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() {
+            shown.extend(c.escape_default());
+        } else {
+            shown.push(c);
+        }
+    }
+    shown
 }
 
 /// [`read_file`] as UTF-8 text.

@@ -5,10 +5,9 @@
 //! particles, its substeps and its largest strain, on the pool's threads and on one.
 //!
 //! `cargo run -p bevy_cloth_lab --example recipe_cost`
-use std::time::Duration;
-
 use bevy::prelude::*;
-use bevy::time::TimeUpdateStrategy;
+use bevy_cloth::headless::headless_base_in;
+use bevy_cloth::layout::garment::asset_root;
 use bevy_cloth::prelude::*;
 
 #[allow(dead_code)]
@@ -30,18 +29,13 @@ type Recipe = fn(&mut App);
 const SETTLE: usize = 63;
 const MEASURED: usize = 250;
 
-/// A recipe's app without a window: what `DefaultPlugins` gives a recipe and a headless
-/// run needs (assets, meshes, materials, skins), time advanced by one 16 ms step an update.
+/// A recipe's app without a window: the crate's headless base (assets, meshes, skins,
+/// one 16 ms step an update) with what `DefaultPlugins` gives a recipe besides
+/// (transforms, materials).
 fn app(recipe: Recipe) -> App {
-    let mut app = App::new();
-    app.add_plugins((MinimalPlugins, AssetPlugin::default(), TransformPlugin))
-        .init_asset::<Mesh>()
-        .init_asset::<StandardMaterial>()
-        .init_asset::<bevy::mesh::skinning::SkinnedMeshInverseBindposes>()
-        .insert_resource(Time::<Fixed>::from_duration(Duration::from_millis(16)))
-        .insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_millis(
-            16,
-        )));
+    let mut app = headless_base_in(asset_root().to_string_lossy());
+    app.add_plugins(TransformPlugin)
+        .init_asset::<StandardMaterial>();
     recipe(&mut app);
     app
 }

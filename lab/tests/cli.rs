@@ -633,21 +633,21 @@ fn a_short_soak_finds_nothing() {
     assert_eq!(summary["accepted_invalid_edits"], 0, "{summary}");
 }
 
-/// The verbs' value-taking flags, read from their own `--help`: `(verb, flags, whether it
-/// takes a scene)`.
+/// Every verb and its value-taking flags, read from `cloth --help` and the verb's own
+/// `--help`: `(verb, flags, whether it takes a scene)`.
 fn verbs_and_flags() -> Vec<(String, Vec<String>, bool)> {
-    let verbs = [
-        "run",
-        "bench",
-        "accuracy",
-        "stability",
-        "choose",
-        "soak",
-        "peers",
-        "cantilever",
-        "drape",
-        "charts",
-    ];
+    // The verbs as `cloth --help` lists them: a new verb is fuzzed without a word here.
+    let help = cloth().arg("--help").output().unwrap();
+    let help = String::from_utf8_lossy(&help.stdout).to_string();
+    let verbs: Vec<&str> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|&v| v != "help")
+        .collect();
+    assert!(verbs.len() >= 9, "{help}");
     verbs
         .iter()
         .map(|verb| {

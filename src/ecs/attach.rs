@@ -4,7 +4,7 @@
 use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 
-use crate::ecs::cloth::{ClothInvalid, ClothSimulation, pause_invalid};
+use crate::ecs::cloth::{ClothInvalid, ClothSimulation, Named, pause_invalid};
 use crate::error::ClothError;
 use crate::solver;
 
@@ -120,7 +120,7 @@ fn attach_cloths(
     for (entity, mut sim, mut attachments, name) in &mut cloths {
         let rebuilt = sim.is_added();
         let solver = &mut sim.solver;
-        let who = Who(entity, name);
+        let who = Named(entity, name);
         // The chosen particles are the plugin's bookkeeping, not a change of the user's
         // attachments (which lifts a refusal, `retry_attachments`).
         let attachments = attachments.bypass_change_detection();
@@ -152,7 +152,7 @@ fn attach_cloths(
                 .iter()
                 .try_for_each(|&(i, local)| solver.attach(i, frame.transform_point(local)));
             if let Err(e) = attached {
-                warn!("{who}: attachment {k}: {e}; choosing its particles again");
+                warn!("cloth {who}: attachment {k}: {e}; choosing its particles again");
                 attachment.held = None;
             }
         }
@@ -172,23 +172,10 @@ fn retry_attachments(
     }
 }
 
-/// A cloth as a person reads it in a log line: its `Name` and entity, or the entity alone.
-#[derive(Clone, Copy)]
-struct Who<'a>(Entity, Option<&'a Name>);
-
-impl std::fmt::Display for Who<'_> {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self.1 {
-            Some(name) => write!(f, "cloth `{name}` ({})", self.0),
-            None => write!(f, "cloth {}", self.0),
-        }
-    }
-}
-
 /// The particles an attachment holds and each one's point in the target's frame (`frame`
 /// where the target is now): given, or where the particle is now; or why it holds none.
 fn choose_held(
-    who: Who,
+    who: Named,
     particles: &AttachParticles,
     solver: &solver::ClothSolver,
     frame: &GlobalTransform,
@@ -239,7 +226,7 @@ fn choose_held(
 /// are left out with a warning; none held at all is an error (a cloth whose every
 /// attached index lay outside it fell without a word).
 fn left_out(
-    who: Who,
+    who: Named,
     held: Vec<(u32, Vec3)>,
     given: usize,
     count: usize,
@@ -253,7 +240,7 @@ fn left_out(
     }
     if held.len() < given {
         warn!(
-            "{who}: {} of the attachment's {given} particles are not among its {count} \
+            "cloth {who}: {} of the attachment's {given} particles are not among its {count} \
              (or their points are not finite) and are left out",
             given - held.len(),
         );

@@ -292,12 +292,12 @@ pub(crate) fn build_cloths(
             | max.as_ref().is_some_and(|m| m.is_changed());
         // The pins it has: `Auto` pins nothing on an attached cloth.
         let pins = cloth.pins.when_attached(attached);
-        let forced = forced || sim.as_ref().is_some_and(|s| s.built_from.1 != pins);
+        let forced = forced || sim.as_ref().is_some_and(|s| s.built_from.1 != *pins);
         if !wants_build(&mut commands, entity, &cloth, sim, frame, forced, invalid) {
             continue;
         }
         let cloth = &Cloth {
-            pins,
+            pins: pins.into_owned(),
             ..Cloth::clone(&cloth)
         };
         let (layout_source, source_handle) = match layout_source(

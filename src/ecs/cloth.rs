@@ -265,13 +265,20 @@ pub(crate) fn pause_invalid(commands: &mut Commands, entity: Entity, error: Clot
 /// Logs why a cloth is not simulated, naming it by its `Name` when it has one (an entity
 /// id alone, `47v0`, says little to a person reading the log).
 pub(crate) fn log_invalid(invalid: On<ClothBecameInvalid>, names: Query<&Name>) {
-    let entity = invalid.entity;
-    match names.get(entity) {
-        Ok(name) => error!(
-            "cloth `{name}` ({entity}) is not simulated: {}",
-            invalid.error
-        ),
-        Err(_) => error!("cloth {entity} is not simulated: {}", invalid.error),
+    let who = Named(invalid.entity, names.get(invalid.entity).ok());
+    error!("cloth {who} is not simulated: {}", invalid.error);
+}
+
+/// An entity as a log line names it: its `Name` and id (`` `cape` (47v0) ``), or its id.
+#[derive(Clone, Copy)]
+pub(crate) struct Named<'a>(pub(crate) Entity, pub(crate) Option<&'a Name>);
+
+impl std::fmt::Display for Named<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.1 {
+            Some(name) => write!(f, "`{name}` ({})", self.0),
+            None => write!(f, "{}", self.0),
+        }
     }
 }
 

@@ -5,7 +5,7 @@ use bevy::prelude::*;
 use bevy::transform::helper::TransformHelper;
 use serde::{Deserialize, Serialize};
 
-use crate::ecs::cloth::{ClothSimulation, Layers};
+use crate::ecs::cloth::{ClothSimulation, Layers, Named};
 use crate::ecs::events::ClothColliderBecameInvalid;
 use crate::error::ClothError;
 use crate::solver;
@@ -577,10 +577,7 @@ fn check_colliders(
 
 /// Logs why a collider is left out, naming it by its `Name` when it has one.
 fn log_invalid_collider(invalid: On<ClothColliderBecameInvalid>, names: Query<&Name>) {
-    let entity = invalid.entity;
-    let who = names
-        .get(entity)
-        .map_or_else(|_| entity.to_string(), |n| format!("`{n}` ({entity})"));
+    let who = Named(invalid.entity, names.get(invalid.entity).ok());
     error!("collider {who} is left out: {}", invalid.error);
 }
 

@@ -163,12 +163,15 @@ pub enum ClothPins {
 
 impl ClothPins {
     /// The pins a cloth has: [`ClothPins::Auto`] is nothing when the cloth is `attached`
-    /// to another entity and its top corners otherwise; the others are themselves.
-    pub fn when_attached(&self, attached: bool) -> ClothPins {
+    /// to another entity and its top corners otherwise; the others are themselves
+    /// (borrowed: the plugin compares them every step, and a list of indices is not copied
+    /// for that).
+    pub fn when_attached(&self, attached: bool) -> std::borrow::Cow<'_, ClothPins> {
+        use std::borrow::Cow;
         match self {
-            ClothPins::Auto if attached => ClothPins::None,
-            ClothPins::Auto => ClothPins::TopCorners,
-            pins => pins.clone(),
+            ClothPins::Auto if attached => Cow::Owned(ClothPins::None),
+            ClothPins::Auto => Cow::Owned(ClothPins::TopCorners),
+            pins => Cow::Borrowed(pins),
         }
     }
 
