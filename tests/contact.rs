@@ -408,8 +408,10 @@ fn a_cloth_falling_edge_first_onto_a_thin_rope_hangs_on_it_and_the_rope_adds_no_
 }
 
 #[test]
-#[ignore = "target not met yet: at 1 XPBD substep the draped cloth is pulled through the rope \
-            (top at -8.4 m after 2 s); mass-spring drapes, then slips off it (-2.1 m)"]
+#[ignore = "target not met yet: at 1 XPBD substep each row edge across the rope pivots about \
+            it and slips off its far end; the column nearest the rope piles onto it while the \
+            sheet slides past (top at -8.4 m after 2 s, friction 0.3 to 3 alike); mass-spring \
+            drapes, then slips off (-2.1 m)"]
 fn a_cloth_falling_edge_first_onto_a_thin_rope_hangs_on_it_at_1_substep_and_on_mass_spring() {
     edge_first_onto_a_rope(&[
         (
@@ -482,60 +484,87 @@ fn fastest(cloth: &ClothSolver) -> f32 {
         .fold(0.0, f32::max)
 }
 
-#[test]
-#[ignore = "target not met yet: the cloth's constraints, fighting the ball's radial pushes, launch it (XPBD's automatic substeps climb to the cap)"]
-fn a_cloth_started_through_a_ball_is_moved_out_at_the_cap_speed() {
-    // Hung by its top row, a ball of radius 0.2 centred on its plane 0.65 m below the
-    // top: its lower rows start inside. Contact used to launch them at 12 m/s.
-    for (name, model) in [
+/// A cloth hung by its top row with a ball of radius 0.2 centred on its plane 0.65 m below
+/// the top, its lower rows starting inside: the step at which no particle is inside any
+/// more (if one is, within 1 s) and the fastest particle seen before then.
+fn started_through_a_ball(model: Model) -> (Option<usize>, f32) {
+    let params = ClothParams {
+        model,
+        ..ClothParams::default()
+    };
+    assert_eq!(params.max_depenetration_speed, 1.0);
+    let frame = Affine3A::from_translation(Vec3::new(0.0, 1.0, 0.0));
+    let mut cloth = Cloth::grid(16, 16, 0.05)
+        .shape
+        .build_solver(&ClothPins::TopRow, &params, frame)
+        .unwrap();
+    let (center, radius) = (Vec3::new(0.0, 0.35, 0.0), 0.2);
+    let mut ball = collider(ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
+        center,
+        radius,
+    }));
+    ball.friction = 0.0;
+    cloth.set_colliders([ball]);
+    let inside = |c: &ClothSolver| {
+        c.positions()
+            .iter()
+            .filter(|x| x.distance(center) < radius)
+            .count()
+    };
+    assert!(inside(&cloth) > 10);
+    let mut fastest_seen = 0.0f32;
+    for step in 1..=63 {
+        cloth.step(DT, &Environment::default());
+        assert!(cloth.is_stable());
+        fastest_seen = fastest_seen.max(fastest(&cloth));
+        if inside(&cloth) == 0 {
+            return (Some(step), fastest_seen);
+        }
+    }
+    (None, fastest_seen)
+}
+
+fn models() -> [(&'static str, Model); 2] {
+    [
         ("xpbd", Model::Xpbd(XpbdParams::default())),
         ("mass-spring", Model::MassSpring),
-    ] {
-        let params = ClothParams {
-            model,
-            ..ClothParams::default()
-        };
-        assert_eq!(params.max_depenetration_speed, 1.0);
-        let frame = Affine3A::from_translation(Vec3::new(0.0, 1.0, 0.0));
-        let mut cloth = Cloth::grid(16, 16, 0.05)
-            .shape
-            .build_solver(&ClothPins::TopRow, &params, frame)
-            .unwrap();
-        let (center, radius) = (Vec3::new(0.0, 0.35, 0.0), 0.2);
-        let mut ball = collider(ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
-            center,
-            radius,
-        }));
-        ball.friction = 0.0;
-        cloth.set_colliders([ball]);
-        let inside = |c: &ClothSolver| {
-            c.positions()
-                .iter()
-                .filter(|x| x.distance(center) < radius)
-                .count()
-        };
-        assert!(inside(&cloth) > 10);
-        let (mut out_at, mut fastest_seen) = (None, 0.0f32);
-        for step in 1..=63 {
-            cloth.step(DT, &Environment::default());
-            fastest_seen = fastest_seen.max(fastest(&cloth));
-            if out_at.is_none() && inside(&cloth) == 0 {
-                out_at = Some(step);
-            }
-        }
+    ]
+}
+
+#[test]
+fn a_cloth_started_through_a_ball_leaves_it_along_its_normal_within_half_a_second() {
+    // Its plane through the ball's centre, the nearest-surface push opened a hole the
+    // ball's size against the cloth's constraints: 591 m/s (XPBD, its automatic substeps
+    // at the cap) and 16 m/s (mass-spring). Leaving along its own normal, each particle
+    // inside at the cap speed, it only bends. Its neighbours, dragged out elastically,
+    // overshoot that speed (about 2.5× it, measured at caps of 0.5, 1 and 2 m/s).
+    for (name, model) in models() {
+        let (out_at, fastest_seen) = started_through_a_ball(model);
         eprintln!(
             "{name}: out of the ball after {out_at:?} steps, fastest particle {fastest_seen:.2} m/s"
         );
-        assert!(
-            fastest_seen <= 1.05,
-            "{name}: launched at {fastest_seen} m/s"
-        );
-        let out_at = out_at.unwrap_or(usize::MAX);
+        let out_at = out_at.expect("still inside after 1 s");
         assert!(
             out_at as f32 * DT <= 0.5,
             "{name}: still inside after {out_at} steps"
         );
-        assert!(cloth.is_stable(), "{name}");
+        assert!(
+            fastest_seen <= 3.0,
+            "{name}: launched at {fastest_seen} m/s"
+        );
+    }
+}
+
+#[test]
+#[ignore = "target not met yet: the particles pushed out move at the cap, but the cloth they \
+            drag out overshoots it elastically (2.5 m/s XPBD, 2.7 m/s mass-spring)"]
+fn a_cloth_started_through_a_ball_is_moved_out_no_faster_than_the_cap() {
+    for (name, model) in models() {
+        let (_, fastest_seen) = started_through_a_ball(model);
+        assert!(
+            fastest_seen <= 1.05,
+            "{name}: launched at {fastest_seen} m/s"
+        );
     }
 }
 
@@ -583,5 +612,5 @@ fn a_cape_spawned_5_cm_into_its_capsule_is_out_within_10_steps() {
     assert_eq!(inside(&cloth), 0, "still inside after 10 steps");
     // The target is the cap (1 m/s); measured 1.19 m/s as the cloth straightens after it
     // is out (5.5 m/s before the cap and the fix of the approach's direction).
-    assert!(fastest_seen <= 1.25, "launched at {fastest_seen} m/s");
+    assert!(fastest_seen <= 1.0, "launched at {fastest_seen} m/s");
 }

@@ -47,6 +47,20 @@ pub(super) struct Structure {
 }
 
 impl Structure {
+    /// Particle `i`'s normal, unnormalised: the sum of its visible triangles' area
+    /// vectors (twice their areas) at positions `x`, in increasing triangle order; zero
+    /// for a particle on no visible triangle.
+    pub fn normal_sum(&self, x: &[Vec3], i: usize) -> Vec3 {
+        let mut sum = Vec3::ZERO;
+        for &t in self.vertex_faces.of(i) {
+            if self.triangle_visible[t as usize] {
+                let [a, b, c] = self.triangles[t as usize].map(|v| v as usize);
+                sum += (x[b] - x[a]).cross(x[c] - x[a]);
+            }
+        }
+        sum
+    }
+
     /// The make-up of a validated layout.
     pub fn new(layout: Layout) -> Self {
         let Layout {

@@ -115,8 +115,15 @@ impl Contact {
     /// part adds no velocity. That part is at most `depenetration` (m) a substep: a
     /// particle that started deep inside comes out over several (PhysX's maximum
     /// depenetration velocity), so the cloth's constraints are not yanked by a push of
-    /// its whole depth and do not launch it.
-    pub fn resolve(&mut self, p: &mut Particles, tau: f32, h: f32, depenetration: f32) {
+    /// its whole depth and do not launch it. Deeper than that, it leaves along the
+    /// cloth's own normal where that leads out (`normal(x, i)`: particle `i`'s normal,
+    /// any length, at positions `x`), and keeps no motion back in.
+    pub fn resolve(
+        &mut self,
+        p: &mut Particles,
+        (tau, h, depenetration): (f32, f32, f32),
+        normal: impl Fn(&[Vec3], usize) -> Vec3,
+    ) {
         if self.colliders.is_empty() {
             return;
         }
@@ -143,7 +150,8 @@ impl Contact {
             }
             let (x, previous) = (p.position[i], p.previous[i]);
             pushes.clear();
-            let Some((x, previous)) = world.resolve_particle(x, previous, pushes) else {
+            let exit = || normal(&p.position, i).try_normalize();
+            let Some((x, previous)) = world.resolve_particle(x, previous, exit, pushes) else {
                 continue;
             };
             // The reaction: each collider takes the particle's momentum change it caused,
@@ -372,6 +380,7 @@ impl World<'_> {
         &self,
         x: Vec3,
         previous: Vec3,
+        exit: impl Fn() -> Option<Vec3>,
         pushes: &mut Vec<(usize, Vec3)>,
     ) -> Option<(Vec3, Vec3)> {
         let start = x;
@@ -404,11 +413,25 @@ impl World<'_> {
             let own = (-moved.dot(n)).max(0.0);
             let before = (depth - own).max(0.0);
             // Of that, no more than the cap this substep: the rest waits for the next.
-            let held = (before - self.depenetration).max(0.0);
-            x -= n * held;
-            let before = before - held;
             shift += n * before;
-            add_push(pushes, k, push - n * (held + before));
+            if before > self.depenetration {
+                x -= n * before;
+                shift -= n * before;
+                let out = self.way_out(k, x, n, before, &exit);
+                x += out;
+                shift += out;
+                // A particle on its way out keeps no motion back in: what the cloth's
+                // constraints pulled it in by is taken out of its velocity, or they would
+                // pump momentum into it every substep that moving `previous` with it
+                // hides, and launch its neighbours.
+                let d = out.normalize_or_zero();
+                let into = (x - self.start(k, previous + shift)).dot(d);
+                if into < 0.0 {
+                    shift += d * into;
+                    add_push(pushes, k, -d * into);
+                }
+            }
+            add_push(pushes, k, push - n * before);
             // Stopped where its path met the surface, its motion into the surface ends
             // there (Müller 2007 §3.5: the collision's velocity update, no restitution).
             if swept {
@@ -428,8 +451,55 @@ impl World<'_> {
         Some((x, previous))
     }
 
+    /// How a particle at `x`, `before` deep in collider `k` (outward normal `n`) since
+    /// the start of the substep, more than the cap, moves out of it this substep: by the
+    /// cap. It leaves along the cloth's own normal (`exit`), to the side that is out
+    /// sooner, when that side leads out within [`EXIT_REACH`] times its depth. A cloth
+    /// spawned through a ball and pushed toward the nearest surface would open a hole the
+    /// ball's size, and its constraints would fight the push; along its normal it only
+    /// bends, and every particle leaves to the same side. Otherwise (a cloth edge-on in
+    /// the ground) toward the nearest surface.
+    #[cold]
+    #[inline(never)]
+    fn way_out(
+        &self,
+        k: usize,
+        x: Vec3,
+        n: Vec3,
+        before: f32,
+        exit: impl Fn() -> Option<Vec3>,
+    ) -> Vec3 {
+        let cap = self.depenetration;
+        let c = &self.colliders[k];
+        let reach = EXIT_REACH * before;
+        // How far along `d` the particle is out: swept back from the far point.
+        let out_along = |d: Vec3| {
+            let far = x + d * reach;
+            if c.penetration(far).is_some() {
+                return None;
+            }
+            c.sweep(far, x).map(|(t, _)| (reach * (1.0 - t), d))
+        };
+        let Some(m) = exit() else {
+            return n * cap;
+        };
+        // Across the cloth already (a cloth pressed into the ground, wrapped on a body):
+        // the nearest surface is the way out along its normal too, without the search.
+        if m.dot(n).abs() > ALONG_NORMAL {
+            return n * cap;
+        }
+        let sides = [m, -m];
+        let nearest = sides
+            .into_iter()
+            .filter(|d| *d != Vec3::ZERO)
+            .filter_map(out_along)
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        nearest.map_or(n, |(_, d)| d) * cap
+    }
+
     /// The collider the particle at `x` (from `previous`) is deepest in, in pass `pass`;
     /// the first pass also sweeps its path, and counts in `met` the colliders it meets.
+    #[inline(always)]
     fn deepest(&self, pass: usize, previous: Vec3, x: Vec3, met: &mut usize) -> Option<Hit> {
         let mut deepest: Option<Hit> = None;
         let path = Bounds::segment(previous, x);
@@ -523,6 +593,13 @@ impl World<'_> {
         (past < 0.0).then_some((-past, n))
     }
 }
+
+/// How much farther than its depth a particle that started deep in a collider may have to
+/// go along its cloth's normal to leave that way rather than toward the nearest surface.
+const EXIT_REACH: f32 = 8.0;
+
+/// The cosine above which the nearest surface's normal counts as the cloth's (8°).
+const ALONG_NORMAL: f32 = 0.99;
 
 /// Adds `push` to collider `k`'s share.
 /// Keeps in `most` the collider whose whole push on the particle so far (its entry of

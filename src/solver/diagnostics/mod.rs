@@ -145,19 +145,11 @@ impl ClothSolver {
     /// cloth (whose tasks are the only allocation).
     pub fn normals_into(&self, out: &mut [Vec3]) {
         let x = &self.particles.position;
-        let (triangles, visible) = (&self.structure.triangles, &self.structure.triangle_visible);
         // Gathered per particle over its triangles in increasing order: the same sums, in
         // the same order, as scattering each triangle's normal onto its corners, and a
         // particle's normal is written by one piece only.
         parallel::for_each_indexed(out, |i, n| {
-            let mut sum = Vec3::ZERO;
-            for &t in self.structure.vertex_faces.of(i) {
-                if visible[t as usize] {
-                    let [a, b, c] = triangles[t as usize].map(|v| v as usize);
-                    sum += (x[b] - x[a]).cross(x[c] - x[a]);
-                }
-            }
-            *n = sum.normalize_or(Vec3::Z);
+            *n = self.structure.normal_sum(x, i).normalize_or(Vec3::Z);
         });
     }
 }

@@ -335,8 +335,11 @@ impl ClothSolver {
         self.drivers.motion.hold(&mut self.particles, t, h);
         let tau = self.clock.left_after_substep();
         let depenetration = self.params.max_depenetration_speed * h;
+        let structure = &self.structure;
         self.contact
-            .resolve(&mut self.particles, tau, h, depenetration);
+            .resolve(&mut self.particles, (tau, h, depenetration), |x, i| {
+                structure.normal_sum(x, i)
+            });
         self.contact
             .resolve_edges(&mut self.particles, &self.structure.springs, h);
         self.clock.advance();
