@@ -6,7 +6,8 @@
 //! (`Cloth::from_mesh` on an entity with a `SkinnedMesh`): the plugin skins it on the CPU
 //! every step and keeps each vertex within its painted maximum distance
 //! (`ATTRIBUTE_MAX_DISTANCE`: 0 at the waist, growing to the hem) of where the skin puts
-//! it. Its legs are capsules spanning their joints (`ClothColliderSpan`), so they push
+//! it, and out of a sphere 2 cm behind it (`ClothBackStop`: the hips without a collider).
+//! Its legs are capsules spanning their joints (`ClothColliderSpan`), so they push
 //! the skirt as they swing; the cape hangs from the spine joint (`ClothAttachments`)
 //! against a capsule on the back. Orbit camera and inspector as in the other examples.
 //!
@@ -347,6 +348,11 @@ fn setup(
                 node_mass: 2e-4,
                 ..default()
             }),
+        // Never more than 2 cm into the body, however the hips turn.
+        ClothBackStop::Uniform {
+            distance: 0.02,
+            radius: 0.3,
+        },
         MeshMaterial3d(materials.add(fabric(Color::srgb(0.15, 0.35, 0.75), 0.85))),
         Name::new("skirt"),
     ));

@@ -110,6 +110,15 @@ pub enum ClothError {
         /// Where its layout comes from.
         source_of: &'static str,
     },
+    /// A component that paints a mesh's vertices (a maximum distance, a back stop) was
+    /// put on a cloth that is not made of a mesh.
+    #[error(
+        "`{component}` paints a mesh's vertices: it needs a cloth made of a mesh (`Cloth::from_mesh`)"
+    )]
+    PaintNeedsMesh {
+        /// The component.
+        component: &'static str,
+    },
     /// A garment whose patterns give no faces.
     #[error("the garment has no faces")]
     EmptyGarment,

@@ -64,11 +64,12 @@ pub mod prelude {
     #[cfg(feature = "avian")]
     pub use crate::ecs::avian::ClothAvianPlugin;
     pub use crate::ecs::{
-        AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBecameInvalid,
-        ClothBuilt, ClothCollider, ClothColliderBecameInvalid, ClothColliderInvalid,
-        ClothColliderSpan, ClothEnvironment, ClothFellAsleep, ClothInterpolation, ClothInvalid,
-        ClothLod, ClothMaxDistance, ClothPause, ClothPlugin, ClothSimulation, ClothSleep,
-        ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems, ClothTorn, ClothWake,
+        AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBackStop,
+        ClothBecameInvalid, ClothBuilt, ClothCollider, ClothColliderBecameInvalid,
+        ClothColliderInvalid, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
+        ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
+        ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
+        ClothTorn, ClothWake,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;

@@ -578,6 +578,7 @@ fn error_field(e: &crate::error::ClothError) -> &'static str {
         | BadLayout { .. }
         | ModelNeedsGrid { .. }
         | ShapeNeedsSource { .. }
+        | PaintNeedsMesh { .. }
         | EmptyGarment
         | Pattern(_)
         | Garment { .. } => "shape",

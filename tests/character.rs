@@ -6,6 +6,7 @@
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::params::Environment;
 use bevy_cloth::prelude::*;
+use bevy_cloth::solver::BackStop;
 
 /// Where a 12 × 12 grid's rest particle `local` is at time `t` on a body that walks
 /// (1.5 m/s along x), bobs (3 cm at 2 Hz) and sways (±20° about y at 1 Hz).
@@ -106,6 +107,99 @@ fn motion_constraints_cleared_let_the_cloth_go() {
         cloth.set_motion_constraints(&rest, &[-1.0; 16]).is_err(),
         "no negative distance"
     );
+}
+
+/// Each particle's unit normal at positions `x`: the sum of its triangles' area vectors
+/// (counter-clockwise winding), as a renderer's smooth normals.
+fn normals_at(triangles: &[[u32; 3]], x: &[Vec3]) -> Vec<Vec3> {
+    let mut n = vec![Vec3::ZERO; x.len()];
+    for t in triangles {
+        let [a, b, c] = t.map(|v| v as usize);
+        let area = (x[b] - x[a]).cross(x[c] - x[a]);
+        for v in [a, b, c] {
+            n[v] += area;
+        }
+    }
+    n.iter().map(|n| n.normalize_or_zero()).collect()
+}
+
+/// How deep particle positions `x` are in their back-stop spheres (Jolt's definition:
+/// centred `distance + radius` behind each target along its normal), the deepest; ≤ 0
+/// when none is inside.
+fn deepest_in_back_stops(x: &[Vec3], targets: &[Vec3], normals: &[Vec3], stop: BackStop) -> f32 {
+    x.iter()
+        .zip(targets.iter().zip(normals))
+        .map(|(&x, (&target, &n))| {
+            let centre = target - n * (stop.distance + stop.radius);
+            stop.radius - x.distance(centre)
+        })
+        .fold(f32::MIN, f32::max)
+}
+
+/// A back stop keeps a cloth off the body it lags behind: a 12 × 12 grid held by its top
+/// row, its targets (the body) swinging ±0.3 m at 1 Hz along the grid's own normal, so
+/// the free rows trail behind the body each half swing. Back stops 1 cm behind the
+/// targets, radius 0.5 m: no particle is ever inside its sphere (1e-5 m). Without them
+/// the same motion puts the cloth more than 2 cm into the spheres, and with them it
+/// still moves freely in front of its targets (more than 2 cm out).
+#[test]
+fn a_back_stop_keeps_a_lagging_cloth_out_of_its_sphere() {
+    let (w, h) = (12u32, 12u32);
+    let stop = BackStop {
+        distance: 0.01,
+        radius: 0.5,
+    };
+    let run = |stopped: bool| -> (f32, f32) {
+        let mut cloth = free_grid(w, h);
+        let rest: Vec<Vec3> = cloth.positions().to_vec();
+        let normals = normals_at(cloth.triangles(), &rest);
+        let n = normals[(w * h / 2) as usize];
+        let radius: Vec<f32> = (0..w * h)
+            .map(|k| if k < w { 0.0 } else { f32::INFINITY })
+            .collect();
+        if stopped {
+            cloth.set_back_stops(&vec![stop; (w * h) as usize]).unwrap();
+        }
+        let env = Environment::default();
+        let dt = 1.0 / 60.0;
+        let (mut deepest, mut ahead) = (f32::MIN, 0.0f32);
+        for frame in 1..=180 {
+            let swing = 0.3 * (std::f32::consts::TAU * frame as f32 * dt).sin();
+            let targets: Vec<Vec3> = rest.iter().map(|&x| x + n * swing).collect();
+            cloth.set_motion_constraints(&targets, &radius).unwrap();
+            cloth.step(dt, &env);
+            let x = cloth.positions();
+            deepest = deepest.max(deepest_in_back_stops(x, &targets, &normals, stop));
+            for (&x, &target) in x.iter().zip(&targets) {
+                ahead = ahead.max((x - target).dot(n));
+            }
+        }
+        (deepest, ahead)
+    };
+    let (deepest, ahead) = run(true);
+    let (free, _) = run(false);
+    eprintln!(
+        "deepest into a back stop: {deepest} m (without back stops {free} m); in front: {ahead} m"
+    );
+    assert!(
+        deepest <= 1e-5,
+        "a particle went {deepest} m into its back stop"
+    );
+    assert!(
+        free > 0.02,
+        "without back stops the cloth lags into them: {free} m"
+    );
+    assert!(
+        ahead > 0.02,
+        "in front of the body the cloth is free: {ahead} m"
+    );
+    let mut cloth = free_grid(4, 4);
+    assert!(cloth.set_back_stops(&[stop; 3]).is_err(), "one a particle");
+    let bad = BackStop {
+        distance: f32::NAN,
+        radius: 0.1,
+    };
+    assert!(cloth.set_back_stops(&[bad; 16]).is_err(), "no NaN distance");
 }
 
 /// Distances painted anew: a 6 × 6 grid lying flat with a layout pin at a corner of its
@@ -494,13 +588,16 @@ fn a_capsule_spanning_two_joints_follows_them_and_keeps_the_cloth_out() {
     );
 }
 
-/// A skirt on a walking character: an A-line cone of 12 rings × 32, skinned to the hips,
-/// its distance 0 at the waist growing to 0.2 m at the hem; two legs whose thighs swing
-/// ±26° at 1 Hz in opposite phase while the hips walk at 1 m/s, each thigh a capsule
-/// spanning its hip and knee joints. Over 3 s no skirt particle is ever inside a thigh,
-/// and the thighs do push the skirt (some particle comes within 2 cm of their surface).
-#[test]
-fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
+/// An A-line skirt: a cone of 12 rings × 32 (radius 19 cm at the waist, 0.96 m up, to 31
+/// cm at the hem, 40 cm down), wound to face out, skinned wholly to joint 0, its maximum
+/// distance 0 at the waist growing to 0.2 m at the hem.
+fn skirt_cone() -> Mesh {
+    skirt_cone_wound(false)
+}
+
+/// [`skirt_cone`], or (`inward`) wound to face in and given normals that point out, as
+/// hand-made meshes can be.
+fn skirt_cone_wound(inward: bool) -> Mesh {
     let (rows, around) = (12u32, 32u32);
     let (mut positions, mut indices, mut distances) = (Vec::new(), Vec::new(), Vec::new());
     for j in 0..rows {
@@ -519,7 +616,7 @@ fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
         }
     }
     let n = positions.len();
-    let mesh = Mesh::new(
+    let mut mesh = Mesh::new(
         PrimitiveTopology::TriangleList,
         RenderAssetUsages::default(),
     )
@@ -529,8 +626,46 @@ fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
         VertexAttributeValues::Uint16x4(vec![[0; 4]; n]),
     )
     .with_inserted_attribute(Mesh::ATTRIBUTE_JOINT_WEIGHT, vec![[1.0, 0.0, 0.0, 0.0]; n])
-    .with_inserted_attribute(ATTRIBUTE_MAX_DISTANCE, distances)
-    .with_inserted_indices(Indices::U32(indices));
+    .with_inserted_attribute(ATTRIBUTE_MAX_DISTANCE, distances);
+    if inward {
+        let out: Vec<[f32; 3]> = positions_of(&mesh)
+            .iter()
+            .map(|p| {
+                let radial = Vec3::new(p.x, 0.0, p.z).normalize();
+                // The cone's slant: 12 cm out over 40 cm down.
+                (radial * 0.4 + Vec3::Y * 0.12).normalize().to_array()
+            })
+            .collect();
+        for t in indices.chunks_exact_mut(3) {
+            t.swap(1, 2);
+        }
+        mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, out);
+    }
+    mesh.with_inserted_indices(Indices::U32(indices))
+}
+
+/// A mesh's vertex positions.
+fn positions_of(mesh: &Mesh) -> Vec<Vec3> {
+    match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
+        Some(VertexAttributeValues::Float32x3(p)) => p.iter().map(|&p| Vec3::from(p)).collect(),
+        _ => panic!("the mesh has no positions"),
+    }
+}
+
+/// A mesh's triangles.
+fn triangles_of(mesh: &Mesh) -> Vec<[u32; 3]> {
+    let flat: Vec<u32> = mesh.indices().unwrap().iter().map(|i| i as u32).collect();
+    flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect()
+}
+
+/// A skirt on a walking character: an A-line cone of 12 rings × 32, skinned to the hips,
+/// its distance 0 at the waist growing to 0.2 m at the hem; two legs whose thighs swing
+/// ±26° at 1 Hz in opposite phase while the hips walk at 1 m/s, each thigh a capsule
+/// spanning its hip and knee joints. Over 3 s no skirt particle is ever inside a thigh,
+/// and the thighs do push the skirt (some particle comes within 2 cm of their surface).
+#[test]
+fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
+    let mesh = skirt_cone();
     let mut app = bevy_cloth::headless::headless_app();
     let hip_rest = Transform::from_xyz(0.0, 0.92, 0.0);
     let hips = app.world_mut().spawn(hip_rest).id();
@@ -614,6 +749,155 @@ fn a_skirt_on_a_walking_character_never_has_a_particle_inside_a_leg() {
         "a skirt particle went {inside} m into a thigh"
     );
     assert!(closest < 0.02, "the thighs reach the skirt: {closest} m");
+}
+
+/// A back stop keeps a skirt off the body with no collider: the skirt cone on hips that
+/// walk for 6 s at 1 m/s, surging ±0.25 m/s at 1.5 Hz and turning ±35° at 1 Hz, so that
+/// the hem swings back into where the legs would be. With `ClothBackStop::Uniform`
+/// (1 cm behind, radius 0.3 m) no particle is ever inside its sphere at a frame's end
+/// (1e-4 m), its centre found here from the skinned positions and the cone's outward
+/// normals; so too for the cone wound inward with outward normals (the normals say which
+/// side is out). Without it the same walk takes the skirt more than 2 cm into them.
+#[test]
+fn a_back_stop_keeps_a_walking_skirt_off_the_body_without_colliders() {
+    let stop = BackStop {
+        distance: 0.01,
+        radius: 0.3,
+    };
+    let out = triangles_of(&skirt_cone());
+    let walk = |stopped: bool, inward: bool| -> f32 {
+        let mut app = bevy_cloth::headless::headless_app();
+        let hip_rest = Transform::from_xyz(0.0, 0.92, 0.0);
+        let hips = app.world_mut().spawn(hip_rest).id();
+        let bindposes = app
+            .world_mut()
+            .resource_mut::<Assets<SkinnedMeshInverseBindposes>>()
+            .add(SkinnedMeshInverseBindposes::from(vec![
+                hip_rest.to_matrix().inverse(),
+            ]));
+        let mesh = skirt_cone_wound(inward);
+        let rest = positions_of(&mesh);
+        let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(mesh);
+        let mut skirt = app.world_mut().spawn((
+            Mesh3d(handle),
+            SkinnedMesh {
+                inverse_bindposes: bindposes,
+                joints: vec![hips],
+            },
+            Cloth::from_mesh().with_pins(ClothPins::None),
+        ));
+        if stopped {
+            skirt.insert(ClothBackStop::Uniform {
+                distance: stop.distance,
+                radius: stop.radius,
+            });
+        }
+        let skirt = skirt.id();
+        let mut deepest = f32::MIN;
+        for frame in 0..360 {
+            let t = frame as f32 / 60.0;
+            let tau = std::f32::consts::TAU;
+            let place =
+                Transform::from_xyz(0.0, 0.92, t - 0.25 / (1.5 * tau) * (1.5 * tau * t).cos())
+                    .with_rotation(Quat::from_rotation_y(0.6 * (tau * t).sin()));
+            *app.world_mut().get_mut::<Transform>(hips).unwrap() = place;
+            app.update();
+            let Some(sim) = app.world().get::<ClothSimulation>(skirt) else {
+                continue;
+            };
+            assert!(sim.solver.is_stable(), "frame {frame}");
+            // The skin: the hips now, from their rest (the particles are the mesh's
+            // vertices, in order: it has no seam to weld).
+            let skin = place.to_matrix() * hip_rest.to_matrix().inverse();
+            let targets: Vec<Vec3> = rest.iter().map(|&v| skin.transform_point3(v)).collect();
+            let normals = normals_at(&out, &targets);
+            deepest = deepest.max(deepest_in_back_stops(
+                sim.solver.positions(),
+                &targets,
+                &normals,
+                stop,
+            ));
+        }
+        deepest
+    };
+    let (deepest, inward, free) = (walk(true, false), walk(true, true), walk(false, false));
+    eprintln!(
+        "deepest into a back stop over 6 s: {deepest} m, wound inward with normals out \
+         {inward} m (without back stops {free} m)"
+    );
+    assert!(
+        deepest <= 1e-4,
+        "a skirt particle went {deepest} m into its back stop"
+    );
+    assert!(
+        inward <= 1e-4,
+        "wound inward: {inward} m into its back stop"
+    );
+    assert!(
+        free > 0.02,
+        "without back stops the walk takes the skirt into them: {free} m"
+    );
+}
+
+/// Bad back stops are refused at the door, each with the error that names it, and a
+/// fixed one builds: on a grid (it paints a mesh's vertices), one of the wrong count for
+/// the mesh, a NaN distance.
+#[test]
+fn bad_back_stops_are_refused_with_what_is_wrong() {
+    let mut app = bevy_cloth::headless::headless_app();
+    let grid = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(4, 4, 0.1),
+            ClothBackStop::Uniform {
+                distance: 0.0,
+                radius: 0.1,
+            },
+        ))
+        .id();
+    let mut skirt = |back: ClothBackStop| {
+        let handle = app
+            .world_mut()
+            .resource_mut::<Assets<Mesh>>()
+            .add(skirt_cone());
+        app.world_mut()
+            .spawn((
+                Mesh3d(handle),
+                Cloth::from_mesh().with_pins(ClothPins::None),
+                back,
+            ))
+            .id()
+    };
+    let short = skirt(ClothBackStop::PerVertex(vec![[0.0, 0.1]; 3]));
+    let nan = skirt(ClothBackStop::Uniform {
+        distance: f32::NAN,
+        radius: 0.1,
+    });
+    for _ in 0..3 {
+        app.update();
+    }
+    let error = |app: &App, e: Entity| {
+        let invalid = app.world().get::<ClothInvalid>(e).expect("refused");
+        assert!(app.world().get::<ClothSimulation>(e).is_none());
+        invalid.0.to_string()
+    };
+    let (grid_error, short_error, nan_error) =
+        (error(&app, grid), error(&app, short), error(&app, nan));
+    eprintln!("{grid_error}\n{short_error}\n{nan_error}");
+    assert!(grid_error.contains("ClothBackStop"), "{grid_error}");
+    assert!(short_error.contains("3 back stops"), "{short_error}");
+    assert!(nan_error.contains("back stop distance"), "{nan_error}");
+    *app.world_mut().get_mut::<ClothBackStop>(nan).unwrap() = ClothBackStop::Uniform {
+        distance: 0.0,
+        radius: 0.1,
+    };
+    app.update();
+    app.update();
+    assert!(
+        app.world().get::<ClothInvalid>(nan).is_none(),
+        "fixed, it builds"
+    );
+    assert!(app.world().get::<ClothSimulation>(nan).is_some());
 }
 
 /// A plain (unskinned) mesh with painted distances: its targets are its rest shape in the

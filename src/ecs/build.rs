@@ -12,7 +12,7 @@ use crate::ecs::events::ClothBuilt;
 use bevy::mesh::skinning::SkinnedMesh;
 
 use crate::ecs::mesh::{cloth_mesh, mesh_triangles};
-use crate::ecs::skin::{ClothBody, ClothMaxDistance};
+use crate::ecs::skin::{ClothBackStop, ClothBody, ClothMaxDistance};
 use crate::error::ClothError;
 use crate::layout::garment::{Garment, GarmentLoader};
 use crate::layout::shape::{ClothPins, ClothShape};
@@ -33,6 +33,7 @@ enum LayoutSource<'a> {
 struct BodySource<'a> {
     skin: Option<&'a SkinnedMesh>,
     max: Option<&'a ClothMaxDistance>,
+    back: Option<&'a ClothBackStop>,
 }
 
 /// A built cloth: its solver, its mesh, and for a mesh-shaped cloth its body.
@@ -68,11 +69,20 @@ fn build_one(
             };
             build_from_mesh(cloth, mesh, frame, body)?
         }
-        _ => plain(
-            cloth
-                .shape
-                .build_solver(&cloth.pins, &cloth.params, frame)?,
-        ),
+        _ => {
+            let painted = [
+                (body.max.is_some(), "ClothMaxDistance"),
+                (body.back.is_some(), "ClothBackStop"),
+            ];
+            if let Some(&(_, component)) = painted.iter().find(|(on, _)| *on) {
+                return Err(ClothError::PaintNeedsMesh { component });
+            }
+            plain(
+                cloth
+                    .shape
+                    .build_solver(&cloth.pins, &cloth.params, frame)?,
+            )
+        }
     };
     Ok(Some(built))
 }
@@ -85,7 +95,15 @@ fn build_from_mesh(
     frame: bevy::math::Affine3A,
     body: BodySource,
 ) -> Result<BuiltCloth, ClothError> {
-    let source = mesh_triangles(mesh)?;
+    let mut source = mesh_triangles(mesh)?;
+    let back_stops = crate::ecs::skin::back_stops(mesh, &source, body.back)?;
+    if !back_stops.is_empty() && crate::ecs::skin::wound_against_normals(mesh, &source) {
+        // The back stops go behind the side the mesh's normals face: its triangles are
+        // wound to face the same way.
+        for t in &mut source.triangles {
+            t.swap(1, 2);
+        }
+    }
     let layout = Layout::from_mesh(&source.positions, &source.triangles)?;
     let pins = match &cloth.pins {
         // The mesh's own vertex indices, each to the particle it was welded into.
@@ -104,14 +122,16 @@ fn build_from_mesh(
         }
         pins => pins.resolve_for(&layout)?,
     };
-    let body = ClothBody::read(mesh, &source, body.skin, body.max, &pins)?;
+    let back_stopped = !back_stops.is_empty();
+    let body = ClothBody::read(mesh, &source, body.skin, body.max, &pins, back_stopped)?;
     // A skinned cloth's pins follow its skin (distance 0), not the entity's frame.
     let frame_pins = if body.as_ref().is_some_and(|b| b.skin.is_some()) {
         Vec::new()
     } else {
         pins
     };
-    let solver = solver::ClothSolver::new(layout, &frame_pins, &cloth.params, frame)?;
+    let mut solver = solver::ClothSolver::new(layout, &frame_pins, &cloth.params, frame)?;
+    solver.set_back_stops(&back_stops)?;
     let mesh = cloth_mesh(&solver, source.uvs);
     Ok(BuiltCloth { solver, mesh, body })
 }
@@ -263,6 +283,7 @@ type ClothsToBuild<'w, 's> = Query<
             Option<&'static SkinnedMesh>,
             Option<&'static ClothBody>,
             Option<Ref<'static, ClothMaxDistance>>,
+            Option<Ref<'static, ClothBackStop>>,
         ),
     ),
 >;
@@ -277,8 +298,16 @@ pub(crate) fn build_cloths(
     transforms: TransformHelper,
     mut cloths: ClothsToBuild,
 ) {
-    for (entity, cloth, sim, mesh3d, source, mut garment, (invalid, attached), (skin, body, max)) in
-        &mut cloths
+    for (
+        entity,
+        cloth,
+        sim,
+        mesh3d,
+        source,
+        mut garment,
+        (invalid, attached),
+        (skin, body, max, back),
+    ) in &mut cloths
     {
         let frame = transforms
             .compute_global_transform(entity)
@@ -289,7 +318,8 @@ pub(crate) fn build_cloths(
         let forced = garment
             .as_mut()
             .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed))
-            | max.as_ref().is_some_and(|m| m.is_changed());
+            | max.as_ref().is_some_and(|m| m.is_changed())
+            | back.as_ref().is_some_and(|b| b.is_changed());
         // The pins it has: `Auto` pins nothing on an attached cloth.
         let pins = cloth.pins.when_attached(attached);
         let forced = forced || sim.as_ref().is_some_and(|s| s.built_from.1 != *pins);
@@ -317,6 +347,7 @@ pub(crate) fn build_cloths(
             // The entity's skin, or the one taken off it when it was last built.
             skin: skin.or(body.and_then(|b| b.skin.as_ref().map(|s| &s.mesh))),
             max: max.as_deref(),
+            back: back.as_deref(),
         };
         match build_one(cloth, frame, layout_source, body_source) {
             Ok(Some(built)) => {

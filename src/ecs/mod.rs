@@ -33,7 +33,9 @@ pub use events::{
 pub use lod::{ClothLod, ClothLodPlugin};
 pub use mesh::ClothMeshPlugin;
 pub use plugin::{ClothCorePlugin, ClothPlugin, ClothPrepareSystems, ClothSystems};
-pub use skin::{ATTRIBUTE_MAX_DISTANCE, ClothMaxDistance, ClothSkinPlugin};
+pub use skin::{
+    ATTRIBUTE_BACK_STOP, ATTRIBUTE_MAX_DISTANCE, ClothBackStop, ClothMaxDistance, ClothSkinPlugin,
+};
 pub use sleep::{ClothSleep, ClothSleepPlugin, ClothWake};
 pub use stats::{ClothStats, StatSample};
 pub use step::{ClothSubstep, ClothSubstepPlan, ClothSubstepSystems};

@@ -10,7 +10,9 @@
 //! inverse bindposeₖ) · v`), from the joints' transforms as they are when the step
 //! begins, and gives the solver those points and the distances as motion constraints.
 //! A mesh that is not skinned can have distances too: its targets are its rest shape in
-//! the entity's frame.
+//! the entity's frame. A back stop ([`ClothBackStop`]) keeps each particle off a sphere
+//! behind its target (Jolt's skinned constraints): the body's surface without a collider
+//! per bone.
 
 use bevy::math::Affine3A;
 use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
@@ -26,6 +28,36 @@ use crate::error::ClothError;
 /// where the body (or the entity's frame) puts the vertex; 0 holds it there.
 pub const ATTRIBUTE_MAX_DISTANCE: MeshVertexAttribute =
     MeshVertexAttribute::new("Cloth_MaxDistance", 2_094_662_831, VertexFormat::Float32);
+
+/// A mesh's per-vertex back stop (`Float32x2`: distance, radius, m): see
+/// [`ClothBackStop`].
+pub const ATTRIBUTE_BACK_STOP: MeshVertexAttribute =
+    MeshVertexAttribute::new("Cloth_BackStop", 3_187_430_519, VertexFormat::Float32x2);
+
+/// A mesh-shaped cloth's back stops (Jolt's skinned constraints, NvCloth's separation
+/// constraints, Chaos's backstop): each particle kept outside a sphere of `radius` whose
+/// surface lies `distance` behind its target (where the skin, or the entity's frame,
+/// puts the vertex) along the target's normal, so a cape or skirt cannot swing into the
+/// body it lies on, with no collider per bone. "Behind" is against the way the mesh's
+/// normals point (out of the body), or without normals the side its triangles face
+/// (counter-clockwise winding). A back stop acts only where its distance is below the particle's maximum
+/// distance ([`ClothMaxDistance`]). Without this component a mesh with an
+/// [`ATTRIBUTE_BACK_STOP`] uses it. A welded vertex (a UV seam) takes its first copy's.
+#[derive(Component, Clone, Debug, PartialEq, Reflect)]
+#[reflect(Component, Debug, PartialEq)]
+pub enum ClothBackStop {
+    /// One back stop for every vertex.
+    Uniform {
+        /// How far behind its target a particle may go, m.
+        distance: f32,
+        /// The sphere's radius, m (0: none; large: a plane `distance` behind).
+        radius: f32,
+    },
+    /// The mesh's [`ATTRIBUTE_BACK_STOP`].
+    Attribute,
+    /// `[distance, radius]` per vertex of the mesh, by its own vertex indices, m.
+    PerVertex(Vec<[f32; 2]>),
+}
 
 /// Where a mesh-shaped cloth ([`Cloth::from_mesh`](crate::Cloth::from_mesh)) reads each
 /// vertex's maximum distance from its target (its skinned position, or its rest position
@@ -83,9 +115,10 @@ impl ClothBody {
         skin: Option<&SkinnedMesh>,
         max: Option<&ClothMaxDistance>,
         pins: &[u32],
+        back_stopped: bool,
     ) -> Result<Option<Self>, ClothError> {
         let per_vertex = painted(mesh, max, source.particle_of.len())?;
-        if skin.is_none() && per_vertex.is_none() {
+        if skin.is_none() && per_vertex.is_none() && !back_stopped {
             return Ok(None);
         }
         let n = source.positions.len();
@@ -183,6 +216,78 @@ fn painted(
     Ok(Some(d))
 }
 
+/// Each particle's back stop as `back` says (or from the mesh's [`ATTRIBUTE_BACK_STOP`]
+/// without it), its first vertex's; empty: none. The values are checked by the solver.
+pub(crate) fn back_stops(
+    mesh: &Mesh,
+    source: &MeshSource,
+    back: Option<&ClothBackStop>,
+) -> Result<Vec<crate::solver::BackStop>, ClothError> {
+    use crate::solver::BackStop;
+    use bevy::mesh::VertexAttributeValues::Float32x2;
+    let back = match back {
+        Some(back) => back,
+        None if mesh.attribute(ATTRIBUTE_BACK_STOP).is_some() => &ClothBackStop::Attribute,
+        None => return Ok(Vec::new()),
+    };
+    let per_vertex = match back {
+        &ClothBackStop::Uniform { distance, radius } => {
+            return Ok(vec![BackStop { distance, radius }; source.positions.len()]);
+        }
+        ClothBackStop::Attribute => match mesh.attribute(ATTRIBUTE_BACK_STOP) {
+            Some(Float32x2(d)) => d,
+            _ => {
+                return Err(ClothError::BadMesh {
+                    reason: "it has no Float32x2 Cloth_BackStop attribute".into(),
+                });
+            }
+        },
+        ClothBackStop::PerVertex(d) => d,
+    };
+    let vertices = source.particle_of.len();
+    if per_vertex.len() != vertices {
+        return Err(ClothError::BadMesh {
+            reason: format!(
+                "{} back stops for its {vertices} vertices",
+                per_vertex.len()
+            ),
+        });
+    }
+    Ok(source
+        .first_vertex
+        .iter()
+        .map(|&v| {
+            let [distance, radius] = per_vertex[v as usize];
+            BackStop { distance, radius }
+        })
+        .collect())
+}
+
+/// Whether a mesh's triangles are wound (counter-clockwise) to face against its normals
+/// (`Mesh::ATTRIBUTE_NORMAL`), taken over the whole mesh: each triangle's area vector
+/// against its corners' normals. False without normals.
+pub(crate) fn wound_against_normals(mesh: &Mesh, source: &MeshSource) -> bool {
+    let Some(bevy::mesh::VertexAttributeValues::Float32x3(normals)) =
+        mesh.attribute(Mesh::ATTRIBUTE_NORMAL)
+    else {
+        return false;
+    };
+    let x = &source.positions;
+    let normal = |k: u32| {
+        let v = source.first_vertex[k as usize] as usize;
+        normals.get(v).map_or(Vec3::ZERO, |&n| Vec3::from(n))
+    };
+    let agreement: f32 = source
+        .triangles
+        .iter()
+        .map(|&[a, b, c]| {
+            let area = (x[b as usize] - x[a as usize]).cross(x[c as usize] - x[a as usize]);
+            area.dot(normal(a) + normal(b) + normal(c))
+        })
+        .sum();
+    agreement < 0.0
+}
+
 impl BodySkin {
     /// The skin `skinned` of a cloth made of `mesh` (`source` its welded layout): each
     /// particle's joints and weights, its first vertex's.
@@ -267,15 +372,18 @@ fn move_bodies(
 }
 
 /// Cloth on skinned characters: a cloth made of a skinned mesh follows its skin, each
-/// particle within its painted [`ClothMaxDistance`] of where the skin puts it.
+/// particle within its painted [`ClothMaxDistance`] of where the skin puts it and off its
+/// [`ClothBackStop`].
 pub struct ClothSkinPlugin;
 
 impl Plugin for ClothSkinPlugin {
     fn build(&self, app: &mut App) {
         let schedule = crate::ecs::plugin::ClothSchedule::of(app);
-        app.register_type::<ClothMaxDistance>().add_systems(
-            schedule,
-            move_bodies.in_set(crate::ecs::plugin::ClothPrepareSystems::Skin),
-        );
+        app.register_type::<ClothMaxDistance>()
+            .register_type::<ClothBackStop>()
+            .add_systems(
+                schedule,
+                move_bodies.in_set(crate::ecs::plugin::ClothPrepareSystems::Skin),
+            );
     }
 }

@@ -36,6 +36,7 @@ use models::switch;
 pub use contact::shapes::{self, ColliderShape, ConvexHull, Placement, Shape};
 pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};
+pub use drivers::BackStop;
 pub use drivers::interact::Grab;
 pub use layout::{Layout, MAX_PARTICLES};
 pub(crate) use many::{begin_cloths, run_cloths};

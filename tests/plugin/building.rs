@@ -249,6 +249,11 @@ fn every_public_component_resource_message_and_event_is_reflected_and_registered
         },
         true,
     );
+    round_trips(
+        &app,
+        ClothBackStop::PerVertex(vec![[0.01, 0.3], [0.0, 0.1]]),
+        true,
+    );
     round_trips(&app, bevy_cloth::StatSample::default(), false);
     round_trips(&app, ClothWake(e), false);
     round_trips(

@@ -3,7 +3,8 @@
 //! substeps of a step; seams shorten from their starting gap to their rest length over
 //! the sewing time (Maslova §1.4); motion constraints keep particles within a distance
 //! of targets that move (NvCloth's motion constraints, Unreal's painted max distance: a
-//! skirt on a walking body).
+//! skirt on a walking body), and off a sphere behind their targets (a back stop: Jolt's
+//! skinned constraints, NvCloth's separation constraints).
 
 pub(super) mod interact;
 
@@ -35,6 +36,8 @@ pub(super) struct Drivers {
 /// Motion constraints: each particle with a finite `radius` kept within it of its
 /// target, which goes from `from` to `to` over the step as pins do. A radius of 0 makes
 /// the particle an attached pin instead (exactly at its target); `f32::INFINITY`, free.
+/// With back stops, each particle is also kept out of a sphere behind its target along
+/// the targets' normal (`normal_from` to `normal_to` over the step).
 #[derive(Clone, Debug, Default)]
 pub(super) struct MotionConstraints {
     pub from: Vec<Vec3>,
@@ -45,33 +48,102 @@ pub(super) struct MotionConstraints {
     /// Each particle's place among the pins while the constraints are set (kept for its
     /// storage).
     pub slot: Vec<u32>,
+    /// One per particle (empty: none).
+    pub back_stop: Vec<BackStop>,
+    /// The targets' unit normals at the step's start and end, and for the next step (from
+    /// the cloth's triangles at the targets); empty without back stops.
+    pub normal_from: Vec<Vec3>,
+    pub normal_to: Vec<Vec3>,
+    pub normal_next: Vec<Vec3>,
+}
+
+/// A back stop (Jolt's skinned constraint, NvCloth's separation constraint, Chaos's
+/// backstop): the particle is kept outside a sphere of `radius` m whose surface lies
+/// `distance` m behind its target, along the target's normal (the centre at
+/// `target − normal · (distance + radius)`), so a skinned cloth cannot swing into the body
+/// it lies on without a collider per bone. "Behind" is against the side the cloth's
+/// triangles face (their counter-clockwise winding, the side a mesh's normals point to).
+/// It acts only while `distance` is less than the particle's maximum distance (Jolt's
+/// rule: otherwise the max distance already keeps the particle off it). A radius of 0
+/// is no back stop.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BackStop {
+    /// How far behind its target the particle may go, m (≥ 0).
+    pub distance: f32,
+    /// The sphere's radius, m (≥ 0; 0: none). A large radius makes the stop a plane at
+    /// `distance` behind the target; a small one lets the particle round it sideways.
+    pub radius: f32,
 }
 
 impl MotionConstraints {
-    /// Starts a step: the targets go from where the last step's ended to those given.
+    /// Starts a step: the targets (and their normals) go from where the last step's ended
+    /// to those given.
     fn begin_step(&mut self) {
         if self.next.len() != self.to.len() {
             self.to.clone_from(&self.next);
         }
         std::mem::swap(&mut self.from, &mut self.to);
         self.to.clone_from(&self.next);
+        if self.normal_next.len() != self.normal_to.len() {
+            self.normal_to.clone_from(&self.normal_next);
+        }
+        std::mem::swap(&mut self.normal_from, &mut self.normal_to);
+        self.normal_to.clone_from(&self.normal_next);
     }
 
     /// Pulls each constrained free particle back within its radius of where its target
-    /// is a fraction `t` through the step, with the velocity that leaves it there.
+    /// is a fraction `t` through the step, then out of its back stop, with the velocity
+    /// that leaves it there. The back stop acts last, as the one a body cannot do without
+    /// (Jolt applies it first; the order matters only where the two spheres' surfaces
+    /// cross, and there this one keeps the particle out of the body).
     pub fn hold(&self, p: &mut Particles, t: f32, h: f32) {
         for (i, &r) in self.radius.iter().enumerate() {
-            if !r.is_finite() || p.inv_mass[i] == 0.0 {
+            if p.inv_mass[i] == 0.0 {
                 continue;
             }
-            let centre = self.from[i].lerp(self.to[i], t);
-            let off = p.position[i] - centre;
-            let l2 = off.length_squared();
-            if l2 > r * r {
-                p.position[i] = centre + off * (r / l2.sqrt());
+            let target = self.from[i].lerp(self.to[i], t);
+            let mut moved = false;
+            if r.is_finite() {
+                let off = p.position[i] - target;
+                let l2 = off.length_squared();
+                if l2 > r * r {
+                    p.position[i] = target + off * (r / l2.sqrt());
+                    moved = true;
+                }
+            }
+            if let Some(stop) = self.back_stop.get(i)
+                && stop.radius > 0.0
+                && stop.distance < r
+                && let (Some(&from), Some(&to)) = (self.normal_from.get(i), self.normal_to.get(i))
+            {
+                let n = from.lerp(to, t).normalize_or_zero();
+                let centre = target - n * (stop.distance + stop.radius);
+                let off = p.position[i] - centre;
+                let l2 = off.length_squared();
+                if l2 < stop.radius * stop.radius {
+                    // Out to the sphere's surface the nearest way (along the normal from its
+                    // centre).
+                    let out = if l2 > 0.0 { off / l2.sqrt() } else { n };
+                    p.position[i] = centre + out * stop.radius;
+                    moved = true;
+                }
+            }
+            if moved {
                 p.velocity[i] = (p.position[i] - p.previous[i]) / h;
             }
         }
+    }
+
+    /// The targets' normals for the next step, from the cloth's triangles at the targets
+    /// (what the back stops push along).
+    fn aim_normals(&mut self, structure: &super::structure::Structure) {
+        self.normal_next.clear();
+        if self.back_stop.is_empty() || self.next.len() != self.back_stop.len() {
+            return;
+        }
+        let next = &self.next;
+        self.normal_next
+            .extend((0..next.len()).map(|i| structure.normal_sum(next, i).normalize_or_zero()));
     }
 }
 
@@ -265,6 +337,43 @@ impl ClothSolver {
         motion.radius.extend_from_slice(max_distance);
         motion.next.clear();
         motion.next.extend_from_slice(targets);
+        motion.aim_normals(&self.structure);
+        self.disturbed = true;
+        Ok(())
+    }
+
+    /// Back stops for the motion constraints, one per particle ([`BackStop`]: each
+    /// particle kept out of a sphere behind its target, along the targets' normal, as
+    /// Jolt's skinned constraints do). They act with the motion constraints
+    /// ([`ClothSolver::set_motion_constraints`]), from the next step on, until
+    /// [`ClothSolver::clear_motion_constraints`] or an empty slice.
+    pub fn set_back_stops(&mut self, stops: &[BackStop]) -> Result<(), ClothError> {
+        let n = self.particles.len();
+        if !stops.is_empty() && stops.len() != n {
+            return Err(ClothError::InvalidParameter {
+                field: "back stops",
+                value: stops.len() as f32,
+                expected: format!("one back stop per particle ({n}), or none").into(),
+            });
+        }
+        let limit = crate::limits::MAX_POSITION;
+        let bad = |d: f32| !(0.0..=limit).contains(&d);
+        if let Some(s) = stops.iter().find(|s| bad(s.distance) || bad(s.radius)) {
+            let (field, value) = if bad(s.distance) {
+                ("back stop distance", s.distance)
+            } else {
+                ("back stop radius", s.radius)
+            };
+            return Err(ClothError::InvalidParameter {
+                field,
+                value,
+                expected: format!("a distance from 0 to {limit:e} m (limits::MAX_POSITION)").into(),
+            });
+        }
+        let motion = &mut self.drivers.motion;
+        motion.back_stop.clear();
+        motion.back_stop.extend_from_slice(stops);
+        motion.aim_normals(&self.structure);
         self.disturbed = true;
         Ok(())
     }
