@@ -69,11 +69,11 @@ pub mod prelude {
         ClothColliderInvalid, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
         ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
         ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
-        ClothTorn, ClothWake,
+        ClothTeleport, ClothTeleported, ClothTorn, ClothWake,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;
     pub use crate::layout::shape::{ClothPins, ClothShape};
-    pub use crate::params::{Air, ClothParams, SelfCollision};
+    pub use crate::params::{Air, ClothParams, SelfCollision, Teleport, TeleportMode};
     pub use crate::scene::ClothScene;
 }

@@ -1442,3 +1442,236 @@ fn on_the_fixed_clock_a_gltf_character_is_read_a_frame_late() {
         walk.waist_off_drawn
     );
 }
+
+/// Where the walking body of [`animated`] puts `local` at time `t`, after it has been
+/// teleported at `jump_at` seconds: 10 m along x and turned 45° about y.
+fn teleported(local: Vec3, t: f32, jump_at: f32) -> Vec3 {
+    let x = animated(local, t);
+    if t < jump_at {
+        return x;
+    }
+    Quat::from_rotation_y(std::f32::consts::FRAC_PI_4) * x + Vec3::new(10.0, 0.0, 0.0)
+}
+
+/// What a cloth did across its body's teleport: the largest strain in the half second
+/// before and in the second after, the farthest any particle was from the body's centre
+/// just after, the steps that counted as teleports, and a step that failed.
+struct AcrossJump {
+    strain_before: f32,
+    strain_after: f32,
+    left_behind: f32,
+    teleports: Vec<u32>,
+    /// The step that failed the stability test (`ClothSolver::is_stable`), if one did.
+    failed_at: Option<u32>,
+}
+
+/// A 12 × 16 cape (5 cm spacing, default parameters) attached by its top row to the
+/// walking body, or held by motion constraints (its top row at distance 0, the rows below
+/// 2 cm farther each: a skinned cloth), teleported at 1 s in `mode`.
+fn cape_across_a_jump(mode: TeleportMode, skinned: bool, jump_at: f32) -> AcrossJump {
+    let (w, h) = (12u32, 16u32);
+    let mut cloth = free_grid(w, h);
+    let mut params = *cloth.params();
+    params.teleport.mode = mode;
+    cloth.set_params(&params).unwrap();
+    let rest = cloth.positions().to_vec();
+    let radius: Vec<f32> = (0..w * h).map(|k| 0.02 * (k / w) as f32).collect();
+    let env = Environment::default();
+    let dt = 1.0 / 60.0;
+    let mut across = AcrossJump {
+        strain_before: f32::MIN,
+        strain_after: f32::MIN,
+        left_behind: 0.0,
+        teleports: Vec::new(),
+        failed_at: None,
+    };
+    for frame in 1..=120u32 {
+        let t = frame as f32 * dt;
+        let targets: Vec<Vec3> = rest.iter().map(|&x| teleported(x, t, jump_at)).collect();
+        if skinned {
+            cloth.set_motion_constraints(&targets, &radius).unwrap();
+        } else {
+            for i in 0..w {
+                cloth.attach(i, targets[i as usize]).unwrap();
+            }
+        }
+        if frame == 1 {
+            // Spawned on the body (whatever the mode: without it the pins would drag the
+            // cape the metre up to the body in one step).
+            cloth.teleport_next_step(TeleportMode::Reset);
+        }
+        let report = cloth.step(dt, &env);
+        if !cloth.is_stable() {
+            across.failed_at = Some(frame);
+            break;
+        }
+        if report.teleported.is_some() {
+            across.teleports.push(frame);
+        }
+        let strain = cloth.strain().max;
+        // The walk before the jump (the first step puts the cape on the body), and after.
+        if frame > 1 && frame < 60 {
+            across.strain_before = across.strain_before.max(strain);
+        } else if frame >= 60 {
+            across.strain_after = across.strain_after.max(strain);
+        }
+        if frame == 60 {
+            let centre = teleported(Vec3::new(0.275, 0.0, 0.0), t, jump_at);
+            across.left_behind = cloth
+                .positions()
+                .iter()
+                .map(|x| x.distance(centre))
+                .fold(0.0, f32::max);
+        }
+    }
+    across
+}
+
+/// A body teleported 10 m and turned 45° takes its cape along (Keep and Reset): the
+/// largest strain in the second after is within 1 point of the second before, and no
+/// particle is left behind (all within the cape's reach of the body just after), whether
+/// the cape is attached or skinned; the jump is the one step after the first (a teleport
+/// asked for, which puts the cape on the body) that counted as a teleport. The same walk without the jump gives
+/// the strain the walk itself reaches after 1 s. Without teleports (`Off`) the pins drag
+/// the cape across the gap.
+#[test]
+fn a_cape_teleported_with_its_body_keeps_its_shape() {
+    // The farthest a particle can be from the top row's centre: the corner of the 0.55 ×
+    // 0.75 m cape, its springs stretched 20%.
+    let reach = 0.275f32.hypot(0.75) * 1.2;
+    for skinned in [false, true] {
+        let twin = cape_across_a_jump(TeleportMode::Keep, skinned, f32::INFINITY);
+        eprintln!(
+            "skinned {skinned}, no jump: strain {:.4} in the first second, {:.4} in the next",
+            twin.strain_before, twin.strain_after
+        );
+        for mode in [TeleportMode::Keep, TeleportMode::Reset] {
+            let a = cape_across_a_jump(mode, skinned, 1.0);
+            eprintln!(
+                "skinned {skinned}, {mode:?}: strain {:.4} before, {:.4} after; farthest \
+                 from the body {:.3} m; teleports at {:?}",
+                a.strain_before, a.strain_after, a.left_behind, a.teleports
+            );
+            assert_eq!(a.failed_at, None, "{mode:?}");
+            assert_eq!(
+                a.teleports.iter().filter(|&&f| f > 1).collect::<Vec<_>>(),
+                vec![&60],
+                "{mode:?}: the jump, and only it"
+            );
+            assert!(
+                a.strain_after <= a.strain_before + 0.01,
+                "{mode:?}: strain {} after against {} before",
+                a.strain_after,
+                a.strain_before
+            );
+            assert!(
+                a.left_behind < reach,
+                "{mode:?}: a particle {} m away",
+                a.left_behind
+            );
+        }
+        let off = cape_across_a_jump(TeleportMode::Off, skinned, 1.0);
+        eprintln!(
+            "skinned {skinned}, Off: strain {:.4} before, {:.4} after; farthest {:.3} m; \
+             failed at step {:?}",
+            off.strain_before, off.strain_after, off.left_behind, off.failed_at
+        );
+        assert_eq!(off.teleports, vec![1], "only the one asked for");
+        assert!(
+            off.failed_at.is_some()
+                || off.strain_after > off.strain_before + 0.01
+                || off.left_behind > reach,
+            "dragged across 10 m the cape fails, stretches or is left behind"
+        );
+    }
+}
+
+/// Reset leaves the cloth at rest on its skinned pose: after the jump each particle with
+/// a motion constraint starts on its target, moving with the body, so the step ends with
+/// every particle near its target and moving as it does.
+#[test]
+fn a_reset_teleport_starts_a_skinned_cloth_on_its_targets_at_rest() {
+    let (w, h) = (6u32, 6u32);
+    let mut cloth = free_grid(w, h);
+    let rest = cloth.positions().to_vec();
+    let radius: Vec<f32> = (0..w * h).map(|k| 0.05 * (k / w) as f32).collect();
+    let env = Environment::default();
+    let dt = 1.0 / 60.0;
+    for frame in 1..=40u32 {
+        let t = frame as f32 * dt;
+        let targets: Vec<Vec3> = rest.iter().map(|&x| animated(x, t)).collect();
+        cloth.set_motion_constraints(&targets, &radius).unwrap();
+        cloth.step(dt, &env);
+    }
+    // The body reappears 5 m up; the game says so even below the thresholds' jump.
+    let t = 41.0 * dt;
+    let targets: Vec<Vec3> = rest
+        .iter()
+        .map(|&x| animated(x, t) + Vec3::Y * 5.0)
+        .collect();
+    cloth.set_motion_constraints(&targets, &radius).unwrap();
+    cloth.teleport_next_step(TeleportMode::Reset);
+    let report = cloth.step(dt, &env);
+    let jump = report.teleported.expect("asked for");
+    assert_eq!(jump.mode, TeleportMode::Reset);
+    assert!((jump.distance - 5.0).abs() < 0.05, "{}", jump.distance);
+    let before: Vec<Vec3> = rest
+        .iter()
+        .map(|&x| animated(x, t - dt) + Vec3::Y * 5.0)
+        .collect();
+    let fastest = cloth
+        .particles()
+        .velocity
+        .iter()
+        .zip(targets.iter().zip(&before))
+        .map(|(v, (to, from))| v.distance((*to - *from) / dt))
+        .fold(0.0, f32::max);
+    let farthest = cloth
+        .positions()
+        .iter()
+        .zip(&targets)
+        .map(|(x, t)| x.distance(*t))
+        .fold(0.0, f32::max);
+    eprintln!(
+        "after a reset: fastest against its target {fastest} m/s, farthest from it {farthest} m"
+    );
+    assert!(fastest < 0.5, "{fastest} m/s");
+    assert!(farthest < 0.02, "{farthest} m from its target");
+}
+
+/// The thresholds are checked at the door.
+#[test]
+fn bad_teleport_thresholds_are_refused() {
+    for (teleport, field) in [
+        (
+            Teleport {
+                distance: 0.0,
+                ..Teleport::default()
+            },
+            "teleport.distance",
+        ),
+        (
+            Teleport {
+                angle_degrees: 200.0,
+                ..Teleport::default()
+            },
+            "teleport.angle_degrees",
+        ),
+        (
+            Teleport {
+                distance: f32::NAN,
+                ..Teleport::default()
+            },
+            "teleport.distance",
+        ),
+    ] {
+        let params = ClothParams {
+            teleport,
+            ..ClothParams::default()
+        };
+        match params.validate() {
+            Err(ClothError::InvalidParameter { field: f, .. }) => assert_eq!(f, field),
+            other => panic!("{teleport:?}: {other:?}"),
+        }
+    }
+}

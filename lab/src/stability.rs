@@ -152,6 +152,7 @@ pub fn params(
         fabric: None,
         still_air: false,
         max_depenetration_speed: 1.0,
+        teleport: Default::default(),
     })
 }
 

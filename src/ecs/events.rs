@@ -17,6 +17,7 @@ use bevy::ecs::message::Message;
 use bevy::prelude::*;
 
 use crate::error::ClothError;
+use crate::params::TeleportMode;
 
 /// A spring tore (over-stretched past its tear strain, or cut): triggered on the cloth
 /// entity and sent as a message, once per spring, at the end of the step that tore it.
@@ -73,6 +74,36 @@ pub struct ClothColliderBecameInvalid {
     pub entity: Entity,
     /// Why.
     pub error: ClothError,
+}
+
+/// Asks for a teleport of a cloth at its next step (a game moving the body it hangs on to
+/// a new place): the move of its drivers (pins, attachments, skinned targets) that step,
+/// however small, carries the whole cloth, by `mode` (see
+/// [`Teleport`](crate::params::Teleport); jumps past its thresholds need no message).
+/// A sleeping cloth wakes for it.
+#[derive(Message, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Debug, PartialEq)]
+pub struct ClothTeleport {
+    /// The cloth entity.
+    pub cloth: Entity,
+    /// What the cloth does: keep its motion, or start at rest on its skinned pose.
+    pub mode: TeleportMode,
+}
+
+/// The cloth was teleported at the start of the step that just ended: its drivers jumped
+/// past the [`Teleport`](crate::params::Teleport) thresholds, or a [`ClothTeleport`]
+/// asked for it. Triggered on the cloth entity.
+#[derive(EntityEvent, Clone, Copy, Debug, PartialEq, Reflect)]
+#[reflect(Debug, PartialEq)]
+pub struct ClothTeleported {
+    /// The cloth entity.
+    pub entity: Entity,
+    /// What it did.
+    pub mode: TeleportMode,
+    /// How far its drivers' centre jumped, m.
+    pub distance: f32,
+    /// How far they turned, radians.
+    pub angle: f32,
 }
 
 /// The cloth's solver and mesh were built: the first time, and again after a change of

@@ -28,7 +28,7 @@ pub use colliders::{
 };
 pub use events::{
     ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothColliderBecameInvalid, ClothFellAsleep,
-    ClothTorn,
+    ClothTeleport, ClothTeleported, ClothTorn,
 };
 pub use lod::{ClothLod, ClothLodPlugin};
 pub use mesh::ClothMeshPlugin;

@@ -38,14 +38,17 @@ use crate::ecs::cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
 };
 use crate::ecs::colliders::ClothCollidersPlugin;
-use crate::ecs::events::{ClothBecameInvalid, ClothBuilt, ClothTorn};
+use crate::ecs::events::{
+    ClothBecameInvalid, ClothBuilt, ClothTeleport, ClothTeleported, ClothTorn,
+};
 use crate::ecs::lod::ClothLodPlugin;
 use crate::ecs::mesh::ClothMeshPlugin;
 use crate::ecs::skin::ClothSkinPlugin;
 use crate::ecs::sleep::ClothSleepPlugin;
 use crate::ecs::stats::{ClothStats, StatSample};
 use crate::ecs::step::{
-    ClothSubstepPlan, begin_steps, finish_steps, recover_cloths, run_substeps, substep_schedule,
+    ClothSubstepPlan, begin_steps, finish_steps, recover_cloths, request_teleports, run_substeps,
+    substep_schedule,
 };
 use crate::layout::shape::{ClothPins, ClothShape};
 use crate::params::{
@@ -195,6 +198,7 @@ impl Plugin for ClothCorePlugin {
             .init_resource::<ClothPause>()
             .init_resource::<ClothSubstepPlan>()
             .add_message::<ClothTorn>()
+            .add_message::<ClothTeleport>()
             .add_observer(crate::ecs::cloth::log_invalid);
 
         app.add_schedule(substep_schedule());
@@ -248,6 +252,7 @@ fn configure_sets(app: &mut App, schedule: Interned<dyn ScheduleLabel>) {
         schedule,
         (
             build_cloths.in_set(P::Build),
+            request_teleports.in_set(P::Colliders),
             (recover_cloths, begin_steps).chain().in_set(P::Begin),
             run_substeps.in_set(ClothSystems::Substeps),
             finish_steps.in_set(ClothSystems::Finish),
@@ -303,6 +308,10 @@ fn register_types(app: &mut App) {
         .register_type::<StatSample>()
         .register_type::<crate::solver::Energy>()
         .register_type::<ClothTorn>()
+        .register_type::<ClothTeleport>()
+        .register_type::<ClothTeleported>()
+        .register_type::<crate::params::Teleport>()
+        .register_type::<crate::params::TeleportMode>()
         .register_type::<ClothBecameInvalid>()
         .register_type::<ClothBuilt>();
 }

@@ -9,7 +9,7 @@ use bevy::prelude::*;
 use crate::ecs::cloth::{
     ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
 };
-use crate::ecs::events::ClothTorn;
+use crate::ecs::events::{ClothTeleport, ClothTeleported, ClothTorn};
 use crate::ecs::sleep::ClothSleep;
 use crate::ecs::stats::ClothStats;
 use crate::error::ClothError;
@@ -94,6 +94,23 @@ pub(crate) fn recover_cloths(
     for (entity, sim, invalid) in &cloths {
         if matches!(invalid.0, ClothError::NonFinite { .. }) && sim.solver.last_report().finite {
             commands.entity(entity).remove::<ClothInvalid>();
+        }
+    }
+}
+
+/// Hands each [`ClothTeleport`] to its cloth's solver (before the sleeping cloths are
+/// woken: the request wakes its cloth).
+pub(crate) fn request_teleports(
+    mut messages: MessageReader<ClothTeleport>,
+    mut cloths: Query<&mut ClothSimulation>,
+) {
+    for message in messages.read() {
+        match cloths.get_mut(message.cloth) {
+            Ok(mut sim) => sim.solver.teleport_next_step(message.mode),
+            Err(_) => warn!(
+                "ClothTeleport for {}, which is not a built cloth: ignored",
+                message.cloth
+            ),
         }
     }
 }
@@ -294,6 +311,24 @@ pub(crate) fn finish_steps(
             pause_invalid(&mut commands, entity, error);
             sim.mesh_dirty = true;
             continue;
+        }
+        if let Some(jump) = report.teleported {
+            // Drawn from the carried start: no streak across the jump between steps.
+            for x in &mut sim.previous {
+                *x = jump.by.apply(*x);
+            }
+            debug!(
+                "{entity} teleported ({:?}): {:.2} m, {:.0}°",
+                jump.mode,
+                jump.distance,
+                jump.angle.to_degrees()
+            );
+            commands.trigger(ClothTeleported {
+                entity,
+                mode: jump.mode,
+                distance: jump.distance,
+                angle: jump.angle,
+            });
         }
         for &spring in sim.solver.last_torn() {
             let s = spring as usize;

@@ -13,11 +13,13 @@ use crate::error::ClothError;
 pub use crate::fabric::Fabric;
 
 mod environment;
+mod following;
 mod models;
 mod self_collision;
 mod springs;
 
 pub use environment::{Air, Environment, Wind, WindAt, WindField};
+pub use following::{Teleport, TeleportMode};
 pub use models::{
     GoalUpdate, Model, ModelKind, PatchParams, PatchTargets, RotationMethod, ShapeMatchingParams,
     XpbdParams, XpbdSolve,
@@ -137,6 +139,10 @@ pub struct ClothParams {
     /// velocity left behind. Contact met from outside is not limited. PhysX's and
     /// avian's `max_depenetration_velocity` sense; `f32::INFINITY` moves it out at once.
     pub max_depenetration_speed: f32,
+    /// What the cloth does when the bodies holding it jump or turn farther in a step than
+    /// any run does ([`Teleport`]): by default its shape and motion are carried with
+    /// them.
+    pub teleport: Teleport,
 }
 
 impl Default for ClothParams {
@@ -156,6 +162,7 @@ impl Default for ClothParams {
             fabric: None,
             still_air: true,
             max_depenetration_speed: 1.0,
+            teleport: Teleport::default(),
         }
     }
 }
@@ -220,6 +227,7 @@ impl ClothParams {
             cap > 0.0,
             "a speed > 0 m/s (`inf`: no cap)",
         )?;
+        self.teleport.validate()?;
         self.validate_stepping()?;
         if let Some(ratio) = self.tear_ratio {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;

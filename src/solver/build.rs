@@ -43,6 +43,8 @@ impl ClothSolver {
             disturbed: true,
             report: Default::default(),
             checkpoint: Default::default(),
+            teleport_request: None,
+            drivers_motion: None,
             air: Vec::new(),
         };
         cloth.clock.substeps = 1;

@@ -38,6 +38,7 @@ pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};
 pub use drivers::BackStop;
 pub use drivers::interact::Grab;
+pub use drivers::teleport::{RigidMove, Teleported};
 pub use layout::{Layout, MAX_PARTICLES};
 pub(crate) use many::{begin_cloths, run_cloths};
 pub use many::{begin_together, substep_together};
@@ -90,6 +91,10 @@ pub struct ClothSolver {
     report: StepReport,
     /// The state the step in progress started from.
     checkpoint: steps::Checkpoint,
+    /// A teleport asked for the next step ([`ClothSolver::teleport_next_step`]).
+    teleport_request: Option<crate::params::TeleportMode>,
+    /// The drivers' rigid motion over the last step, while teleports are watched for.
+    drivers_motion: Option<RigidMove>,
     /// Each particle's share of the air's force and its drag rate's numerator, this
     /// substep (`forces.rs`; kept for its storage).
     air: Vec<(Vec3, f32)>,

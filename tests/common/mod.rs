@@ -199,6 +199,7 @@ pub fn conservative(integrator: Integrator) -> ClothParams {
         fabric: None,
         still_air: false,
         max_depenetration_speed: 1.0,
+        teleport: Default::default(),
     }
 }
 

@@ -310,3 +310,81 @@ fn an_attached_cloth_has_no_default_world_pins() {
         .to_vec();
     assert_eq!(held.len(), 1);
 }
+
+/// A shoulder that jumps 10 m takes its attached cloth along at once (a teleport by the
+/// default thresholds), and a small move the game calls a teleport (`ClothTeleport`)
+/// carries it too: each triggers one `ClothTeleported` with the mode and the distance.
+#[test]
+fn a_jumping_body_teleports_its_cloth_and_says_so() {
+    let mut app = app();
+    let shoulder = app
+        .world_mut()
+        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
+        .id();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
+            Transform::from_xyz(0.0, 2.0, 0.0),
+            ClothAttachments(vec![ClothAttachment::indices(shoulder, vec![0, 7])]),
+        ))
+        .id();
+    let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
+    let record = seen.clone();
+    app.world_mut()
+        .entity_mut(cloth)
+        .observe(move |jump: On<ClothTeleported>| {
+            record.lock().unwrap().push((jump.mode, jump.distance));
+        });
+    for _ in 0..30 {
+        app.update();
+    }
+    assert!(
+        seen.lock().unwrap().is_empty(),
+        "hanging still is no teleport"
+    );
+    let lowest = |app: &App| {
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        sim.solver
+            .positions()
+            .iter()
+            .map(|x| x.y)
+            .fold(f32::MAX, f32::min)
+    };
+    let hang = lowest(&app);
+    app.world_mut()
+        .get_mut::<Transform>(shoulder)
+        .unwrap()
+        .translation += Vec3::new(10.0, 0.0, 0.0);
+    app.update();
+    let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+    let farthest_back = sim
+        .solver
+        .positions()
+        .iter()
+        .map(|x| x.x)
+        .fold(f32::MAX, f32::min);
+    assert!(
+        farthest_back > 9.8,
+        "a particle left at x = {farthest_back}"
+    );
+    assert!(
+        (lowest(&app) - hang).abs() < 0.01,
+        "the same hang after the jump"
+    );
+    app.world_mut()
+        .get_mut::<Transform>(shoulder)
+        .unwrap()
+        .translation += Vec3::new(0.0, 0.0, 0.1);
+    app.world_mut().write_message(ClothTeleport {
+        cloth,
+        mode: TeleportMode::Reset,
+    });
+    app.update();
+    let seen = seen.lock().unwrap().clone();
+    assert_eq!(seen.len(), 2, "{seen:?}");
+    assert_eq!(seen[0].0, TeleportMode::Keep);
+    assert!((seen[0].1 - 10.0).abs() < 0.05, "{seen:?}");
+    assert_eq!(seen[1].0, TeleportMode::Reset);
+    assert!((seen[1].1 - 0.1).abs() < 0.01, "{seen:?}");
+}

@@ -7,6 +7,7 @@
 //! skinned constraints, NvCloth's separation constraints).
 
 pub(super) mod interact;
+pub(super) mod teleport;
 
 use bevy::math::{Affine3A, Vec3};
 

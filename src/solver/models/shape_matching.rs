@@ -83,6 +83,13 @@ impl ShapeMatching {
         }
     }
 
+    /// Turns the warm-start rotations by `turn` (the cloth was carried rigidly by it).
+    pub(in crate::solver) fn turn(&mut self, turn: Quat) {
+        for c in &mut self.clusters {
+            c.rotation = (turn * c.rotation).normalize();
+        }
+    }
+
     /// Goals `g_i = G (x_i0 − x_cm0) + x_cm` (Sladović 2014 eq. 12) from the current positions,
     /// with `G = R` or Müller's `β A + (1 − β) R`. Allocates nothing.
     ///
@@ -160,7 +167,8 @@ fn centre_of_mass(particles: &[u32], x: &[Vec3], weight: impl Fn(u32) -> f32) ->
     (com / total).as_vec3()
 }
 
-fn outer(a: Vec3, b: Vec3) -> Mat3 {
+/// `a bᵀ`.
+pub(in crate::solver) fn outer(a: Vec3, b: Vec3) -> Mat3 {
     Mat3::from_cols(a * b.x, a * b.y, a * b.z)
 }
 
@@ -202,7 +210,7 @@ fn average_rotation(c: &Cluster, x: &[Vec3], com: Vec3) -> Quat {
 /// of deformations": maximise tr(Rᵀ A) by rotating `R` about `ω = Σ r_i × a_i / |Σ r_i·a_i|`.
 /// Works for rank-deficient `A` (flat or straight shapes), never yields a reflection or a
 /// NaN, and is continuous in time when warm-started.
-fn extract_rotation(a: &Mat3, start: Quat) -> Quat {
+pub(in crate::solver) fn extract_rotation(a: &Mat3, start: Quat) -> Quat {
     let norm =
         (a.x_axis.length_squared() + a.y_axis.length_squared() + a.z_axis.length_squared()).sqrt();
     if !(norm > 0.0 && norm.is_finite()) {

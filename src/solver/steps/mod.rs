@@ -90,6 +90,9 @@ pub struct StepReport {
     pub finite: bool,
     /// Springs torn in the step.
     pub torn: usize,
+    /// The step began with a teleport (the cloth carried with its drivers'
+    /// jump, [`Teleport`](crate::params::Teleport)).
+    pub teleported: Option<super::Teleported>,
     /// Wall time spent in each stage, summed over the substeps.
     pub time: StageTimes,
 }
@@ -104,6 +107,7 @@ impl Default for StepReport {
             max_strain: None,
             finite: true,
             torn: 0,
+            teleported: None,
             time: StageTimes::default(),
         }
     }
@@ -222,6 +226,7 @@ impl ClothSolver {
             self.clock.substeps = 0;
             return 0;
         }
+        self.teleport_if_jumped(dt);
         self.stepping = self.params.model;
         let model = self.stepping;
         let steps = model_steps(&model);
