@@ -313,22 +313,7 @@ pub(crate) fn finish_steps(
             continue;
         }
         if let Some(jump) = report.teleported {
-            // Drawn from the carried start: no streak across the jump between steps.
-            for x in &mut sim.previous {
-                *x = jump.by.apply(*x);
-            }
-            debug!(
-                "{entity} teleported ({:?}): {:.2} m, {:.0}°",
-                jump.mode,
-                jump.distance,
-                jump.angle.to_degrees()
-            );
-            commands.trigger(ClothTeleported {
-                entity,
-                mode: jump.mode,
-                distance: jump.distance,
-                angle: jump.angle,
-            });
+            announce_teleport(&mut commands, entity, sim, jump);
         }
         for &spring in sim.solver.last_torn() {
             let s = spring as usize;
@@ -348,4 +333,29 @@ pub(crate) fn finish_steps(
             stats.record(&sim.solver, &env, sim.last_step_ms);
         }
     }
+}
+
+/// A teleport the step began with: the mesh drawn between steps from the carried start
+/// (no streak across the jump), a debug line and [`ClothTeleported`] on the cloth.
+fn announce_teleport(
+    commands: &mut Commands,
+    entity: Entity,
+    sim: &mut ClothSimulation,
+    jump: solver::Teleported,
+) {
+    for x in &mut sim.previous {
+        *x = jump.by.apply(*x);
+    }
+    debug!(
+        "{entity} teleported ({:?}): {:.2} m, {:.0}°",
+        jump.mode,
+        jump.distance,
+        jump.angle.to_degrees()
+    );
+    commands.trigger(ClothTeleported {
+        entity,
+        mode: jump.mode,
+        distance: jump.distance,
+        angle: jump.angle,
+    });
 }
