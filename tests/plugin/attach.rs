@@ -6,27 +6,37 @@ use bevy_cloth::prelude::*;
 
 use crate::common::*;
 
+/// A "shoulder" entity 2 m up and an 8 × 6 cloth (5 cm, no pins) beside it, held by the
+/// attachments `held` makes for the shoulder: (shoulder, cloth).
+fn cloth_on_a_shoulder(
+    app: &mut App,
+    held: impl FnOnce(Entity) -> Vec<ClothAttachment>,
+) -> (Entity, Entity) {
+    let place = Transform::from_xyz(0.0, 2.0, 0.0);
+    let shoulder = app.world_mut().spawn(place).id();
+    let cloth = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
+            place,
+            ClothAttachments(held(shoulder)),
+        ))
+        .id();
+    (shoulder, cloth)
+}
+
 #[test]
 fn an_attached_cloth_follows_its_moving_entity_with_no_lag_beyond_a_step() {
     // A cape-like cloth hanging from a "shoulder" entity that walks along x and turns:
     // its two top corners, attached, are where the entity puts them at the end of every
     // step (the solver reaches the target over the step's substeps, as pins do).
     let mut app = app();
-    let shoulder = app
-        .world_mut()
-        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
-        .id();
-    let cloth = app
-        .world_mut()
-        .spawn((
-            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
-            Transform::from_xyz(0.0, 2.0, 0.0),
-            ClothAttachments(vec![
-                ClothAttachment::indices(shoulder, vec![0]),
-                ClothAttachment::nearest(shoulder, Vec3::new(0.175, 0.0, 0.0), 1),
-            ]),
-        ))
-        .id();
+    let (shoulder, cloth) = cloth_on_a_shoulder(&mut app, |shoulder| {
+        vec![
+            ClothAttachment::indices(shoulder, vec![0]),
+            ClothAttachment::nearest(shoulder, Vec3::new(0.175, 0.0, 0.0), 1),
+        ]
+    });
     // Built in the first frame (by command), attached from the second.
     app.update();
     app.update();
@@ -317,18 +327,9 @@ fn an_attached_cloth_has_no_default_world_pins() {
 #[test]
 fn a_jumping_body_teleports_its_cloth_and_says_so() {
     let mut app = app();
-    let shoulder = app
-        .world_mut()
-        .spawn(Transform::from_xyz(0.0, 2.0, 0.0))
-        .id();
-    let cloth = app
-        .world_mut()
-        .spawn((
-            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
-            Transform::from_xyz(0.0, 2.0, 0.0),
-            ClothAttachments(vec![ClothAttachment::indices(shoulder, vec![0, 7])]),
-        ))
-        .id();
+    let (shoulder, cloth) = cloth_on_a_shoulder(&mut app, |shoulder| {
+        vec![ClothAttachment::indices(shoulder, vec![0, 7])]
+    });
     let seen = std::sync::Arc::new(std::sync::Mutex::new(Vec::new()));
     let record = seen.clone();
     app.world_mut()
