@@ -74,6 +74,6 @@ pub mod prelude {
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;
     pub use crate::layout::shape::{ClothPins, ClothShape};
-    pub use crate::params::{Air, ClothParams, SelfCollision, Teleport, TeleportMode};
+    pub use crate::params::{Air, ClothParams, Inertia, SelfCollision, Teleport, TeleportMode};
     pub use crate::scene::ClothScene;
 }

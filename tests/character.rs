@@ -4,7 +4,7 @@
 //! `cargo test --test character`.
 
 use bevy::math::{Affine3A, Quat, Vec3};
-use bevy_cloth::params::Environment;
+use bevy_cloth::params::{Environment, Model};
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::BackStop;
 
@@ -1674,4 +1674,173 @@ fn bad_teleport_thresholds_are_refused() {
             other => panic!("{teleport:?}: {other:?}"),
         }
     }
+}
+
+/// The largest strain of a 12 × 16 cape (5 cm spacing, `params`) whose top row is
+/// attached to a body 1 m up, 20 cm in front of the cape, spinning about its upright
+/// axis: from rest up to `turns` turns a second over half a second, then held. Measured
+/// over the last second of two, with the step's failure if one failed.
+fn cape_spun(params: ClothParams, turns: f32) -> Result<f32, u32> {
+    let (w, h) = (12u32, 16u32);
+    let mut cloth = free_grid(w, h);
+    cloth.set_params(&params).unwrap();
+    let axis = Vec3::new(0.275, 0.0, 0.2);
+    let rest = cloth.positions().to_vec();
+    let (env, dt) = (Environment::default(), 1.0 / 60.0);
+    let omega = turns * std::f32::consts::TAU;
+    let mut largest = 0.0f32;
+    for frame in 1..=120u32 {
+        let t = frame as f32 * dt;
+        let angle = if t < 0.5 {
+            omega * t * t
+        } else {
+            omega * (t - 0.25)
+        };
+        let turn = Quat::from_rotation_y(angle);
+        for i in 0..w {
+            let x = axis + turn * (rest[i as usize] - axis) + Vec3::Y;
+            cloth.attach(i, x).unwrap();
+        }
+        if frame == 1 {
+            cloth.teleport_next_step(TeleportMode::Reset);
+        }
+        cloth.step(dt, &env);
+        if !cloth.is_stable() {
+            return Err(frame);
+        }
+        if frame > 60 {
+            largest = largest.max(cloth.strain().max);
+        }
+    }
+    Ok(largest)
+}
+
+/// Inertia scaling (NvCloth's local-space inertia): a character spinning at 4 turns a
+/// second keeps its cape within the material's strain (its 10% limit, the limiter run
+/// to convergence) + 1 point when the cape feels half its body's acceleration; in world
+/// space the spin stretches it past that, and fully local it hangs within the limit as a
+/// cape on a body standing still does. With the default four limiter sweeps half the
+/// spin's pull (5 g at the hem) is more than they hold, but still far less than the whole.
+#[test]
+fn a_spinning_character_keeps_its_cape_with_half_inertia() {
+    let limit = 0.1;
+    let material = ClothParams {
+        strain_limit: Some(limit),
+        strain_limit_tolerance: Some(0.002),
+        strain_limit_iterations: 64,
+        ..ClothParams::default()
+    };
+    let spun = |params: ClothParams, share: f32| {
+        let inertia = Inertia::scaled(share);
+        cape_spun(ClothParams { inertia, ..params }, 4.0).expect("holds")
+    };
+    let still = cape_spun(material, 0.0).expect("hangs");
+    let [world, half, local] = [1.0, 0.5, 0.0].map(|share| spun(material, share));
+    eprintln!(
+        "largest strain at 4 turns/s, limiter converged: world {world:.4}, half {half:.4}, \
+         local {local:.4}; standing still {still:.4}"
+    );
+    assert!(half <= limit + 0.01, "half inertia: {half}");
+    assert!(local <= limit + 0.005, "fully local: {local}");
+    assert!(world > limit + 0.01, "world space is flung out: {world}");
+    let default = ClothParams::default();
+    let [world, half, local] = [1.0, 0.5, 0.0].map(|share| spun(default, share));
+    eprintln!("four limiter sweeps: world {world:.4}, half {half:.4}, local {local:.4}");
+    assert!(local < half && half < world / 2.0);
+}
+
+/// Inertia's shares and caps are checked at the door, and the patch model (whose part
+/// lattice is a cloth of its own) refuses anything but world space.
+#[test]
+fn bad_inertia_is_refused() {
+    for (inertia, field) in [
+        (Inertia::scaled(1.5), "inertia.linear"),
+        (
+            Inertia {
+                angular: -0.1,
+                ..Inertia::WORLD
+            },
+            "inertia.angular",
+        ),
+        (
+            Inertia {
+                max_speed: f32::NAN,
+                ..Inertia::WORLD
+            },
+            "inertia.max_speed",
+        ),
+        (
+            Inertia {
+                max_turn_speed: -1.0,
+                ..Inertia::WORLD
+            },
+            "inertia.max_turn_speed",
+        ),
+    ] {
+        let params = ClothParams {
+            inertia,
+            ..ClothParams::default()
+        };
+        match params.validate() {
+            Err(ClothError::InvalidParameter { field: f, .. }) => assert_eq!(f, field),
+            other => panic!("{inertia:?}: {other:?}"),
+        }
+    }
+    let patches = ClothParams {
+        model: Model::Patches(Default::default()),
+        inertia: Inertia::scaled(0.5),
+        ..ClothParams::default()
+    };
+    assert!(matches!(
+        patches.validate(),
+        Err(ClothError::ModelLacks { .. })
+    ));
+}
+
+/// Inertia's speed cap: motion of the body faster than `max_speed` carries the cape
+/// rigidly instead of through the air. A cape on a body running at 20 m/s with a cap of
+/// 0 hangs exactly as on a body standing still (to float rounding), where without the
+/// cap the air streams it back.
+#[test]
+fn a_cape_past_its_speed_cap_is_carried_as_if_standing() {
+    let run = |params: ClothParams, speed: f32| {
+        let (w, h) = (8u32, 10u32);
+        let mut cloth = free_grid(w, h);
+        cloth.set_params(&params).unwrap();
+        let rest = cloth.positions().to_vec();
+        let (env, dt) = (Environment::default(), 1.0 / 60.0);
+        let mut shift = Vec3::ZERO;
+        for frame in 1..=60u32 {
+            shift = Vec3::new(speed * frame as f32 * dt, 1.0, 0.0);
+            for i in 0..w {
+                cloth.attach(i, rest[i as usize] + shift).unwrap();
+            }
+            if frame == 1 {
+                cloth.teleport_next_step(TeleportMode::Reset);
+            }
+            cloth.step(dt, &env);
+        }
+        let x: Vec<Vec3> = cloth.positions().iter().map(|&x| x - shift).collect();
+        x
+    };
+    let capped = ClothParams {
+        inertia: Inertia {
+            max_speed: 0.0,
+            ..Inertia::WORLD
+        },
+        ..ClothParams::default()
+    };
+    let standing = run(ClothParams::default(), 0.0);
+    let carried = run(capped, 20.0);
+    let streamed = run(ClothParams::default(), 20.0);
+    let apart = |a: &[Vec3], b: &[Vec3]| {
+        a.iter()
+            .zip(b)
+            .map(|(a, b)| a.distance(*b))
+            .fold(0.0, f32::max)
+    };
+    let (carried, streamed) = (apart(&carried, &standing), apart(&streamed, &standing));
+    eprintln!("from the standing cape: capped {carried:.2e} m, world {streamed:.3} m");
+    assert!(carried < 1e-4, "{carried} m");
+    assert!(streamed > 0.05, "{streamed} m");
 }

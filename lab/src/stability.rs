@@ -153,6 +153,7 @@ pub fn params(
         still_air: false,
         max_depenetration_speed: 1.0,
         teleport: Default::default(),
+        inertia: Default::default(),
     })
 }
 

@@ -76,3 +76,87 @@ impl Teleport {
         )
     }
 }
+
+/// How much of its drivers' motion a cloth feels as motion through the air (NvCloth's
+/// local-space inertia, Magica Cloth's inertia and its movement and rotation speed
+/// limits). The drivers (pins, attachments, motion-constraint targets) define a moving
+/// frame, their best rigid fit step to step; a cloth feels the share `linear` of that
+/// frame's change of velocity and the share `angular` of its change of turn: 1 is world
+/// space (a cape whipped by every turn of its character as in the air), 0 is fully local
+/// (the cloth carried along as if the frame stood still: a spinning character's cape
+/// hangs as at rest). Frame motion faster than `max_speed` or `max_turn_speed` is not
+/// felt at all: the excess carries the cloth rigidly.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Inertia {
+    /// The share of the frame's linear acceleration the cloth feels, 0 to 1.
+    pub linear: f32,
+    /// The share of the frame's angular acceleration (and of the centrifugal and
+    /// Coriolis pull of its turn) the cloth feels, 0 to 1.
+    pub angular: f32,
+    /// The fastest frame motion the cloth feels, m/s (`inf`: all of it); a body moving
+    /// faster carries the cloth by the rest.
+    pub max_speed: f32,
+    /// The fastest frame turn the cloth feels, degrees a second (`inf`: all of it).
+    pub max_turn_speed: f32,
+}
+
+impl Default for Inertia {
+    fn default() -> Self {
+        Self::WORLD
+    }
+}
+
+impl Inertia {
+    /// World space: the cloth feels all of its drivers' motion (the default).
+    pub const WORLD: Inertia = Inertia {
+        linear: 1.0,
+        angular: 1.0,
+        max_speed: f32::INFINITY,
+        max_turn_speed: f32::INFINITY,
+    };
+
+    /// Feels `share` of both the frame's linear and angular acceleration, with no caps.
+    pub fn scaled(share: f32) -> Self {
+        Inertia {
+            linear: share,
+            angular: share,
+            ..Self::WORLD
+        }
+    }
+
+    /// Whether the cloth feels all of its drivers' motion (nothing to do).
+    pub fn is_world(&self) -> bool {
+        self.linear == 1.0
+            && self.angular == 1.0
+            && self.max_speed == f32::INFINITY
+            && self.max_turn_speed == f32::INFINITY
+    }
+
+    /// Checks the shares and caps; the error names the field.
+    pub(crate) fn validate(&self) -> Result<(), ClothError> {
+        for (field, share) in [
+            ("inertia.linear", self.linear),
+            ("inertia.angular", self.angular),
+        ] {
+            check(
+                field,
+                share,
+                (0.0..=1.0).contains(&share),
+                "a share from 0 to 1",
+            )?;
+        }
+        for (field, cap) in [
+            ("inertia.max_speed", self.max_speed),
+            ("inertia.max_turn_speed", self.max_turn_speed),
+        ] {
+            check(
+                field,
+                cap.min(crate::limits::MAX_POSITION),
+                cap >= 0.0,
+                "a speed ≥ 0 (`inf`: no cap)",
+            )?;
+        }
+        Ok(())
+    }
+}

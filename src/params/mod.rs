@@ -19,7 +19,7 @@ mod self_collision;
 mod springs;
 
 pub use environment::{Air, Environment, Wind, WindAt, WindField};
-pub use following::{Teleport, TeleportMode};
+pub use following::{Inertia, Teleport, TeleportMode};
 pub use models::{
     GoalUpdate, Model, ModelKind, PatchParams, PatchTargets, RotationMethod, ShapeMatchingParams,
     XpbdParams, XpbdSolve,
@@ -143,6 +143,9 @@ pub struct ClothParams {
     /// any run does ([`Teleport`]): by default its shape and motion are carried with
     /// them.
     pub teleport: Teleport,
+    /// How much of its drivers' motion the cloth feels ([`Inertia`]): by default all of
+    /// it, as in world space.
+    pub inertia: Inertia,
 }
 
 impl Default for ClothParams {
@@ -163,6 +166,7 @@ impl Default for ClothParams {
             still_air: true,
             max_depenetration_speed: 1.0,
             teleport: Teleport::default(),
+            inertia: Inertia::default(),
         }
     }
 }
@@ -228,6 +232,7 @@ impl ClothParams {
             "a speed > 0 m/s (`inf`: no cap)",
         )?;
         self.teleport.validate()?;
+        self.inertia.validate()?;
         self.validate_stepping()?;
         if let Some(ratio) = self.tear_ratio {
             check("tear_ratio", ratio, ratio > 1.0, "a tear ratio > 1")?;
@@ -241,6 +246,13 @@ impl ClothParams {
                     feature: "fabric in physical units (`fabric`)",
                 });
             }
+        }
+        if !self.inertia.is_world() && matches!(self.model, Model::Patches(_)) {
+            // Its part lattice is a cloth of its own, which the blend does not reach.
+            return Err(ClothError::ModelLacks {
+                model: self.model.kind().name(),
+                feature: "inertia other than world space (`inertia`)",
+            });
         }
         match &self.model {
             Model::ShapeMatching(sm) => sm.validate()?,

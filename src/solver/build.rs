@@ -45,6 +45,7 @@ impl ClothSolver {
             checkpoint: Default::default(),
             teleport_request: None,
             drivers_motion: None,
+            felt: Default::default(),
             air: Vec::new(),
         };
         cloth.clock.substeps = 1;

@@ -95,6 +95,9 @@ pub struct ClothSolver {
     teleport_request: Option<crate::params::TeleportMode>,
     /// The drivers' rigid motion over the last step, while teleports are watched for.
     drivers_motion: Option<RigidMove>,
+    /// The part of it the cloth felt and where it started, while its
+    /// [`Inertia`](crate::params::Inertia) is scaled.
+    felt: drivers::inertia::Felt,
     /// Each particle's share of the air's force and its drag rate's numerator, this
     /// substep (`forces.rs`; kept for its storage).
     air: Vec<(Vec3, f32)>,

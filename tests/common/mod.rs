@@ -200,6 +200,7 @@ pub fn conservative(integrator: Integrator) -> ClothParams {
         still_air: false,
         max_depenetration_speed: 1.0,
         teleport: Default::default(),
+        inertia: Default::default(),
     }
 }
 

@@ -6,6 +6,7 @@
 //! skirt on a walking body), and off a sphere behind their targets (a back stop: Jolt's
 //! skinned constraints, NvCloth's separation constraints).
 
+pub(super) mod inertia;
 pub(super) mod interact;
 pub(super) mod teleport;
 

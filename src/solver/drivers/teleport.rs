@@ -150,29 +150,45 @@ impl ClothSolver {
         RigidMove::fit(pins.chain(motion))
     }
 
-    /// At a step's start: when the drivers jump past the thresholds of
-    /// [`Teleport`](crate::params::Teleport) (or a teleport was asked for), the cloth is
-    /// carried with them ([`ClothSolver::carry`]).
-    pub(in crate::solver) fn teleport_if_jumped(&mut self, dt: f32) {
+    /// At a step's start, the cloth follows its drivers: when they jump past the
+    /// thresholds of [`Teleport`](crate::params::Teleport) (or a teleport was asked for),
+    /// it is carried with them ([`ClothSolver::carry`]); otherwise it feels the share of
+    /// their motion its [`Inertia`](crate::params::Inertia) sets.
+    pub(in crate::solver) fn follow_drivers(&mut self, dt: f32) {
         let request = self.teleport_request.take();
-        let settings = self.params.teleport;
+        let (settings, inertia) = (self.params.teleport, self.params.inertia);
         let last = self.drivers_motion.take();
-        if request.is_none() && settings.mode == TeleportMode::Off {
-            return;
+        let watch = settings.mode != TeleportMode::Off;
+        if inertia.is_world() {
+            self.felt.clear();
+            if request.is_none() && !watch {
+                return;
+            }
         }
         let Some(jump) = self.drivers_move() else {
             return;
         };
-        let past = jump.distance() > settings.distance
-            || jump.angle() > settings.angle_degrees.to_radians();
-        let Some(mode) = request.or(past.then_some(settings.mode)) else {
+        let past = watch
+            && (jump.distance() > settings.distance
+                || jump.angle() > settings.angle_degrees.to_radians());
+        if let Some(mode) = request.or(past.then_some(settings.mode)) {
+            self.drivers_motion = last;
+            self.felt.clear();
+            self.teleport(jump, last, mode, dt);
+        } else {
             self.drivers_motion = Some(jump);
-            return;
-        };
+            if !inertia.is_world() {
+                self.feel(jump, dt);
+            }
+        }
+    }
+
+    /// Carries the cloth by the jump `jump` (beyond `last`, the drivers' ordinary step)
+    /// as `mode` says, and reports it.
+    fn teleport(&mut self, jump: RigidMove, last: Option<RigidMove>, mode: TeleportMode, dt: f32) {
         // Carried by the jump beyond the drivers' ordinary step (the last one's motion
         // continued), which the step then sweeps them through as it would have anyway.
         let by = last.map_or(jump, |last| jump.beyond(&last));
-        self.drivers_motion = last;
         self.carry(by, mode);
         if let (TeleportMode::Reset, Some(last)) = (mode, last) {
             // At rest on the bodies: each particle moving as their ordinary step (the last
@@ -216,27 +232,9 @@ impl ClothSolver {
         if mode == TeleportMode::Off {
             return;
         }
-        let p = &mut self.particles;
         let keep = mode == TeleportMode::Keep;
-        for i in 0..p.len() {
-            p.position[i] = by.apply(p.position[i]);
-            if keep {
-                p.previous[i] = by.apply(p.previous[i]);
-                p.velocity[i] = by.rotation * p.velocity[i];
-                p.residue[i] = by.rotation * p.residue[i];
-            } else {
-                p.velocity[i] = Vec3::ZERO;
-                p.residue[i] = Vec3::ZERO;
-            }
-        }
-        // The targets (and their normals) begin the step carried with the cloth.
-        let m = &mut self.drivers.motion;
-        for x in &mut m.to {
-            *x = by.apply(*x);
-        }
-        for n in &mut m.normal_to {
-            *n = by.rotation * *n;
-        }
+        self.move_rigidly(by, keep);
+        let (p, m) = (&mut self.particles, &self.drivers.motion);
         if !keep {
             // On the pose the step starts from (the next one before any step has run).
             let pose = if m.to.len() == p.len() {
@@ -254,7 +252,7 @@ impl ClothSolver {
             p.previous.clone_from(&p.position);
         }
         match &mut self.model {
-            ModelState::ShapeMatching(s) if keep => s.turn(by.rotation),
+            ModelState::ShapeMatching(_) if keep => {}
             ModelState::ShapeMatching(s) => s.reset(),
             // The part lattice is rebuilt where the particles now are.
             ModelState::Patches(_) => self.model = ModelState::None,
@@ -263,5 +261,34 @@ impl ClothSolver {
         self.switch = None;
         self.save_checkpoint();
         self.disturbed = true;
+    }
+
+    /// Moves every particle (the pinned ones too) by `by`, with its previous position
+    /// and velocity turned with it when `keep` (at rest otherwise), the drivers' last
+    /// targets with them (the step sweeps them from there to where they are asked to be)
+    /// and shape matching's warm-start rotations.
+    pub(in crate::solver) fn move_rigidly(&mut self, by: RigidMove, keep: bool) {
+        let p = &mut self.particles;
+        for i in 0..p.len() {
+            p.position[i] = by.apply(p.position[i]);
+            if keep {
+                p.previous[i] = by.apply(p.previous[i]);
+                p.velocity[i] = by.rotation * p.velocity[i];
+                p.residue[i] = by.rotation * p.residue[i];
+            } else {
+                p.velocity[i] = Vec3::ZERO;
+                p.residue[i] = Vec3::ZERO;
+            }
+        }
+        let m = &mut self.drivers.motion;
+        for x in &mut m.to {
+            *x = by.apply(*x);
+        }
+        for n in &mut m.normal_to {
+            *n = by.rotation * *n;
+        }
+        if let ModelState::ShapeMatching(s) = &mut self.model {
+            s.turn(by.rotation);
+        }
     }
 }

@@ -226,7 +226,7 @@ impl ClothSolver {
             self.clock.substeps = 0;
             return 0;
         }
-        self.teleport_if_jumped(dt);
+        self.follow_drivers(dt);
         self.stepping = self.params.model;
         let model = self.stepping;
         let steps = model_steps(&model);
