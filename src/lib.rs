@@ -69,11 +69,13 @@ pub mod prelude {
         ClothColliderInvalid, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
         ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
         ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
-        ClothTeleport, ClothTeleported, ClothTorn, ClothWake,
+        ClothTeleport, ClothTeleported, ClothTorn, ClothWake, ClothWindZone,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;
     pub use crate::layout::shape::{ClothPins, ClothShape};
-    pub use crate::params::{Air, ClothParams, Inertia, SelfCollision, Teleport, TeleportMode};
+    pub use crate::params::{
+        Air, ClothParams, Inertia, SelfCollision, Teleport, TeleportMode, Turbulence, ZoneShape,
+    };
     pub use crate::scene::ClothScene;
 }

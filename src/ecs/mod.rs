@@ -16,6 +16,7 @@ pub(crate) mod skin;
 pub(crate) mod sleep;
 pub(crate) mod stats;
 pub(crate) mod step;
+pub(crate) mod wind;
 
 pub use attach::{AttachParticles, ClothAttachPlugin, ClothAttachment, ClothAttachments};
 pub use build::ClothGarmentPlugin;
@@ -39,3 +40,4 @@ pub use skin::{
 pub use sleep::{ClothSleep, ClothSleepPlugin, ClothWake};
 pub use stats::{ClothStats, StatSample};
 pub use step::{ClothSubstep, ClothSubstepPlan, ClothSubstepSystems};
+pub use wind::{ClothWindPlugin, ClothWindZone};

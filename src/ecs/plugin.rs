@@ -3,7 +3,7 @@
 //! the core here (the cloth, its building and stepping, the events), garments as assets
 //! (`build.rs`), colliders (`colliders.rs`), attachments (`attach.rs`), motion
 //! constraints from skinned meshes (`skin.rs`), sleeping (`sleep.rs`), level of detail
-//! (`lod.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
+//! (`lod.rs`), wind zones (`wind.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
 //! bodies (`avian.rs`, added by the game). A game leaves a feature out with
 //! `ClothPlugin::default().build().disable::<ClothLodPlugin>()`.
 //!
@@ -11,7 +11,8 @@
 //! ```text
 //! ClothSystems::Prepare      in the order of ClothPrepareSystems: level of detail, build /
 //!                            rebuild cloths and apply edited parameters, attachments,
-//!                            skinned bodies, colliders, waking, begin each cloth's step
+//!                            skinned bodies, colliders and wind zones, waking, begin
+//!                            each cloth's step
 //! ClothSystems::Substeps     run the ClothSubstep schedule N times, which holds
 //!     ClothSubstepSystems::AccumulateForces → Integrate → FitTargets → Constrain
 //! ClothSystems::Finish       end each step: tearing, statistics, events; then sleep
@@ -50,6 +51,7 @@ use crate::ecs::step::{
     ClothSubstepPlan, begin_steps, finish_steps, recover_cloths, request_teleports, run_substeps,
     substep_schedule,
 };
+use crate::ecs::wind::ClothWindPlugin;
 use crate::layout::shape::{ClothPins, ClothShape};
 use crate::params::{
     Air, ClothParams, Environment, GoalUpdate, Integrator, Model, PatchParams, PatchTargets,
@@ -86,7 +88,8 @@ pub enum ClothPrepareSystems {
     Attach,
     /// Skinned bodies move their cloths' motion constraints ([`ClothSkinPlugin`]).
     Skin,
-    /// The colliders are placed and given to the cloths ([`ClothCollidersPlugin`]).
+    /// The colliders are placed and given to the cloths ([`ClothCollidersPlugin`]), and
+    /// the wind zones that reach each cloth ([`ClothWindPlugin`]).
     Colliders,
     /// Sleeping cloths that something may move wake ([`ClothSleepPlugin`]).
     Wake,
@@ -164,6 +167,7 @@ impl PluginGroup for ClothPlugin {
             .add(ClothSkinPlugin)
             .add(ClothCollidersPlugin)
             .add(ClothSleepPlugin)
+            .add(ClothWindPlugin)
             .add(ClothMeshPlugin)
     }
 }

@@ -17,6 +17,7 @@ mod following;
 mod models;
 mod self_collision;
 mod springs;
+mod wind_zone;
 
 pub use environment::{Air, Environment, Wind, WindAt, WindField};
 pub use following::{Inertia, Teleport, TeleportMode};
@@ -26,6 +27,7 @@ pub use models::{
 };
 pub use self_collision::SelfCollision;
 pub use springs::{SpringFamily, SpringParams};
+pub use wind_zone::{Turbulence, WindZone, ZoneAt, ZoneShape};
 
 /// Serde for `Vec3` as a `(x, y, z)` tuple, so scene files can hold vectors without
 /// turning on serde for the whole of Bevy.

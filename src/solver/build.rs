@@ -46,6 +46,7 @@ impl ClothSolver {
             teleport_request: None,
             drivers_motion: None,
             felt: Default::default(),
+            wind: Default::default(),
             air: Vec::new(),
         };
         cloth.clock.substeps = 1;

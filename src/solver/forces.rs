@@ -6,7 +6,18 @@ use bevy::math::Vec3;
 use super::parallel;
 use super::state::ParticleChunk;
 use super::{ClothSolver, Particles, SpringKind, Springs};
-use crate::params::{Air, Environment};
+use crate::error::ClothError;
+use crate::params::{Air, Environment, WindZone, ZoneAt};
+
+/// The wind zones blowing on a cloth ([`ClothSolver::set_wind_zones`]).
+#[derive(Clone, Debug, Default)]
+pub(super) struct Blowing {
+    zones: Vec<WindZone>,
+    /// The zones' clock less the cloth's, s.
+    time_offset: f32,
+    /// The zones at this substep's time (kept for its storage).
+    now: Vec<ZoneAt>,
+}
 
 impl ClothSolver {
     /// Sets every particle's force to gravity (Maslova eq. 1.6) and wind. The linear drag
@@ -43,12 +54,44 @@ impl ClothSolver {
         };
         parallel::for_each(n, self.particles.chunks(), kernel);
         let still = self.params.fabric.is_some() && self.params.still_air;
+        // Wind zones blow through the air model: still air's coefficients when the
+        // environment has no air of its own.
+        let zones = !self.wind.zones.is_empty();
         match env.air {
             _ if held => {}
             Some(air) => self.air_forces(&air),
-            None if still => self.air_forces(&Air::default()),
+            None if still || zones => self.air_forces(&Air::default()),
             None => {}
         }
+    }
+
+    /// Takes the wind zones of `zones` that reach this cloth (its particles' bounding
+    /// sphere, as it is now), their time `time` s (the world's clock, so that every cloth
+    /// in a zone gusts together): they blow on it from its next substep, through the air
+    /// model ([`Air`]; still air's coefficients when the environment has none), until
+    /// they are set again. Returns how many reach it; a zone that fails its check
+    /// ([`WindZone::validate`]) is refused, and none are taken.
+    pub fn set_wind_zones(&mut self, zones: &[WindZone], time: f32) -> Result<usize, ClothError> {
+        self.wind.zones.clear();
+        for zone in zones {
+            zone.validate()?;
+        }
+        let (centre, radius) = self.bounding_sphere();
+        let wind = &mut self.wind;
+        wind.zones
+            .extend(zones.iter().filter(|z| z.reaches(centre, radius)).copied());
+        wind.time_offset = time - self.clock.time;
+        // Moving air moves a resting cloth: it wakes.
+        if wind.zones.iter().any(|z| z.velocity != Vec3::ZERO) {
+            self.disturbed = true;
+        }
+        Ok(wind.zones.len())
+    }
+
+    /// The wind zones blowing on this cloth (those [`set_wind_zones`](Self::set_wind_zones)
+    /// found reach it).
+    pub fn wind_zones(&self) -> &[WindZone] {
+        &self.wind.zones
     }
 
     /// Adds the air's force on every shown triangle, a third to each corner, each
@@ -62,6 +105,10 @@ impl ClothSolver {
         scratch.resize(p.len(), (Vec3::ZERO, 0.0));
         let half_rho = 0.5 * air.density;
         let flow = air.at_time(time);
+        let zones = &mut self.wind.now;
+        zones.clear();
+        let zone_time = time + self.wind.time_offset;
+        zones.extend(self.wind.zones.iter().map(|z| z.at_time(zone_time)));
         for (t, corners) in s.triangles.iter().enumerate() {
             if !s.triangle_visible[t] {
                 continue;
@@ -76,7 +123,8 @@ impl ClothSolver {
             let (area, normal) = (0.5 * twice_area, cross / twice_area);
             let centre = (xa + xb + xc) / 3.0;
             let moving = (p.velocity[a] + p.velocity[b] + p.velocity[c]) / 3.0;
-            let w = flow.vector_at(centre) - moving;
+            let blowing = zones.iter().map(|z| z.velocity_at(centre)).sum::<Vec3>();
+            let w = flow.vector_at(centre) + blowing - moving;
             let wn = w.dot(normal);
             let across = w - wn * normal;
             let drag = half_rho * air.drag * area * wn * wn.abs() * normal;

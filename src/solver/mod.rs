@@ -40,7 +40,7 @@ pub use drivers::BackStop;
 pub use drivers::interact::Grab;
 pub use drivers::teleport::{RigidMove, Teleported};
 pub use layout::{Layout, MAX_PARTICLES};
-pub(crate) use many::{begin_cloths, run_cloths};
+pub use many::{begin_cloths, run_cloths};
 pub use many::{begin_together, substep_together};
 pub use models::{patches, shape_matching};
 pub(crate) use parallel::for_each_indexed;
@@ -101,6 +101,8 @@ pub struct ClothSolver {
     /// Each particle's share of the air's force and its drag rate's numerator, this
     /// substep (`forces.rs`; kept for its storage).
     air: Vec<(Vec3, f32)>,
+    /// The wind zones that reach it.
+    wind: forces::Blowing,
 }
 
 /// The active model's own state: none for mass-spring (or before the first step

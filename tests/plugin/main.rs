@@ -9,3 +9,4 @@ mod colliders;
 mod drawing;
 mod keys;
 mod stepping;
+mod wind;

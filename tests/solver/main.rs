@@ -7,3 +7,4 @@ mod analytic;
 mod kernels;
 mod stability;
 mod structure;
+mod wind;

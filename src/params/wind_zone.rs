@@ -1,0 +1,356 @@
+//! Wind zones: regions of moving air (everywhere, a sphere or a box, fading at their
+//! edge), with gusts in time and turbulence in space from seeded noise, whose velocities
+//! add to the air's and act on a cloth's triangles through the air model ([`Air`]).
+//! Unity's and Godot's wind zones, and the area forces of Jolt's soft bodies, in that
+//! sense; the noise is value noise (Perlin 1985's lattice with random values in place of
+//! gradients), hashed from the lattice point and the seed, so it needs no tables and
+//! gives the same bits everywhere.
+//!
+//! [`Air`]: super::Air
+
+use bevy::math::{Quat, Vec3};
+use bevy::reflect::Reflect;
+
+use super::check;
+use crate::error::ClothError;
+
+/// Where a wind zone blows.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+pub enum ZoneShape {
+    /// Everywhere, at full strength.
+    Global,
+    /// Within `radius` m of its centre.
+    Sphere {
+        /// Its radius, m.
+        radius: f32,
+    },
+    /// Within a box of these half extents about its centre, turned with its rotation.
+    Box {
+        /// Half its size along each of its own axes, m.
+        half_extents: Vec3,
+    },
+}
+
+/// Gusts and turbulence of a wind zone, from seeded noise.
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+pub struct Turbulence {
+    /// How much the strength swells and drops in time, as a share of it (0: steady; 0.5:
+    /// between half and one and a half times).
+    pub gust: f32,
+    /// The time a gust takes, s (the spacing of the noise's lattice in time).
+    pub gust_period: f32,
+    /// How large the velocity's random part is, as a share of the zone's speed, in each
+    /// direction.
+    pub noise: f32,
+    /// The size of a whirl of it, m (the spacing of the noise's lattice in space); the
+    /// pattern drifts with the wind.
+    pub scale: f32,
+    /// The seed: two zones with different seeds gust and whirl differently.
+    pub seed: u32,
+}
+
+impl Default for Turbulence {
+    fn default() -> Self {
+        Turbulence {
+            gust: 0.0,
+            gust_period: 2.0,
+            noise: 0.0,
+            scale: 1.0,
+            seed: 0,
+        }
+    }
+}
+
+/// A region of moving air, placed in the world: its velocity, at full strength inside
+/// and fading over the outer `falloff` share of its size to nothing at its edge, swelled
+/// by gusts and stirred by turbulence. Cloths take the zones that reach them
+/// (`ClothSolver::set_wind_zones`; the plugin's `ClothWindZone`).
+#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+pub struct WindZone {
+    /// Where it blows.
+    pub shape: ZoneShape,
+    /// Its centre, m.
+    pub centre: Vec3,
+    /// Its turn (a box's axes).
+    pub rotation: Quat,
+    /// The air's velocity at full strength, m/s.
+    pub velocity: Vec3,
+    /// The outer share of its size (of the radius, or of each half extent) over which it
+    /// fades to nothing, 0 to 1 (0: a hard edge). A global zone does not fade.
+    pub falloff: f32,
+    /// Gusts and turbulence.
+    pub turbulence: Turbulence,
+}
+
+impl Default for WindZone {
+    fn default() -> Self {
+        WindZone {
+            shape: ZoneShape::Global,
+            centre: Vec3::ZERO,
+            rotation: Quat::IDENTITY,
+            velocity: Vec3::ZERO,
+            falloff: 0.0,
+            turbulence: Turbulence::default(),
+        }
+    }
+}
+
+impl WindZone {
+    /// Checks the shape, velocity and turbulence; the error names the field.
+    pub fn validate(&self) -> Result<(), ClothError> {
+        let finite = self.centre.is_finite() && self.rotation.is_finite();
+        check(
+            "wind_zone.centre",
+            0.0,
+            finite,
+            "a finite centre and rotation",
+        )?;
+        let speed = self.velocity.length();
+        check(
+            "wind_zone.velocity",
+            speed,
+            speed <= 1e3,
+            "a finite velocity of at most 1,000 m/s",
+        )?;
+        match self.shape {
+            ZoneShape::Global => {}
+            ZoneShape::Sphere { radius } => {
+                check("wind_zone.radius", radius, radius > 0.0, "a radius > 0 m")?
+            }
+            ZoneShape::Box { half_extents: e } => check(
+                "wind_zone.half_extents",
+                e.min_element(),
+                e.is_finite() && e.min_element() > 0.0,
+                "half extents > 0 m",
+            )?,
+        }
+        let f = self.falloff;
+        check(
+            "wind_zone.falloff",
+            f,
+            (0.0..=1.0).contains(&f),
+            "a share from 0 to 1",
+        )?;
+        let t = &self.turbulence;
+        for (field, value, ok, expected) in [
+            (
+                "wind_zone.turbulence.gust",
+                t.gust,
+                (0.0..=1.0).contains(&t.gust),
+                "a share from 0 to 1",
+            ),
+            (
+                "wind_zone.turbulence.gust_period",
+                t.gust_period,
+                t.gust_period > 0.0,
+                "a time > 0 s",
+            ),
+            (
+                "wind_zone.turbulence.noise",
+                t.noise,
+                (0.0..=10.0).contains(&t.noise),
+                "a share from 0 to 10",
+            ),
+            (
+                "wind_zone.turbulence.scale",
+                t.scale,
+                t.scale > 0.0,
+                "a size > 0 m",
+            ),
+        ] {
+            check(field, value, ok, expected)?;
+        }
+        Ok(())
+    }
+
+    /// Whether it can reach anything within `radius` of `centre`.
+    pub fn reaches(&self, centre: Vec3, radius: f32) -> bool {
+        let reach = match self.shape {
+            ZoneShape::Global => return true,
+            ZoneShape::Sphere { radius } => radius,
+            ZoneShape::Box { half_extents } => half_extents.length(),
+        };
+        self.centre.distance(centre) <= reach + radius
+    }
+
+    /// How strongly it blows at `x`, 0 to 1: 1 inside, fading (smoothly) over the outer
+    /// `falloff` share of its size, 0 outside.
+    pub fn weight_at(&self, x: Vec3) -> f32 {
+        let depth = match self.shape {
+            ZoneShape::Global => return 1.0,
+            ZoneShape::Sphere { radius } => self.centre.distance(x) / radius,
+            ZoneShape::Box { half_extents } => {
+                let local = self.rotation.inverse() * (x - self.centre);
+                (local.abs() / half_extents).max_element()
+            }
+        };
+        if depth >= 1.0 {
+            0.0
+        } else if self.falloff <= 0.0 {
+            1.0
+        } else {
+            let s = ((1.0 - depth) / self.falloff).min(1.0);
+            s * s * (3.0 - 2.0 * s)
+        }
+    }
+
+    /// The zone at time `t` (s), what does not depend on position worked out once.
+    pub fn at_time(&self, t: f32) -> ZoneAt {
+        let turbulence = self.turbulence;
+        let gust = 1.0 + turbulence.gust * noise1(turbulence.seed, t / turbulence.gust_period);
+        ZoneAt {
+            zone: *self,
+            gusting: self.velocity * gust,
+            drift: self.velocity * t,
+            stir: turbulence.noise * self.velocity.length() * gust,
+        }
+    }
+
+    /// The air's velocity it adds at `x` at time `t`, m/s.
+    pub fn velocity_at(&self, x: Vec3, t: f32) -> Vec3 {
+        self.at_time(t).velocity_at(x)
+    }
+}
+
+/// A [`WindZone`] at one moment ([`WindZone::at_time`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ZoneAt {
+    zone: WindZone,
+    /// The velocity swelled by this moment's gust.
+    gusting: Vec3,
+    /// How far the turbulence has drifted with the wind.
+    drift: Vec3,
+    /// The turbulence's amplitude now, m/s.
+    stir: f32,
+}
+
+impl ZoneAt {
+    /// The air's velocity the zone adds at `x`, m/s.
+    #[inline]
+    pub fn velocity_at(&self, x: Vec3) -> Vec3 {
+        let weight = self.zone.weight_at(x);
+        if weight == 0.0 {
+            return Vec3::ZERO;
+        }
+        let mut v = self.gusting;
+        if self.stir > 0.0 {
+            let t = &self.zone.turbulence;
+            let q = (x - self.drift) / t.scale;
+            let seed = t.seed.wrapping_mul(3);
+            let whirl = Vec3::new(
+                noise3(seed.wrapping_add(1), q),
+                noise3(seed.wrapping_add(2), q),
+                noise3(seed.wrapping_add(3), q),
+            );
+            v += self.stir * whirl;
+        }
+        weight * v
+    }
+}
+
+/// A hash of a lattice point and a seed to a value in [−1, 1].
+#[inline]
+fn lattice(seed: u32, x: i32, y: i32, z: i32) -> f32 {
+    let mut h = seed.wrapping_mul(0x9e37_79b9)
+        ^ (x as u32).wrapping_mul(0x8da6_b343)
+        ^ (y as u32).wrapping_mul(0xd816_3841)
+        ^ (z as u32).wrapping_mul(0xcb1a_b31f);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2c1b_3c6d);
+    h ^= h >> 12;
+    h = h.wrapping_mul(0x297a_2d39);
+    h ^= h >> 15;
+    (h >> 8) as f32 / (1u32 << 23) as f32 - 1.0
+}
+
+/// The smooth fade `3s² − 2s³` between lattice points.
+#[inline]
+fn fade(s: f32) -> f32 {
+    s * s * (3.0 - 2.0 * s)
+}
+
+/// Value noise in time, in [−1, 1], smooth, 0 mean.
+fn noise1(seed: u32, t: f32) -> f32 {
+    let (i, s) = (t.floor(), fade(t - t.floor()));
+    let i = i as i32;
+    let (a, b) = (lattice(seed, i, 0, 0), lattice(seed, i + 1, 0, 0));
+    a + (b - a) * s
+}
+
+/// Value noise in space, in [−1, 1], smooth, 0 mean: the lattice's values trilinearly
+/// blended with [`fade`].
+#[inline]
+fn noise3(seed: u32, p: Vec3) -> f32 {
+    let cell = p.floor();
+    let (i, j, k) = (cell.x as i32, cell.y as i32, cell.z as i32);
+    let f = p - cell;
+    let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+    let mut along_y = [0.0f32; 2];
+    for (dz, out) in along_y.iter_mut().enumerate() {
+        let k = k + dz as i32;
+        let row = |j| {
+            let a = lattice(seed, i, j, k);
+            a + (lattice(seed, i + 1, j, k) - a) * u
+        };
+        let (a, b) = (row(j), row(j + 1));
+        *out = a + (b - a) * v;
+    }
+    along_y[0] + (along_y[1] - along_y[0]) * w
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The noise stays in [−1, 1], is continuous across lattice cells, averages about
+    /// 0, and depends on its seed.
+    #[test]
+    fn noise_is_bounded_smooth_and_seeded() {
+        let (mut sum, mut n) = (0.0f64, 0);
+        for k in 0..4000 {
+            let p = Vec3::new(k as f32 * 0.137, k as f32 * 0.071, -(k as f32) * 0.053);
+            let v = noise3(7, p);
+            assert!((-1.0..=1.0).contains(&v), "{v}");
+            sum += v as f64;
+            n += 1;
+            let near = noise3(7, p + Vec3::splat(1e-4));
+            assert!((v - near).abs() < 1e-2, "jump {v} to {near} at {p}");
+        }
+        assert!((sum / n as f64).abs() < 0.1, "mean {}", sum / n as f64);
+        let p = Vec3::new(0.3, 1.7, 2.2);
+        assert_ne!(noise3(1, p), noise3(2, p));
+        assert_eq!(noise3(1, p), noise3(1, p));
+        assert!((noise1(3, 4.999_9) - noise1(3, 5.0)).abs() < 1e-3);
+    }
+
+    /// A sphere blows at full strength inside `1 − falloff` of its radius, fades to
+    /// nothing at its edge and not beyond; a turned box by its own axes.
+    #[test]
+    fn a_zone_blows_inside_and_fades_at_its_edge() {
+        let sphere = WindZone {
+            shape: ZoneShape::Sphere { radius: 2.0 },
+            centre: Vec3::new(1.0, 0.0, 0.0),
+            velocity: Vec3::X * 5.0,
+            falloff: 0.5,
+            ..WindZone::default()
+        };
+        assert_eq!(
+            sphere.velocity_at(Vec3::new(1.5, 0.0, 0.0), 0.0),
+            Vec3::X * 5.0
+        );
+        let fading = sphere.weight_at(Vec3::new(2.5, 0.0, 0.0));
+        assert!(fading > 0.0 && fading < 1.0, "{fading}");
+        assert_eq!(sphere.weight_at(Vec3::new(3.0, 0.0, 0.0)), 0.0);
+        assert_eq!(sphere.weight_at(Vec3::new(4.0, 0.0, 0.0)), 0.0);
+        let turned = WindZone {
+            shape: ZoneShape::Box {
+                half_extents: Vec3::new(3.0, 1.0, 1.0),
+            },
+            rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            ..sphere
+        };
+        // Its long axis now runs along z.
+        assert!(turned.weight_at(Vec3::new(1.0, 0.0, 2.5)) > 0.0);
+        assert_eq!(turned.weight_at(Vec3::new(3.5, 0.0, 0.0)), 0.0);
+    }
+}
