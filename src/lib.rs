@@ -68,8 +68,8 @@ pub mod prelude {
         ClothBecameInvalid, ClothBuilt, ClothCollider, ClothColliderBecameInvalid,
         ClothColliderInvalid, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
         ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
-        ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
-        ClothTeleport, ClothTeleported, ClothTorn, ClothWake, ClothWindZone,
+        ClothProxy, ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems,
+        ClothSystems, ClothTeleport, ClothTeleported, ClothTorn, ClothWake, ClothWindZone,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;

@@ -6,6 +6,7 @@ use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
 use bevy::prelude::{Assets, Fixed, Mesh3d, Query, Res, ResMut, Time, Visibility};
 
 use crate::ecs::cloth::{ClothInterpolation, ClothSimulation};
+use crate::ecs::proxy::{ProxyBound, write_proxy};
 
 use crate::error::ClothError;
 use crate::solver;
@@ -164,7 +165,9 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
     })
 }
 
-/// Writes each stepped cloth's positions and normals into its mesh. A cloth whose own
+/// Writes each stepped cloth's positions and normals into its mesh (a proxied cloth's
+/// into its [`ClothProxy`](crate::ClothProxy)'s, each render vertex placed on its
+/// triangle). A cloth whose own
 /// `Visibility` is `Hidden` is not written; it keeps its new state pending and is
 /// written when shown. (Not for a hidden parent, whose effect is known only where
 /// Bevy's visibility systems run; and not for frustum culling: Bevy takes a mesh's
@@ -178,11 +181,16 @@ fn write_meshes(
     mut meshes: ResMut<Assets<Mesh>>,
     interpolation: Option<Res<ClothInterpolation>>,
     fixed: Res<Time<Fixed>>,
-    mut cloths: Query<(&mut ClothSimulation, &Mesh3d, Option<&Visibility>)>,
+    mut cloths: Query<(
+        &mut ClothSimulation,
+        &Mesh3d,
+        Option<&Visibility>,
+        Option<&mut ProxyBound>,
+    )>,
 ) {
     let blend = interpolation.is_some_and(|i| i.0);
     let t = fixed.overstep_fraction().clamp(0.0, 1.0);
-    for (mut sim, mesh3d, visibility) in &mut cloths {
+    for (mut sim, mesh3d, visibility, proxy) in &mut cloths {
         let blending = blend && sim.blending;
         if !(sim.mesh_dirty || blending) || visibility == Some(&Visibility::Hidden) {
             continue;
@@ -196,7 +204,11 @@ fn write_meshes(
             sim.solver.normals_into(&mut sim.normals);
         }
         let from = blending.then_some((sim.previous.as_slice(), t));
-        write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from);
+        match proxy {
+            // A proxy's triangles are its own: torn faces stay drawn.
+            Some(mut bound) => write_proxy(&mut mesh, &sim.solver, &mut bound, &sim.normals, from),
+            None => write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from),
+        }
         sim.mesh_dirty = false;
     }
 }

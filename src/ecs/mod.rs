@@ -12,6 +12,7 @@ pub(crate) mod events;
 pub(crate) mod lod;
 pub(crate) mod mesh;
 pub(crate) mod plugin;
+pub(crate) mod proxy;
 pub(crate) mod skin;
 pub(crate) mod sleep;
 pub(crate) mod stats;
@@ -34,6 +35,7 @@ pub use events::{
 pub use lod::{ClothLod, ClothLodPlugin};
 pub use mesh::ClothMeshPlugin;
 pub use plugin::{ClothCorePlugin, ClothPlugin, ClothPrepareSystems, ClothSystems};
+pub use proxy::{ClothProxy, ClothProxyPlugin};
 pub use skin::{
     ATTRIBUTE_BACK_STOP, ATTRIBUTE_MAX_DISTANCE, ClothBackStop, ClothMaxDistance, ClothSkinPlugin,
 };

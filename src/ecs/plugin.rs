@@ -3,7 +3,7 @@
 //! the core here (the cloth, its building and stepping, the events), garments as assets
 //! (`build.rs`), colliders (`colliders.rs`), attachments (`attach.rs`), motion
 //! constraints from skinned meshes (`skin.rs`), sleeping (`sleep.rs`), level of detail
-//! (`lod.rs`), wind zones (`wind.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
+//! (`lod.rs`), wind zones (`wind.rs`), proxy meshes (`proxy.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
 //! bodies (`avian.rs`, added by the game). A game leaves a feature out with
 //! `ClothPlugin::default().build().disable::<ClothLodPlugin>()`.
 //!
@@ -44,6 +44,7 @@ use crate::ecs::events::{
 };
 use crate::ecs::lod::ClothLodPlugin;
 use crate::ecs::mesh::ClothMeshPlugin;
+use crate::ecs::proxy::ClothProxyPlugin;
 use crate::ecs::skin::ClothSkinPlugin;
 use crate::ecs::sleep::ClothSleepPlugin;
 use crate::ecs::stats::{ClothStats, StatSample};
@@ -169,6 +170,7 @@ impl PluginGroup for ClothPlugin {
             .add(ClothSleepPlugin)
             .add(ClothWindPlugin)
             .add(ClothMeshPlugin)
+            .add(ClothProxyPlugin)
     }
 }
 

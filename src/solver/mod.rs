@@ -21,6 +21,7 @@ mod layout;
 mod many;
 mod models;
 mod parallel;
+mod proxy;
 mod queries;
 mod state;
 mod steps;
@@ -45,6 +46,7 @@ pub use many::{begin_together, substep_together};
 pub use models::{patches, shape_matching};
 pub(crate) use parallel::for_each_indexed;
 pub use parallel::{set_parallel, threads};
+pub use proxy::ProxyBinding;
 // Used by the lab through `crate::lab`: hidden from the docs.
 #[doc(hidden)]
 pub use parallel::pool as task_pool;

@@ -61,6 +61,12 @@ impl ClothSolver {
         &self.structure.springs
     }
 
+    /// Each particle's rest position in the cloth's own frame (as built, before
+    /// [`frame`](Self::frame) places it).
+    pub fn rest_positions(&self) -> &[Vec3] {
+        &self.structure.local_rest
+    }
+
     /// All triangles, hidden ones included.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.structure.triangles

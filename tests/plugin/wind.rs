@@ -33,7 +33,13 @@ fn a_wind_zone_entity_blows_on_the_cloths_it_reaches() {
         app.update();
         calm.update();
     }
-    let sim = |app: &App, e| app.world().get::<ClothSimulation>(e).unwrap().solver.clone();
+    let sim = |app: &App, e| {
+        app.world()
+            .get::<ClothSimulation>(e)
+            .unwrap()
+            .solver
+            .clone()
+    };
     let blown = sim(&app, near);
     let downwind = blown.positions().iter().map(|x| x.z).fold(0.0, f32::max);
     eprintln!("the banner in the zone: {downwind:.3} m downwind");

@@ -64,7 +64,10 @@ fn blown(zones: &[WindZone], steps: u32) -> Vec<Vec<Vec3>> {
 }
 
 fn farthest(a: &[Vec3], b: &[Vec3]) -> f32 {
-    a.iter().zip(b).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max)
+    a.iter()
+        .zip(b)
+        .map(|(a, b)| a.distance(*b))
+        .fold(0.0, f32::max)
 }
 
 /// The banner in the zone streams out along the wind; the one 10 m away is not reached
@@ -87,11 +90,21 @@ fn a_banner_in_a_wind_zone_moves_and_one_outside_does_not() {
          outside: {:e} m",
         farthest(outside, &calm[1])
     );
-    assert!(streamed > 0.2, "the banner in the zone streams: {streamed} m");
-    assert_eq!(outside, &calm[1], "the banner outside moves as in still air");
+    assert!(
+        streamed > 0.2,
+        "the banner in the zone streams: {streamed} m"
+    );
+    assert_eq!(
+        outside, &calm[1],
+        "the banner outside moves as in still air"
+    );
     assert!(runs[0] == runs[1], "one thread and the pool differ");
     let mut cloth = banner(Vec3::new(10.0, 2.0, 0.0));
-    assert_eq!(cloth.set_wind_zones(&zones, 0.0).unwrap(), 0, "out of reach");
+    assert_eq!(
+        cloth.set_wind_zones(&zones, 0.0).unwrap(),
+        0,
+        "out of reach"
+    );
 }
 
 /// The zone's gusts and turbulence swell and stir the force: the banner's hem swings
