@@ -171,7 +171,7 @@ impl ProxyBinding {
     /// Places every render vertex over the simulation's positions `x` (and its smooth
     /// vertex `normals`): each at its bound point at its height along its triangle's
     /// normal, its normal the blend of its corners' by its weights, its tangent turned
-    /// with its triangle. `tangents` is written only when given.
+    /// with its triangle and made square to that normal. `tangents` is written only when given.
     pub fn place(
         &self,
         x: &[Vec3],
@@ -195,8 +195,12 @@ impl ProxyBinding {
                 let (along, across, normal) =
                     frame(x, b.corners).unwrap_or((Vec3::X, Vec3::Y, Vec3::Z));
                 let t = b.tangent;
-                let turned = (t.x * along + t.y * across + t.z * normal).normalize_or(along);
-                *out = turned.extend(t.w).to_array();
+                let turned = t.x * along + t.y * across + t.z * normal;
+                // At right angles to the drawn (smooth) normal (Gram–Schmidt).
+                let (w, n) = (b.weights, b.corners.map(|i| normals[i as usize]));
+                let smooth = (w[0] * n[0] + w[1] * n[1] + w[2] * n[2]).normalize_or(normal);
+                let tangent = (turned - turned.dot(smooth) * smooth).normalize_or(along);
+                *out = tangent.extend(t.w).to_array();
             });
         }
     }

@@ -244,7 +244,7 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
     for (n, t) in normals.iter().zip(tangents) {
         let (n, t) = (Vec3::from(*n), Vec3::new(t[0], t[1], t[2]));
         assert!((n.length() - 1.0).abs() < 1e-4);
-        assert!(n.dot(t).abs() < 0.05, "tangent {t} against normal {n}");
+        assert!(n.dot(t).abs() < 1e-4, "tangent {t} against normal {n}");
     }
 }
 
