@@ -8,6 +8,7 @@ pub mod accuracy;
 pub mod baseline;
 pub mod cantilever;
 pub mod choose;
+pub mod crowd;
 pub mod drape;
 pub mod fps;
 pub mod peers;

@@ -33,41 +33,106 @@ pub fn begin_cloths(cloths: &mut [(&mut ClothSolver, bool)], dt: f32) {
 }
 
 /// Takes the substeps each cloth has left in its step (begun by [`begin_cloths`]): those
-/// in contact with others together in one task ([`substep_together`]), every other cloth
-/// in a task of its own, on the compute pool (a scope, so the calling thread works
-/// beside the pool's).
+/// in contact with others together ([`substep_together`]), every other cloth alone, the
+/// work shared among the threads in balanced lots (the largest first, each to the
+/// least loaded, by particles × substeps): one lot a task on the compute pool, the first
+/// on the calling thread, each lot's cloths one after another. With 100 small cloths one
+/// task per cloth left the two cores at 1.15–1.5× one; one lot per thread, the calling
+/// thread's taken at once rather than by stealing, does not wait on the executor.
+/// One thread ([`set_parallel`](super::set_parallel)`(false)`) runs them all here.
 pub fn run_cloths(cloths: &mut [&mut ClothSolver], env: &Environment) {
     let left = |c: &ClothSolver| c.report.substeps.saturating_sub(c.report.taken);
-    if cloths.iter().filter(|c| left(c) > 0).count() <= 1 {
-        // One cloth at work: on this thread (its own kernels use the pool).
-        for cloth in cloths.iter_mut() {
-            for _ in 0..left(cloth) {
-                cloth.substep(env);
-            }
-        }
+    let threads = super::threads();
+    if threads <= 1 || cloths.iter().filter(|c| left(c) > 0).count() <= 1 {
+        // One cloth at work (its own kernels use the pool), or one thread: here.
+        let (touching, alone): (Vec<_>, Vec<_>) = cloths
+            .iter_mut()
+            .map(|c| &mut **c)
+            .partition(|c| c.touches_other_cloths());
+        run_lot(units_of(alone, touching, &left), env);
         return;
     }
+    let mut units: Vec<(u64, Unit)> = Vec::new();
     let mut touching: Vec<&mut ClothSolver> = Vec::new();
+    for cloth in cloths.iter_mut() {
+        let n = left(cloth);
+        if n == 0 {
+            continue;
+        }
+        if cloth.touches_other_cloths() {
+            touching.push(cloth);
+        } else {
+            units.push((work(cloth, n), Unit::Alone(cloth, n)));
+        }
+    }
+    if !touching.is_empty() {
+        let w = touching.iter().map(|c| work(c, left(c))).sum();
+        units.push((w, Unit::Together(touching)));
+    }
+    // Longest processing time first (Graham 1969): within 4/3 of the best split.
+    units.sort_by_key(|(w, _)| std::cmp::Reverse(*w));
+    let mut lots: Vec<(u64, Vec<Unit>)> = (0..threads).map(|_| (0, Vec::new())).collect();
+    for (w, unit) in units {
+        let least = lots
+            .iter_mut()
+            .min_by_key(|(load, _)| *load)
+            .expect("a thread");
+        least.0 += w;
+        least.1.push(unit);
+    }
+    let mut lots = lots.into_iter().map(|(_, lot)| lot);
+    let here = lots.next().unwrap_or_default();
     super::task_pool().scope(|scope| {
-        for cloth in cloths.iter_mut() {
-            let n = left(cloth);
-            if n == 0 {
-                continue;
-            }
-            if cloth.touches_other_cloths() {
-                touching.push(cloth);
-                continue;
-            }
-            scope.spawn(async move {
+        for lot in lots.filter(|l| !l.is_empty()) {
+            scope.spawn(async move { run_lot(lot, env) });
+        }
+        run_lot(here, env);
+    });
+}
+
+/// What one cloth (or the cloths in contact, together) has left of its step, as work.
+enum Unit<'a> {
+    Alone(&'a mut ClothSolver, u32),
+    Together(Vec<&'a mut ClothSolver>),
+}
+
+/// The work of `n` substeps of `cloth`: its particles times `n`.
+fn work(cloth: &ClothSolver, n: u32) -> u64 {
+    cloth.particle_count() as u64 * n as u64
+}
+
+/// The cloths `alone` each a unit of the substeps `left` to it, and those `touching`
+/// one another one unit together.
+fn units_of<'a>(
+    alone: Vec<&'a mut ClothSolver>,
+    touching: Vec<&'a mut ClothSolver>,
+    left: &impl Fn(&ClothSolver) -> u32,
+) -> Vec<Unit<'a>> {
+    let mut units: Vec<Unit<'a>> = alone
+        .into_iter()
+        .map(|c| {
+            let n = left(c);
+            Unit::Alone(c, n)
+        })
+        .collect();
+    if !touching.is_empty() {
+        units.push(Unit::Together(touching));
+    }
+    units
+}
+
+/// Runs each unit's substeps in turn.
+fn run_lot(lot: Vec<Unit>, env: &Environment) {
+    for unit in lot {
+        match unit {
+            Unit::Alone(cloth, n) => {
                 for _ in 0..n {
                     cloth.substep(env);
                 }
-            });
+            }
+            Unit::Together(mut cloths) => substep_together(&mut cloths, env),
         }
-        if !touching.is_empty() {
-            scope.spawn(async move { substep_together(&mut touching, env) });
-        }
-    });
+    }
 }
 
 /// Begins a step of `dt` for cloths in contact with one another

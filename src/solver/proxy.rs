@@ -10,6 +10,8 @@ use bevy::math::{Vec3, Vec4};
 /// One render vertex's place on the simulation mesh.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Bound {
+    /// Its triangle, in [`ProxyBinding::triangles`].
+    triangle: u32,
     /// The triangle's corners.
     corners: [u32; 3],
     /// The barycentric weights of the vertex's projection on the triangle's plane (they
@@ -27,6 +29,10 @@ struct Bound {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ProxyBinding {
     bound: Vec<Bound>,
+    /// The triangles some vertex is bound to.
+    triangles: Vec<[u32; 3]>,
+    /// Each of those triangles' frame this frame (scratch of [`ProxyBinding::place`]).
+    frames: Vec<(Vec3, Vec3, Vec3)>,
 }
 
 /// The frame of triangle `t` of `x`: its first edge's direction, the direction across it
@@ -116,6 +122,8 @@ impl ProxyBinding {
         if usable.is_empty() {
             return None;
         }
+        let mut index_of = std::collections::HashMap::new();
+        let mut used: Vec<[u32; 3]> = Vec::new();
         let bound = render
             .iter()
             .enumerate()
@@ -137,7 +145,12 @@ impl ProxyBinding {
                     let t3 = t.truncate();
                     Vec4::new(t3.dot(along), t3.dot(across), t3.dot(normal), t.w)
                 });
+                let triangle = *index_of.entry(best).or_insert_with(|| {
+                    used.push(best);
+                    used.len() as u32 - 1
+                });
                 Bound {
+                    triangle,
                     corners: best,
                     weights,
                     height,
@@ -145,7 +158,12 @@ impl ProxyBinding {
                 }
             })
             .collect();
-        Some(ProxyBinding { bound })
+        let frames = vec![(Vec3::X, Vec3::Y, Vec3::Z); used.len()];
+        Some(ProxyBinding {
+            bound,
+            triangles: used,
+            frames,
+        })
     }
 
     /// How many render vertices it binds.
@@ -171,37 +189,35 @@ impl ProxyBinding {
     /// Places every render vertex over the simulation's positions `x` (and its smooth
     /// vertex `normals`): each at its bound point at its height along its triangle's
     /// normal, its normal the blend of its corners' by its weights, its tangent turned
-    /// with its triangle and made square to that normal. `tangents` is written only when given.
+    /// with its triangle and made square to that normal. `tangents` is written only when
+    /// given. Each triangle's frame is worked out once, then every vertex in one pass.
     pub fn place(
-        &self,
+        &mut self,
         x: &[Vec3],
         normals: &[Vec3],
         positions: &mut [[f32; 3]],
         out_normals: &mut [[f32; 3]],
-        tangents: Option<&mut [[f32; 4]]>,
+        mut tangents: Option<&mut [[f32; 4]]>,
     ) {
-        super::parallel::for_each_indexed(positions, |v, out| {
-            *out = self.point(x, v).to_array();
-        });
-        super::parallel::for_each_indexed(out_normals, |v, out| {
-            let b = &self.bound[v];
-            let (w, n) = (b.weights, b.corners.map(|i| normals[i as usize]));
-            let smooth = w[0] * n[0] + w[1] * n[1] + w[2] * n[2];
-            *out = smooth.normalize_or(n[0]).to_array();
-        });
-        if let Some(tangents) = tangents {
-            super::parallel::for_each_indexed(tangents, |v, out| {
-                let b = &self.bound[v];
-                let (along, across, normal) =
-                    frame(x, b.corners).unwrap_or((Vec3::X, Vec3::Y, Vec3::Z));
+        for (f, &t) in self.frames.iter_mut().zip(&self.triangles) {
+            *f = frame(x, t).unwrap_or(*f);
+        }
+        for (v, b) in self.bound.iter().enumerate() {
+            let (along, across, normal) = self.frames[b.triangle as usize];
+            let [i, j, k] = b.corners.map(|i| i as usize);
+            let w = b.weights;
+            let on = w[0] * x[i] + w[1] * x[j] + w[2] * x[k];
+            positions[v] = (on + b.height * normal).to_array();
+            let smooth =
+                (w[0] * normals[i] + w[1] * normals[j] + w[2] * normals[k]).normalize_or(normal);
+            out_normals[v] = smooth.to_array();
+            if let Some(tangents) = tangents.as_deref_mut() {
                 let t = b.tangent;
                 let turned = t.x * along + t.y * across + t.z * normal;
                 // At right angles to the drawn (smooth) normal (Gram–Schmidt).
-                let (w, n) = (b.weights, b.corners.map(|i| normals[i as usize]));
-                let smooth = (w[0] * n[0] + w[1] * n[1] + w[2] * n[2]).normalize_or(normal);
                 let tangent = (turned - turned.dot(smooth) * smooth).normalize_or(along);
-                *out = tangent.extend(t.w).to_array();
-            });
+                tangents[v] = tangent.extend(t.w).to_array();
+            }
         }
     }
 }
@@ -222,7 +238,7 @@ mod tests {
             Vec3::new(1.1, 0.5, -0.02),
         ];
         let tangents = [Vec4::new(1.0, 0.0, 0.0, 1.0); 3];
-        let binding = ProxyBinding::bind(&x, &triangles, &render, Some(&tangents)).unwrap();
+        let mut binding = ProxyBinding::bind(&x, &triangles, &render, Some(&tangents)).unwrap();
         for (v, &p) in render.iter().enumerate() {
             assert!(binding.point(&x, v).distance(p) < 1e-6, "{v}");
         }

@@ -261,6 +261,7 @@ impl ClothSolver {
         model_steps(&model).begin(self, dt, ratio);
         let p = &self.particles.position;
         self.drivers.begin_step(p, &self.structure.local_rest);
+        self.blow_at_particles();
         self.structure.torn_this_step.clear();
         self.contact
             .collider_impulses

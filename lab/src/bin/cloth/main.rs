@@ -43,6 +43,7 @@ mod args;
 mod bench;
 mod cantilever;
 mod choose;
+mod crowd;
 mod drape;
 mod peers;
 mod run;
@@ -89,6 +90,10 @@ enum Verb {
     /// The cantilever test (ASTM D1388): a fabric strip 2.5 cm wide pushed over a ledge
     /// until its tip falls 41.5°; its bending length against `(B / (ρ_A g))^(1/3)`.
     Cantilever(cantilever::CantileverArgs),
+    /// The crowd example's headless twin: characters walking loops in capes and skirts
+    /// drawn through proxies, teleports, a wind zone; each part of a frame timed on one
+    /// thread and on the pool.
+    Crowd(crowd::CrowdArgs),
     /// The drape test (Cusick): a 30 cm circle of fabric clamped between 18 cm discs,
     /// its drape coefficient from its shadow, with a picture of the shadows side by side.
     Drape(drape::DrapeArgs),
@@ -118,6 +123,7 @@ fn main() -> ExitCode {
         Verb::Peers(args) => peers::peers(args),
         Verb::Cantilever(args) => cantilever::cantilever(args),
         Verb::Drape(args) => drape::drape(args),
+        Verb::Crowd(args) => crowd::crowd(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,96 @@
+//! `cloth crowd`: the crowd example's headless twin, timed on one thread and on the pool.
+
+use clap::Args;
+
+use bevy_cloth::prelude::*;
+use bevy_cloth_lab::crowd::{self, CrowdSize};
+
+#[derive(Args)]
+pub(crate) struct CrowdArgs {
+    /// Characters, each with a cape and a skirt (1 to 400).
+    #[arg(long, default_value_t = 50, value_parser = clap::value_parser!(u32).range(1..=400))]
+    pub(crate) characters: u32,
+    /// Frames timed, after the warm-up (1 to 100,000).
+    #[arg(long, default_value_t = 300, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub(crate) frames: u32,
+    /// Frames run before timing (the cloths settle on their bodies).
+    #[arg(long, default_value_t = 60, value_parser = clap::value_parser!(u32).range(0..=100_000))]
+    pub(crate) warm: u32,
+    /// Without the wind zone (no air model on the cloths).
+    #[arg(long)]
+    pub(crate) calm: bool,
+    /// Prints the JSON object instead of a table.
+    #[arg(long)]
+    pub(crate) json: bool,
+}
+
+pub(crate) fn crowd(args: CrowdArgs) -> Result<(), String> {
+    let size = CrowdSize {
+        characters: args.characters as usize,
+        wind: !args.calm,
+        ..CrowdSize::default()
+    };
+    let cost = crowd::measure(
+        size,
+        &ClothParams::default(),
+        args.warm as usize,
+        args.frames as usize,
+    );
+    if !cost.stable {
+        return Err(format!(
+            "a cloth of the crowd failed (largest strain {:.1}%): not timed",
+            cost.strain * 100.0
+        ));
+    }
+    if args.json {
+        println!(
+            "{}",
+            serde_json::to_string(&cost).map_err(|e| e.to_string())?
+        );
+        return Ok(());
+    }
+    println!(
+        "{} characters, {} cloths: {} particles simulated, {} vertices drawn; {}; {} frames after \
+         {} warm-up, {} teleports; largest strain at the end {:.1}%",
+        size.characters,
+        2 * size.characters,
+        cost.particles,
+        cost.drawn,
+        if size.wind { "a wind zone" } else { "calm" },
+        args.frames,
+        args.warm,
+        cost.teleports,
+        cost.strain * 100.0
+    );
+    println!(
+        "| ms a frame, median [min–max] | one thread | {} threads | speed-up |",
+        cost.threads
+    );
+    println!("|---|---:|---:|---:|");
+    let row = |name: &str, one: [f64; 3], pool: [f64; 3]| {
+        println!(
+            "| {name} | {:.2} [{:.2}–{:.2}] | {:.2} [{:.2}–{:.2}] | {:.2}× |",
+            one[0],
+            one[1],
+            one[2],
+            pool[0],
+            pool[1],
+            pool[2],
+            one[0] / pool[0]
+        );
+    };
+    let (one, pool) = (cost.one_thread, cost.pool);
+    row("cloth step", one.step, pool.step);
+    row(
+        "driving (pins, targets, colliders, wind)",
+        one.drive,
+        pool.drive,
+    );
+    row("drawing (normals, proxies)", one.draw, pool.draw);
+    println!(
+        "the rest of the frame against the step (pool): driving {:.0}%, drawing {:.0}%",
+        100.0 * pool.drive[0] / pool.step[0],
+        100.0 * pool.draw[0] / pool.step[0]
+    );
+    Ok(())
+}

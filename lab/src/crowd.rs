@@ -1,0 +1,520 @@
+//! The crowd: characters walking their own loops across a square, each with a cape
+//! (attached at the shoulders) and a skirt (skinned: held within a painted distance of
+//! the hips, with a back stop), each cloth drawn through a finer proxy mesh, every few
+//! seconds one of them teleported across the square, a gusty wind zone across its
+//! middle. The headless twin of `examples/crowd.rs`: it times what a game's frame spends
+//! on the cloth (driving the bodies' pins, targets, colliders and wind; the cloths'
+//! step; drawing: normals and the proxies' vertices), on one thread and on the pool.
+
+use std::time::Instant;
+
+use bevy::math::{Affine3A, Quat, Vec3};
+use serde::Serialize;
+
+use bevy_cloth::layout::shape::ClothPins;
+use bevy_cloth::params::{ClothParams, Environment, Turbulence, WindZone, ZoneShape};
+use bevy_cloth::solver::shapes::Capsule;
+use bevy_cloth::solver::{
+    self, BackStop, ClothSolver, Collider, ColliderShape, Layout, Motion, ProxyBinding,
+};
+
+/// How big the crowd is.
+#[derive(Clone, Copy, Debug, Serialize)]
+pub struct CrowdSize {
+    /// Characters, each with a cape and a skirt.
+    pub characters: usize,
+    /// The cape's particles across and down.
+    pub cape: (u32, u32),
+    /// The skirt's particles around and down.
+    pub skirt: (u32, u32),
+    /// How many times finer each way the drawn meshes are than the simulated ones.
+    pub refine: u32,
+    /// Seconds between teleports (one character at a time, in turn).
+    pub teleport_every: f32,
+    /// Whether the wind zone blows (through the air model on every triangle it reaches).
+    pub wind: bool,
+}
+
+impl Default for CrowdSize {
+    /// 50 characters: 100 cloths of 384 particles (38,400), drawn 3 × 3 finer.
+    fn default() -> Self {
+        CrowdSize {
+            characters: 50,
+            cape: (16, 24),
+            skirt: (32, 12),
+            refine: 3,
+            teleport_every: 3.0,
+            wind: true,
+        }
+    }
+}
+
+/// Shoulder height, hip height and the body's radius, m.
+const SHOULDERS: f32 = 1.45;
+const HIPS: f32 = 0.95;
+const BODY_RADIUS: f32 = 0.17;
+
+/// One character's walk: a loop about `centre` of `radius` at `speed`, and the offset a
+/// teleport has put it at.
+#[derive(Clone, Copy, Debug)]
+struct Walk {
+    centre: Vec3,
+    radius: f32,
+    speed: f32,
+    phase: f32,
+    away: bool,
+}
+
+impl Walk {
+    /// Where the body is at time `t`: its rotation (facing along the loop) and position.
+    fn pose(&self, t: f32) -> (Quat, Vec3) {
+        let angle = self.phase + self.speed * t / self.radius;
+        let (s, c) = angle.sin_cos();
+        let jump = if self.away {
+            Vec3::X * 12.0
+        } else {
+            Vec3::ZERO
+        };
+        let at = self.centre + self.radius * Vec3::new(c, 0.0, s) + jump;
+        // Facing along the tangent (−sin, 0, cos), with a bob of the walk.
+        let facing = Quat::from_rotation_y(-angle);
+        (facing, at + Vec3::Y * 0.02 * (4.0 * angle).sin())
+    }
+}
+
+/// A cloth drawn through a proxy: the simulation, its proxy binding and the drawn
+/// buffers, its pins' rest offsets in the body's frame.
+struct Drawn {
+    cloth: ClothSolver,
+    in_body: Vec<Vec3>,
+    binding: ProxyBinding,
+    normals: Vec<Vec3>,
+    local: Vec<Vec3>,
+    positions: Vec<[f32; 3]>,
+    drawn_normals: Vec<[f32; 3]>,
+    tangents: Vec<[f32; 4]>,
+}
+
+impl Drawn {
+    fn new(cloth: ClothSolver, in_body: Vec<Vec3>, fine: &[Vec3]) -> Self {
+        let binding = ProxyBinding::bind(in_body.as_slice(), cloth.triangles(), fine, None)
+            .expect("a cloth with triangles");
+        let (n, m) = (cloth.particle_count(), fine.len());
+        Drawn {
+            cloth,
+            in_body,
+            binding,
+            normals: vec![Vec3::ZERO; n],
+            local: vec![Vec3::ZERO; n],
+            positions: vec![[0.0; 3]; m],
+            drawn_normals: vec![[0.0; 3]; m],
+            tangents: vec![[1.0, 0.0, 0.0, 1.0]; m],
+        }
+    }
+
+    /// What a game's write-back does: the normals, and each drawn vertex placed.
+    fn draw(&mut self) {
+        self.cloth.normals_into(&mut self.normals);
+        self.local.copy_from_slice(self.cloth.positions());
+        self.binding.place(
+            &self.local,
+            &self.normals,
+            &mut self.positions,
+            &mut self.drawn_normals,
+            Some(&mut self.tangents),
+        );
+    }
+}
+
+/// A grid's rest positions in its own frame (x across, y down from 0), `k` times finer.
+fn grid_points(w: u32, h: u32, spacing: f32, k: u32) -> Vec<Vec3> {
+    let (fw, fh) = ((w - 1) * k + 1, (h - 1) * k + 1);
+    let step = spacing / k as f32;
+    (0..fw * fh)
+        .map(|v| Vec3::new((v % fw) as f32 * step, -((v / fw) as f32) * step, 0.0))
+        .collect()
+}
+
+/// A cone (a skirt) of `around × down` particles from the waist (radius 0.19 m at hip
+/// height) flaring to 0.31 m 0.42 m below, `k` times finer; its triangles.
+fn cone(around: u32, down: u32, k: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let (fa, fd) = (around * k, (down - 1) * k + 1);
+    let mut points = Vec::with_capacity((fa * fd) as usize);
+    for j in 0..fd {
+        let s = j as f32 / (fd - 1) as f32;
+        for i in 0..fa {
+            let a = std::f32::consts::TAU * i as f32 / fa as f32;
+            let r = 0.19 + 0.12 * s;
+            points.push(Vec3::new(r * a.sin(), HIPS - 0.42 * s, r * a.cos()));
+        }
+    }
+    let mut triangles = Vec::new();
+    for j in 0..fd - 1 {
+        for i in 0..fa {
+            let (a, b) = (j * fa + i, j * fa + (i + 1) % fa);
+            triangles.push([a, a + fa, b]);
+            triangles.push([b, a + fa, b + fa]);
+        }
+    }
+    (points, triangles)
+}
+
+/// A character: its walk, its cape and its skirt, and the skirt's painted distances.
+struct Character {
+    walk: Walk,
+    cape: Drawn,
+    skirt: Drawn,
+    cape_top: u32,
+    skirt_radius: Vec<f32>,
+    last_pose: (Quat, Vec3),
+}
+
+/// What one frame cost, ms.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct FrameCost {
+    /// The bodies moved: pins, skinned targets, colliders and wind zones handed over.
+    pub drive: f64,
+    /// The cloths' step.
+    pub step: f64,
+    /// Drawing: normals and every proxy vertex placed.
+    pub draw: f64,
+}
+
+/// The crowd.
+pub struct Crowd {
+    characters: Vec<Character>,
+    zones: [WindZone; 1],
+    env: Environment,
+    dt: f32,
+    time: f32,
+    size: CrowdSize,
+    /// Teleports so far.
+    pub teleports: usize,
+}
+
+impl Crowd {
+    /// Builds the crowd of `size`, each cloth with `params`.
+    pub fn new(size: CrowdSize, params: &ClothParams) -> Self {
+        let (cw, ch) = size.cape;
+        let (around, down) = size.skirt;
+        let spacing = 0.035;
+        // Hung from the shoulders, just behind the body.
+        let shoulders = Vec3::new(
+            -((cw - 1) as f32) * spacing * 0.5,
+            SHOULDERS,
+            -BODY_RADIUS - 0.03,
+        );
+        let on_back = |k| -> Vec<Vec3> {
+            grid_points(cw, ch, spacing, k)
+                .into_iter()
+                .map(|p| p + shoulders)
+                .collect()
+        };
+        let (cape_rest, cape_fine) = (on_back(1), on_back(size.refine));
+        let cape_triangles = grid_triangles(cw, ch);
+        let (skirt_rest, skirt_triangles) = cone(around, down, 1);
+        let (skirt_fine, _) = cone(around, down, size.refine);
+        let skirt_radius: Vec<f32> = (0..around * down)
+            .map(|k| {
+                let s = (k / around) as f32 / (down - 1) as f32;
+                0.2 * s * s
+            })
+            .collect();
+        let side = (size.characters as f32).sqrt().ceil() as usize;
+        let characters = (0..size.characters)
+            .map(|c| {
+                let (row, column) = (c / side, c % side);
+                let walk = Walk {
+                    centre: Vec3::new(column as f32 * 3.0, 0.0, row as f32 * 3.0),
+                    radius: 0.8 + 0.15 * (c % 4) as f32,
+                    speed: 1.0 + 0.1 * (c % 5) as f32,
+                    phase: c as f32 * 0.7,
+                    away: false,
+                };
+                let pose = walk.pose(0.0);
+                let frame = Affine3A::from_rotation_translation(pose.0, pose.1);
+                let cape = solver_of(&cape_rest, &cape_triangles, params, frame);
+                let mut skirt = solver_of(&skirt_rest, &skirt_triangles, params, frame);
+                let targets: Vec<Vec3> = skirt_rest
+                    .iter()
+                    .map(|&p| frame.transform_point3(p))
+                    .collect();
+                skirt
+                    .set_motion_constraints(&targets, &skirt_radius)
+                    .expect("painted");
+                let stops = vec![
+                    BackStop {
+                        distance: 0.01,
+                        radius: 0.3
+                    };
+                    skirt_rest.len()
+                ];
+                skirt.set_back_stops(&stops).expect("stops");
+                Character {
+                    walk,
+                    cape: Drawn::new(cape, cape_rest.clone(), &cape_fine),
+                    skirt: Drawn::new(skirt, skirt_rest.clone(), &skirt_fine),
+                    cape_top: cw,
+                    skirt_radius: skirt_radius.clone(),
+                    last_pose: pose,
+                }
+            })
+            .collect();
+        let extent = side as f32 * 3.0;
+        let zone = WindZone {
+            shape: ZoneShape::Box {
+                half_extents: Vec3::new(extent, 2.0, 2.5),
+            },
+            centre: Vec3::new(extent * 0.5, 1.0, extent * 0.5),
+            velocity: Vec3::new(5.0, 0.0, 1.5),
+            falloff: 0.3,
+            turbulence: Turbulence {
+                gust: 0.4,
+                gust_period: 1.2,
+                noise: 0.3,
+                scale: 0.8,
+                seed: 11,
+            },
+            ..WindZone::default()
+        };
+        let mut crowd = Crowd {
+            characters,
+            zones: [zone],
+            env: Environment::default(),
+            dt: 1.0 / 60.0,
+            time: 0.0,
+            size,
+            teleports: 0,
+        };
+        // Spawned on their bodies.
+        for c in &mut crowd.characters {
+            for cloth in [&mut c.cape.cloth, &mut c.skirt.cloth] {
+                cloth.teleport_next_step(bevy_cloth::params::TeleportMode::Reset);
+            }
+        }
+        crowd
+    }
+
+    /// Every cloth.
+    pub fn cloths(&self) -> impl Iterator<Item = &ClothSolver> {
+        self.characters
+            .iter()
+            .flat_map(|c| [&c.cape.cloth, &c.skirt.cloth])
+    }
+
+    /// Particles in all the cloths, and drawn vertices.
+    pub fn counts(&self) -> (usize, usize) {
+        self.characters.iter().fold((0, 0), |(p, v), c| {
+            (
+                p + c.cape.cloth.particle_count() + c.skirt.cloth.particle_count(),
+                v + c.cape.binding.len() + c.skirt.binding.len(),
+            )
+        })
+    }
+
+    /// One frame: the bodies move (one teleports when its turn comes), the cloths step
+    /// (side by side on the pool with `pool`, else one after another on this thread),
+    /// and are drawn. What each part cost.
+    pub fn frame(&mut self, pool: bool) -> FrameCost {
+        let (dt, t) = (self.dt, self.time + self.dt);
+        let start = Instant::now();
+        let turn = (t / self.size.teleport_every) as usize;
+        let due = (self.time / self.size.teleport_every) as usize != turn;
+        let n = self.characters.len();
+        for (k, c) in self.characters.iter_mut().enumerate() {
+            let jumps = due && turn % n == k;
+            if jumps {
+                c.walk.away = !c.walk.away;
+                self.teleports += 1;
+            }
+            let pose = c.walk.pose(t);
+            let body = Affine3A::from_rotation_translation(pose.0, pose.1);
+            for i in 0..c.cape_top {
+                let goal = body.transform_point3(c.cape.in_body[i as usize]);
+                c.cape.cloth.attach(i, goal).expect("a top-row particle");
+            }
+            let targets: Vec<Vec3> = c
+                .skirt
+                .in_body
+                .iter()
+                .map(|&p| body.transform_point3(p))
+                .collect();
+            c.skirt
+                .cloth
+                .set_motion_constraints(&targets, &c.skirt_radius)
+                .expect("painted");
+            // The body: a capsule from hips to shoulders, swept from its last pose (a
+            // teleported body is not swept across the gap).
+            let motion = if jumps {
+                Motion::NONE
+            } else {
+                Motion::between(c.last_pose, pose, dt)
+            };
+            let capsule = Collider {
+                shape: ColliderShape::from(Capsule {
+                    a: pose.1 + Vec3::Y * (HIPS - 0.3),
+                    b: pose.1 + Vec3::Y * (SHOULDERS - 0.05),
+                    radius: BODY_RADIUS,
+                }),
+                thickness: 0.01,
+                friction: 0.3,
+                motion,
+            };
+            c.last_pose = pose;
+            for cloth in [&mut c.cape.cloth, &mut c.skirt.cloth] {
+                cloth.set_colliders([capsule.clone()]);
+                let zones = if self.size.wind { &self.zones[..] } else { &[] };
+                cloth.set_wind_zones(zones, t).expect("a checked zone");
+            }
+        }
+        let drive = start.elapsed();
+        let start = Instant::now();
+        let mut cloths: Vec<&mut ClothSolver> = self
+            .characters
+            .iter_mut()
+            .flat_map(|c| [&mut c.cape.cloth, &mut c.skirt.cloth])
+            .collect();
+        if pool {
+            let mut flagged: Vec<(&mut ClothSolver, bool)> =
+                cloths.iter_mut().map(|c| (&mut **c, true)).collect();
+            solver::begin_cloths(&mut flagged, dt);
+            drop(flagged);
+            solver::run_cloths(&mut cloths, &self.env);
+            for cloth in cloths.iter_mut() {
+                cloth.end_step();
+            }
+        } else {
+            for cloth in cloths.iter_mut() {
+                cloth.step(dt, &self.env);
+            }
+        }
+        let step = start.elapsed();
+        let start = Instant::now();
+        for c in &mut self.characters {
+            c.cape.draw();
+            c.skirt.draw();
+        }
+        let draw = start.elapsed();
+        self.time = t;
+        FrameCost {
+            drive: drive.as_secs_f64() * 1e3,
+            step: step.as_secs_f64() * 1e3,
+            draw: draw.as_secs_f64() * 1e3,
+        }
+    }
+
+    /// The largest structural strain over every cloth now, and whether every one is
+    /// stable.
+    pub fn health(&self) -> (f32, bool) {
+        self.cloths().fold((0.0f32, true), |(s, ok), c| {
+            (s.max(c.strain().max), ok && c.is_stable())
+        })
+    }
+}
+
+/// The triangles of a `w × h` grid.
+fn grid_triangles(w: u32, h: u32) -> Vec<[u32; 3]> {
+    let mut t = Vec::new();
+    for j in 0..h - 1 {
+        for i in 0..w - 1 {
+            let v = j * w + i;
+            t.push([v, v + w, v + 1]);
+            t.push([v + 1, v + w, v + w + 1]);
+        }
+    }
+    t
+}
+
+/// A solver of `rest` (in the body's frame) and its triangles, placed by `frame`.
+fn solver_of(
+    rest: &[Vec3],
+    triangles: &[[u32; 3]],
+    params: &ClothParams,
+    frame: Affine3A,
+) -> ClothSolver {
+    let layout = Layout::from_mesh(rest, triangles).expect("a mesh");
+    let pins = ClothPins::None.resolve_for(&layout).expect("no pins");
+    ClothSolver::new(layout, &pins, params, frame).expect("valid")
+}
+
+/// The crowd's cost: the median and spread of each part of a frame over `frames` after
+/// `warm` frames, on one thread and on the pool (alternating runs of the same crowd).
+#[derive(Clone, Debug, Serialize)]
+pub struct CrowdCost {
+    /// The crowd.
+    pub size: CrowdSize,
+    /// Particles simulated, vertices drawn.
+    pub particles: usize,
+    /// Vertices drawn.
+    pub drawn: usize,
+    /// The pool's threads.
+    pub threads: usize,
+    /// One thread: median (min–max) ms of the step, the drive and the drawing.
+    pub one_thread: PartCosts,
+    /// The pool.
+    pub pool: PartCosts,
+    /// Teleports in the pool's run.
+    pub teleports: usize,
+    /// The largest structural strain at the end, and whether every cloth stayed stable.
+    pub strain: f32,
+    /// Whether every cloth stayed stable in both runs.
+    pub stable: bool,
+}
+
+/// Medians and ranges of a frame's parts, ms.
+#[derive(Clone, Copy, Debug, Default, Serialize)]
+pub struct PartCosts {
+    /// The cloths' step: median, min, max.
+    pub step: [f64; 3],
+    /// Driving the bodies.
+    pub drive: [f64; 3],
+    /// Drawing.
+    pub draw: [f64; 3],
+}
+
+fn spread(mut v: Vec<f64>) -> [f64; 3] {
+    v.sort_by(f64::total_cmp);
+    let (least, most) = (v[0], v[v.len() - 1]);
+    [super::median(&mut v), least, most]
+}
+
+/// Runs the crowd of `size` with `params` for `warm + frames` frames on one thread and
+/// on the pool and gives each part's cost.
+pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize) -> CrowdCost {
+    let mut parts = Vec::new();
+    let (mut strain, mut stable, mut teleports) = (0.0f32, true, 0);
+    for pool in [false, true] {
+        solver::set_parallel(pool);
+        let mut crowd = Crowd::new(size, params);
+        let mut costs = Vec::new();
+        for f in 0..warm + frames {
+            let cost = crowd.frame(pool);
+            if f >= warm {
+                costs.push(cost);
+            }
+        }
+        let (s, ok) = crowd.health();
+        strain = strain.max(s);
+        stable &= ok;
+        teleports = crowd.teleports;
+        parts.push(PartCosts {
+            step: spread(costs.iter().map(|c| c.step).collect()),
+            drive: spread(costs.iter().map(|c| c.drive).collect()),
+            draw: spread(costs.iter().map(|c| c.draw).collect()),
+        });
+    }
+    solver::set_parallel(true);
+    let crowd = Crowd::new(size, params);
+    let (particles, drawn) = crowd.counts();
+    CrowdCost {
+        size,
+        particles,
+        drawn,
+        threads: solver::threads(),
+        one_thread: parts[0],
+        pool: parts[1],
+        teleports,
+        strain,
+        stable,
+    }
+}
