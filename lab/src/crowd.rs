@@ -92,7 +92,6 @@ struct Drawn {
     local: Vec<Vec3>,
     positions: Vec<[f32; 3]>,
     drawn_normals: Vec<[f32; 3]>,
-    tangents: Vec<[f32; 4]>,
 }
 
 impl Drawn {
@@ -108,11 +107,11 @@ impl Drawn {
             local: vec![Vec3::ZERO; n],
             positions: vec![[0.0; 3]; m],
             drawn_normals: vec![[0.0; 3]; m],
-            tangents: vec![[1.0, 0.0, 0.0, 1.0]; m],
         }
     }
 
-    /// What a game's write-back does: the normals, and each drawn vertex placed.
+    /// What a game's write-back does: the normals, and each drawn vertex placed (the
+    /// example's meshes have no tangents).
     fn draw(&mut self) {
         self.cloth.normals_into(&mut self.normals);
         self.local.copy_from_slice(self.cloth.positions());
@@ -121,7 +120,7 @@ impl Drawn {
             &self.normals,
             &mut self.positions,
             &mut self.drawn_normals,
-            Some(&mut self.tangents),
+            None,
         );
     }
 }
@@ -390,9 +389,24 @@ impl Crowd {
         }
         let step = start.elapsed();
         let start = Instant::now();
-        for c in &mut self.characters {
-            c.cape.draw();
-            c.skirt.draw();
+        if pool {
+            // Each cloth's drawing is its own: the characters in as many lots as threads.
+            let lot = self.characters.len().div_ceil(solver::threads()).max(1);
+            solver::task_pool().scope(|scope| {
+                for chunk in self.characters.chunks_mut(lot) {
+                    scope.spawn(async move {
+                        for c in chunk {
+                            c.cape.draw();
+                            c.skirt.draw();
+                        }
+                    });
+                }
+            });
+        } else {
+            for c in &mut self.characters {
+                c.cape.draw();
+                c.skirt.draw();
+            }
         }
         let draw = start.elapsed();
         self.time = t;
