@@ -3,7 +3,8 @@
 //! hips, Jolt's and Magica's skinned constraints, with a back stop), each cloth drawn
 //! through a proxy mesh three times finer each way. Every three seconds one character
 //! is teleported 12 m across the square and back, its cloth carried with it; a gusty
-//! wind zone blows across the square's middle. `cloth crowd` is its headless twin, which
+//! wind zone blows across the square's middle; cloths out of the camera's view stop
+//! (`ClothCulling`). `cloth crowd` is its headless twin, which
 //! times the parts of a frame.
 //!
 //! `cargo run --example crowd [-- --screenshot out.png --frames 120]`
@@ -204,6 +205,7 @@ fn setup(
             ClothProxy {
                 mesh: cape_fine.clone(),
             },
+            ClothCulling::default(),
             MeshMaterial3d(material.clone()),
             Name::new(format!("cape {c}")),
         ));
@@ -220,6 +222,7 @@ fn setup(
                 ClothProxy {
                     mesh: skirt_fine.clone(),
                 },
+                ClothCulling::default(),
                 Transform::from_xyz(0.0, HIPS, 0.0),
                 MeshMaterial3d(material),
                 Name::new(format!("skirt {c}")),

@@ -66,7 +66,7 @@ pub mod prelude {
     pub use crate::ecs::{
         AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBackStop,
         ClothBecameInvalid, ClothBuilt, ClothCollider, ClothColliderBecameInvalid,
-        ClothColliderInvalid, ClothColliderSpan, ClothEnvironment, ClothFellAsleep,
+        ClothColliderInvalid, ClothColliderSpan, ClothCulling, ClothEnvironment, ClothFellAsleep,
         ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
         ClothProxy, ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems,
         ClothSystems, ClothTeleport, ClothTeleported, ClothTorn, ClothWake, ClothWindZone,

@@ -8,6 +8,7 @@ pub mod avian;
 pub(crate) mod build;
 pub(crate) mod cloth;
 pub(crate) mod colliders;
+pub(crate) mod culling;
 pub(crate) mod events;
 pub(crate) mod lod;
 pub(crate) mod mesh;
@@ -28,6 +29,7 @@ pub use colliders::{
     ClothCollider, ClothColliderInvalid, ClothColliderSpan, ClothCollidersPlugin, ColliderKind,
     TELEPORT_SPEED,
 };
+pub use culling::{ClothCulling, ClothCullingPlugin};
 pub use events::{
     ClothAwoke, ClothBecameInvalid, ClothBuilt, ClothColliderBecameInvalid, ClothFellAsleep,
     ClothTeleport, ClothTeleported, ClothTorn,

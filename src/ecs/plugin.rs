@@ -3,7 +3,7 @@
 //! the core here (the cloth, its building and stepping, the events), garments as assets
 //! (`build.rs`), colliders (`colliders.rs`), attachments (`attach.rs`), motion
 //! constraints from skinned meshes (`skin.rs`), sleeping (`sleep.rs`), level of detail
-//! (`lod.rs`), wind zones (`wind.rs`), proxy meshes (`proxy.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
+//! (`lod.rs`), culling (`culling.rs`), wind zones (`wind.rs`), proxy meshes (`proxy.rs`), the mesh write-back (`mesh.rs`) and, with the `avian` feature, avian's
 //! bodies (`avian.rs`, added by the game). A game leaves a feature out with
 //! `ClothPlugin::default().build().disable::<ClothLodPlugin>()`.
 //!
@@ -39,6 +39,7 @@ use crate::ecs::cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
 };
 use crate::ecs::colliders::ClothCollidersPlugin;
+use crate::ecs::culling::ClothCullingPlugin;
 use crate::ecs::events::{
     ClothBecameInvalid, ClothBuilt, ClothTeleport, ClothTeleported, ClothTorn,
 };
@@ -81,7 +82,8 @@ pub enum ClothSystems {
 /// puts its systems in its part.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ClothPrepareSystems {
-    /// Level of detail picks each cloth's model ([`ClothLodPlugin`]).
+    /// Level of detail picks each cloth's model ([`ClothLodPlugin`]); culled cloths are
+    /// marked ([`ClothCullingPlugin`]).
     Levels,
     /// New cloths are built, changed ones rebuilt, edited parameters applied.
     Build,
@@ -164,6 +166,7 @@ impl PluginGroup for ClothPlugin {
             })
             .add(ClothGarmentPlugin)
             .add(ClothLodPlugin)
+            .add(ClothCullingPlugin)
             .add(ClothAttachPlugin)
             .add(ClothSkinPlugin)
             .add(ClothCollidersPlugin)

@@ -35,6 +35,8 @@ pub struct ClothStats {
     /// True when the cloth fell asleep at its last step (see [`ClothSleep`](crate::ClothSleep), which says
     /// whether it sleeps now): the other values are those of that step.
     pub asleep: bool,
+    /// True while it is culled ([`ClothCulling`](crate::ClothCulling)): it takes no steps.
+    pub culled: bool,
     /// Median step time over the last second of wall-clock steps, ms.
     pub step_ms_median: f32,
     /// Largest structural strain.

@@ -9,6 +9,7 @@ use bevy::prelude::*;
 use crate::ecs::cloth::{
     ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation, pause_invalid,
 };
+use crate::ecs::culling::ClothCulling;
 use crate::ecs::events::{ClothTeleport, ClothTeleported, ClothTorn};
 use crate::ecs::sleep::ClothSleep;
 use crate::ecs::stats::ClothStats;
@@ -127,7 +128,7 @@ pub(crate) fn begin_steps(
             Entity,
             &mut ClothSimulation,
             Option<&mut StepProgress>,
-            Option<&ClothSleep>,
+            (Option<&ClothSleep>, Option<&ClothCulling>),
         ),
         Without<ClothInvalid>,
     >,
@@ -142,8 +143,8 @@ pub(crate) fn begin_steps(
     plan.index = 0;
     // Which cloths step (not paused, not asleep).
     let mut all = Vec::new();
-    for (entity, mut sim, progress, sleep) in &mut cloths {
-        let steps = run && sleep.is_none_or(|s| !s.asleep);
+    for (entity, mut sim, progress, (sleep, culling)) in &mut cloths {
+        let steps = run && sleep.is_none_or(|s| !s.asleep) && culling.is_none_or(|c| !c.culled);
         // Where the step begins, kept only when the mesh is drawn between steps.
         sim.note_step(steps && interpolate);
         all.push((entity, sim, progress, steps));

@@ -6,6 +6,7 @@ mod common;
 mod attach;
 mod building;
 mod colliders;
+mod culling;
 mod drawing;
 mod keys;
 mod stepping;
