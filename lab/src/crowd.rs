@@ -452,7 +452,7 @@ fn solver_of(
 }
 
 /// The crowd's cost: the median and spread of each part of a frame over `frames` after
-/// `warm` frames, on one thread and on the pool (alternating runs of the same crowd).
+/// `warm` frames, on one thread and on the pool (two crowds, a frame of each in turn).
 #[derive(Clone, Debug, Serialize)]
 pub struct CrowdCost {
     /// The crowd.
@@ -492,34 +492,30 @@ fn spread(mut v: Vec<f64>) -> [f64; 3] {
     [super::median(&mut v), least, most]
 }
 
-/// Runs the crowd of `size` with `params` for `warm + frames` frames on one thread and
-/// on the pool and gives each part's cost.
+/// Runs two crowds of `size` with `params` side by side for `warm + frames` frames, one
+/// on one thread and one on the pool, a frame of each in turn (so that the machine's
+/// noise falls on both alike), and gives each part's cost.
 pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize) -> CrowdCost {
-    let mut parts = Vec::new();
-    let (mut strain, mut stable, mut teleports) = (0.0f32, true, 0);
-    for pool in [false, true] {
-        solver::set_parallel(pool);
-        let mut crowd = Crowd::new(size, params);
-        let mut costs = Vec::new();
-        for f in 0..warm + frames {
+    let mut crowds = [Crowd::new(size, params), Crowd::new(size, params)];
+    let mut costs: [Vec<FrameCost>; 2] = [Vec::new(), Vec::new()];
+    for f in 0..warm + frames {
+        for (k, crowd) in crowds.iter_mut().enumerate() {
+            let pool = k == 1;
+            solver::set_parallel(pool);
             let cost = crowd.frame(pool);
             if f >= warm {
-                costs.push(cost);
+                costs[k].push(cost);
             }
         }
-        let (s, ok) = crowd.health();
-        strain = strain.max(s);
-        stable &= ok;
-        teleports = crowd.teleports;
-        parts.push(PartCosts {
-            step: spread(costs.iter().map(|c| c.step).collect()),
-            drive: spread(costs.iter().map(|c| c.drive).collect()),
-            draw: spread(costs.iter().map(|c| c.draw).collect()),
-        });
     }
     solver::set_parallel(true);
-    let crowd = Crowd::new(size, params);
-    let (particles, drawn) = crowd.counts();
+    let parts = costs.map(|c| PartCosts {
+        step: spread(c.iter().map(|c| c.step).collect()),
+        drive: spread(c.iter().map(|c| c.drive).collect()),
+        draw: spread(c.iter().map(|c| c.draw).collect()),
+    });
+    let health = crowds.each_ref().map(|c| c.health());
+    let (particles, drawn) = crowds[0].counts();
     CrowdCost {
         size,
         particles,
@@ -527,8 +523,8 @@ pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize
         threads: solver::threads(),
         one_thread: parts[0],
         pool: parts[1],
-        teleports,
-        strain,
-        stable,
+        teleports: crowds[1].teleports,
+        strain: health[0].0.max(health[1].0),
+        stable: health[0].1 && health[1].1,
     }
 }
