@@ -191,9 +191,18 @@ pub struct Crowd {
     pub teleports: usize,
 }
 
-impl Crowd {
-    /// Builds the crowd of `size`, each cloth with `params`.
-    pub fn new(size: CrowdSize, params: &ClothParams) -> Self {
+/// The rest shapes every character's cloths share: the cape's and the skirt's rest
+/// positions in the body's frame, their finer drawn points and their triangles, and the
+/// skirt's painted distances.
+struct Shapes {
+    cape: (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>),
+    skirt: (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>),
+    skirt_radius: Vec<f32>,
+    cape_top: u32,
+}
+
+impl Shapes {
+    fn new(size: &CrowdSize) -> Self {
         let (cw, ch) = size.cape;
         let (around, down) = size.skirt;
         let spacing = 0.035;
@@ -209,89 +218,156 @@ impl Crowd {
                 .map(|p| p + shoulders)
                 .collect()
         };
-        let (cape_rest, cape_fine) = (on_back(1), on_back(size.refine));
-        let cape_triangles = grid_triangles(cw, ch);
         let (skirt_rest, skirt_triangles) = cone(around, down, 1);
-        let (skirt_fine, _) = cone(around, down, size.refine);
-        let skirt_radius: Vec<f32> = (0..around * down)
-            .map(|k| {
-                let s = (k / around) as f32 / (down - 1) as f32;
-                0.2 * s * s
-            })
-            .collect();
-        let side = (size.characters as f32).sqrt().ceil() as usize;
-        let characters = (0..size.characters)
-            .map(|c| {
-                let (row, column) = (c / side, c % side);
-                let walk = Walk {
-                    centre: Vec3::new(column as f32 * 3.0, 0.0, row as f32 * 3.0),
-                    radius: 0.8 + 0.15 * (c % 4) as f32,
-                    speed: 1.0 + 0.1 * (c % 5) as f32,
-                    phase: c as f32 * 0.7,
-                    away: false,
-                };
-                let pose = walk.pose(0.0);
-                let frame = Affine3A::from_rotation_translation(pose.0, pose.1);
-                let cape = solver_of(&cape_rest, &cape_triangles, params, frame);
-                let mut skirt = solver_of(&skirt_rest, &skirt_triangles, params, frame);
-                let targets: Vec<Vec3> = skirt_rest
-                    .iter()
-                    .map(|&p| frame.transform_point3(p))
-                    .collect();
-                skirt
-                    .set_motion_constraints(&targets, &skirt_radius)
-                    .expect("painted");
-                let stops = vec![
-                    BackStop {
-                        distance: 0.01,
-                        radius: 0.3
-                    };
-                    skirt_rest.len()
-                ];
-                skirt.set_back_stops(&stops).expect("stops");
-                Character {
-                    walk,
-                    cape: Drawn::new(cape, cape_rest.clone(), &cape_fine),
-                    skirt: Drawn::new(skirt, skirt_rest.clone(), &skirt_fine),
-                    cape_top: cw,
-                    skirt_radius: skirt_radius.clone(),
-                    last_pose: pose,
-                }
-            })
-            .collect();
-        let extent = side as f32 * 3.0;
-        let zone = WindZone {
-            shape: ZoneShape::Box {
-                half_extents: Vec3::new(extent, 2.0, 2.5),
-            },
-            centre: Vec3::new(extent * 0.5, 1.0, extent * 0.5),
-            velocity: Vec3::new(5.0, 0.0, 1.5),
-            falloff: 0.3,
-            turbulence: Turbulence {
-                gust: 0.4,
-                gust_period: 1.2,
-                noise: 0.3,
-                scale: 0.8,
-                seed: 11,
-            },
-            ..WindZone::default()
+        Shapes {
+            cape: (on_back(1), on_back(size.refine), grid_triangles(cw, ch)),
+            skirt: (
+                skirt_rest,
+                cone(around, down, size.refine).0,
+                skirt_triangles,
+            ),
+            skirt_radius: (0..around * down)
+                .map(|k| 0.2 * ((k / around) as f32 / (down - 1) as f32).powi(2))
+                .collect(),
+            cape_top: cw,
+        }
+    }
+}
+
+impl Character {
+    /// Character `c` of a square `side` loops across, its cloths with `params`, put on
+    /// its body at its first step.
+    fn new(c: usize, side: usize, shapes: &Shapes, params: &ClothParams) -> Self {
+        let (row, column) = (c / side, c % side);
+        let walk = Walk {
+            centre: Vec3::new(column as f32 * 3.0, 0.0, row as f32 * 3.0),
+            radius: 0.8 + 0.15 * (c % 4) as f32,
+            speed: 1.0 + 0.1 * (c % 5) as f32,
+            phase: c as f32 * 0.7,
+            away: false,
         };
-        let mut crowd = Crowd {
-            characters,
-            zones: [zone],
+        let pose = walk.pose(0.0);
+        let frame = Affine3A::from_rotation_translation(pose.0, pose.1);
+        let (cape_rest, cape_fine, cape_triangles) = &shapes.cape;
+        let (skirt_rest, skirt_fine, skirt_triangles) = &shapes.skirt;
+        let mut cape = solver_of(cape_rest, cape_triangles, params, frame);
+        let mut skirt = solver_of(skirt_rest, skirt_triangles, params, frame);
+        let targets: Vec<Vec3> = skirt_rest
+            .iter()
+            .map(|&p| frame.transform_point3(p))
+            .collect();
+        skirt
+            .set_motion_constraints(&targets, &shapes.skirt_radius)
+            .expect("painted");
+        let stop = BackStop {
+            distance: 0.01,
+            radius: 0.3,
+        };
+        skirt
+            .set_back_stops(&vec![stop; skirt_rest.len()])
+            .expect("stops");
+        for cloth in [&mut cape, &mut skirt] {
+            cloth.teleport_next_step(bevy_cloth::params::TeleportMode::Reset);
+        }
+        Character {
+            walk,
+            cape: Drawn::new(cape, cape_rest.clone(), cape_fine),
+            skirt: Drawn::new(skirt, skirt_rest.clone(), skirt_fine),
+            cape_top: shapes.cape_top,
+            skirt_radius: shapes.skirt_radius.clone(),
+            last_pose: pose,
+        }
+    }
+
+    /// Moves the body to its pose at `t` (a teleport across the square when `jumps`),
+    /// and hands its cloths their pins, skinned targets, the body's capsule and `zones`.
+    fn move_to(&mut self, t: f32, dt: f32, jumps: bool, zones: &[WindZone]) {
+        if jumps {
+            self.walk.away = !self.walk.away;
+        }
+        let pose = self.walk.pose(t);
+        let body = Affine3A::from_rotation_translation(pose.0, pose.1);
+        for i in 0..self.cape_top {
+            let goal = body.transform_point3(self.cape.in_body[i as usize]);
+            self.cape.cloth.attach(i, goal).expect("a top-row particle");
+        }
+        let skirt = &mut self.skirt;
+        let targets: Vec<Vec3> = skirt
+            .in_body
+            .iter()
+            .map(|&p| body.transform_point3(p))
+            .collect();
+        skirt
+            .cloth
+            .set_motion_constraints(&targets, &self.skirt_radius)
+            .expect("painted");
+        // The body: a capsule from hips to shoulders, swept from its last pose (a
+        // teleported body is not swept across the gap).
+        let motion = if jumps {
+            Motion::NONE
+        } else {
+            Motion::between(self.last_pose, pose, dt)
+        };
+        let capsule = Collider {
+            shape: ColliderShape::from(Capsule {
+                a: pose.1 + Vec3::Y * (HIPS - 0.3),
+                b: pose.1 + Vec3::Y * (SHOULDERS - 0.05),
+                radius: BODY_RADIUS,
+            }),
+            thickness: 0.01,
+            friction: 0.3,
+            motion,
+        };
+        self.last_pose = pose;
+        for cloth in [&mut self.cape.cloth, &mut self.skirt.cloth] {
+            cloth.set_colliders([capsule.clone()]);
+            cloth.set_wind_zones(zones, t).expect("a checked zone");
+        }
+    }
+
+    fn draw(&mut self) {
+        self.cape.draw();
+        self.skirt.draw();
+    }
+}
+
+/// A gusty wind across the middle of a square `side` loops across (3 m each).
+fn wind_across(side: usize) -> WindZone {
+    let extent = side as f32 * 3.0;
+    WindZone {
+        shape: ZoneShape::Box {
+            half_extents: Vec3::new(extent, 2.0, 2.5),
+        },
+        centre: Vec3::new(extent * 0.5, 1.0, extent * 0.5),
+        velocity: Vec3::new(5.0, 0.0, 1.5),
+        falloff: 0.3,
+        turbulence: Turbulence {
+            gust: 0.4,
+            gust_period: 1.2,
+            noise: 0.3,
+            scale: 0.8,
+            seed: 11,
+        },
+        ..WindZone::default()
+    }
+}
+
+impl Crowd {
+    /// Builds the crowd of `size`, each cloth with `params`.
+    pub fn new(size: CrowdSize, params: &ClothParams) -> Self {
+        let shapes = Shapes::new(&size);
+        let side = (size.characters as f32).sqrt().ceil() as usize;
+        Crowd {
+            characters: (0..size.characters)
+                .map(|c| Character::new(c, side, &shapes, params))
+                .collect(),
+            zones: [wind_across(side)],
             env: Environment::default(),
             dt: 1.0 / 60.0,
             time: 0.0,
             size,
             teleports: 0,
-        };
-        // Spawned on their bodies.
-        for c in &mut crowd.characters {
-            for cloth in [&mut c.cape.cloth, &mut c.skirt.cloth] {
-                cloth.teleport_next_step(bevy_cloth::params::TeleportMode::Reset);
-            }
         }
-        crowd
     }
 
     /// Every cloth.
@@ -320,101 +396,66 @@ impl Crowd {
         let turn = (t / self.size.teleport_every) as usize;
         let due = (self.time / self.size.teleport_every) as usize != turn;
         let n = self.characters.len();
+        let zones = if self.size.wind { &self.zones[..] } else { &[] };
         for (k, c) in self.characters.iter_mut().enumerate() {
             let jumps = due && turn % n == k;
-            if jumps {
-                c.walk.away = !c.walk.away;
-                self.teleports += 1;
-            }
-            let pose = c.walk.pose(t);
-            let body = Affine3A::from_rotation_translation(pose.0, pose.1);
-            for i in 0..c.cape_top {
-                let goal = body.transform_point3(c.cape.in_body[i as usize]);
-                c.cape.cloth.attach(i, goal).expect("a top-row particle");
-            }
-            let targets: Vec<Vec3> = c
-                .skirt
-                .in_body
-                .iter()
-                .map(|&p| body.transform_point3(p))
-                .collect();
-            c.skirt
-                .cloth
-                .set_motion_constraints(&targets, &c.skirt_radius)
-                .expect("painted");
-            // The body: a capsule from hips to shoulders, swept from its last pose (a
-            // teleported body is not swept across the gap).
-            let motion = if jumps {
-                Motion::NONE
-            } else {
-                Motion::between(c.last_pose, pose, dt)
-            };
-            let capsule = Collider {
-                shape: ColliderShape::from(Capsule {
-                    a: pose.1 + Vec3::Y * (HIPS - 0.3),
-                    b: pose.1 + Vec3::Y * (SHOULDERS - 0.05),
-                    radius: BODY_RADIUS,
-                }),
-                thickness: 0.01,
-                friction: 0.3,
-                motion,
-            };
-            c.last_pose = pose;
-            for cloth in [&mut c.cape.cloth, &mut c.skirt.cloth] {
-                cloth.set_colliders([capsule.clone()]);
-                let zones = if self.size.wind { &self.zones[..] } else { &[] };
-                cloth.set_wind_zones(zones, t).expect("a checked zone");
-            }
+            self.teleports += jumps as usize;
+            c.move_to(t, dt, jumps, zones);
         }
         let drive = start.elapsed();
         let start = Instant::now();
+        self.step_cloths(pool);
+        let step = start.elapsed();
+        let start = Instant::now();
+        self.draw(pool);
+        let draw = start.elapsed();
+        self.time = t;
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+        FrameCost {
+            drive: ms(drive),
+            step: ms(step),
+            draw: ms(draw),
+        }
+    }
+
+    /// Steps every cloth: side by side on the pool (`solver::run_cloths`, as the plugin
+    /// does), or one after another here.
+    fn step_cloths(&mut self, pool: bool) {
+        let dt = self.dt;
         let mut cloths: Vec<&mut ClothSolver> = self
             .characters
             .iter_mut()
             .flat_map(|c| [&mut c.cape.cloth, &mut c.skirt.cloth])
             .collect();
-        if pool {
-            let mut flagged: Vec<(&mut ClothSolver, bool)> =
-                cloths.iter_mut().map(|c| (&mut **c, true)).collect();
-            solver::begin_cloths(&mut flagged, dt);
-            drop(flagged);
-            solver::run_cloths(&mut cloths, &self.env);
-            for cloth in cloths.iter_mut() {
-                cloth.end_step();
-            }
-        } else {
+        if !pool {
             for cloth in cloths.iter_mut() {
                 cloth.step(dt, &self.env);
             }
+            return;
         }
-        let step = start.elapsed();
-        let start = Instant::now();
-        if pool {
-            // Each cloth's drawing is its own: the characters in as many lots as threads.
-            let lot = self.characters.len().div_ceil(solver::threads()).max(1);
-            solver::task_pool().scope(|scope| {
-                for chunk in self.characters.chunks_mut(lot) {
-                    scope.spawn(async move {
-                        for c in chunk {
-                            c.cape.draw();
-                            c.skirt.draw();
-                        }
-                    });
-                }
-            });
-        } else {
-            for c in &mut self.characters {
-                c.cape.draw();
-                c.skirt.draw();
+        let mut flagged: Vec<(&mut ClothSolver, bool)> =
+            cloths.iter_mut().map(|c| (&mut **c, true)).collect();
+        solver::begin_cloths(&mut flagged, dt);
+        drop(flagged);
+        solver::run_cloths(&mut cloths, &self.env);
+        for cloth in cloths.iter_mut() {
+            cloth.end_step();
+        }
+    }
+
+    /// Draws every cloth: on the pool, the characters in as many lots as threads (each
+    /// cloth's drawing is its own), or one after another here.
+    fn draw(&mut self, pool: bool) {
+        if !pool {
+            self.characters.iter_mut().for_each(Character::draw);
+            return;
+        }
+        let lot = self.characters.len().div_ceil(solver::threads()).max(1);
+        solver::task_pool().scope(|scope| {
+            for chunk in self.characters.chunks_mut(lot) {
+                scope.spawn(async move { chunk.iter_mut().for_each(Character::draw) });
             }
-        }
-        let draw = start.elapsed();
-        self.time = t;
-        FrameCost {
-            drive: drive.as_secs_f64() * 1e3,
-            step: step.as_secs_f64() * 1e3,
-            draw: draw.as_secs_f64() * 1e3,
-        }
+        });
     }
 
     /// The largest structural strain over every cloth now, and whether every one is

@@ -61,6 +61,44 @@ impl Default for Turbulence {
     }
 }
 
+impl Turbulence {
+    /// Checks the shares, period and size; the error names the field.
+    fn validate(&self) -> Result<(), ClothError> {
+        let share = |v: f32, most: f32| (0.0..=most).contains(&v);
+        let (gust, period) = (self.gust, self.gust_period);
+        let (noise, scale) = (self.noise, self.scale);
+        for (field, value, ok, expected) in [
+            (
+                "wind_zone.turbulence.gust",
+                gust,
+                share(gust, 1.0),
+                "a share from 0 to 1",
+            ),
+            (
+                "wind_zone.turbulence.gust_period",
+                period,
+                period > 0.0,
+                "a time > 0 s",
+            ),
+            (
+                "wind_zone.turbulence.noise",
+                noise,
+                share(noise, 10.0),
+                "a share from 0 to 10",
+            ),
+            (
+                "wind_zone.turbulence.scale",
+                scale,
+                scale > 0.0,
+                "a size > 0 m",
+            ),
+        ] {
+            check(field, value, ok, expected)?;
+        }
+        Ok(())
+    }
+}
+
 /// A region of moving air, placed in the world: its velocity, at full strength inside
 /// and fading over the outer `falloff` share of its size to nothing at its edge, swelled
 /// by gusts and stirred by turbulence. Cloths take the zones that reach them
@@ -131,36 +169,7 @@ impl WindZone {
             (0.0..=1.0).contains(&f),
             "a share from 0 to 1",
         )?;
-        let t = &self.turbulence;
-        for (field, value, ok, expected) in [
-            (
-                "wind_zone.turbulence.gust",
-                t.gust,
-                (0.0..=1.0).contains(&t.gust),
-                "a share from 0 to 1",
-            ),
-            (
-                "wind_zone.turbulence.gust_period",
-                t.gust_period,
-                t.gust_period > 0.0,
-                "a time > 0 s",
-            ),
-            (
-                "wind_zone.turbulence.noise",
-                t.noise,
-                (0.0..=10.0).contains(&t.noise),
-                "a share from 0 to 10",
-            ),
-            (
-                "wind_zone.turbulence.scale",
-                t.scale,
-                t.scale > 0.0,
-                "a size > 0 m",
-            ),
-        ] {
-            check(field, value, ok, expected)?;
-        }
-        Ok(())
+        self.turbulence.validate()
     }
 
     /// Whether it can reach anything within `radius` of `centre`.

@@ -97,6 +97,23 @@ fn nearest_squared(p: Vec3, [a, b, c]: [Vec3; 3]) -> f32 {
     (p - (a + ab * v + ac * w)).length_squared()
 }
 
+/// The triangle of `usable` (corners, centre, reach) over `x` nearest `p`; those whose
+/// sphere is farther than the nearest so far are passed over.
+fn nearest_triangle(x: &[Vec3], usable: &[([u32; 3], Vec3, f32)], p: Vec3) -> [u32; 3] {
+    let (mut best, mut best_d2) = (usable[0].0, f32::INFINITY);
+    for &(t, centre, reach) in usable {
+        let far = p.distance(centre) - reach;
+        if far > 0.0 && far * far >= best_d2 {
+            continue;
+        }
+        let d2 = nearest_squared(p, t.map(|i| x[i as usize]));
+        if d2 < best_d2 {
+            (best, best_d2) = (t, d2);
+        }
+    }
+    best
+}
+
 impl ProxyBinding {
     /// Binds each of `render` (with its tangents, if any) to the triangle of `triangles`
     /// over `x` nearest it, all in one frame (the simulation's rest, or its positions
@@ -128,17 +145,7 @@ impl ProxyBinding {
             .iter()
             .enumerate()
             .map(|(v, &p)| {
-                let (mut best, mut best_d2) = (usable[0].0, f32::INFINITY);
-                for &(t, centre, reach) in &usable {
-                    let far = p.distance(centre) - reach;
-                    if far > 0.0 && far * far >= best_d2 {
-                        continue;
-                    }
-                    let d2 = nearest_squared(p, t.map(|i| x[i as usize]));
-                    if d2 < best_d2 {
-                        (best, best_d2) = (t, d2);
-                    }
-                }
+                let best = nearest_triangle(x, &usable, p);
                 let (along, across, normal) = frame(x, best).expect("usable");
                 let (weights, height) = project(p, best.map(|i| x[i as usize]), normal);
                 let tangent = tangents.and_then(|t| t.get(v)).map_or(Vec4::ZERO, |t| {

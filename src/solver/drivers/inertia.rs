@@ -50,15 +50,14 @@ pub(in crate::solver) struct Felt {
     by: Option<RigidMove>,
     carried: Option<RigidMove>,
     from: Vec<Vec3>,
+    /// The buffer `from` is copied into next (the last one's, kept for its storage).
+    spare: Vec<Vec3>,
 }
 
 impl Felt {
     /// Forgets the last step (after a teleport, or with inertia off).
     pub(in crate::solver) fn clear(&mut self) {
-        *self = Felt {
-            from: std::mem::take(&mut self.from),
-            ..Felt::default()
-        };
+        (self.by, self.carried) = (None, None);
         self.from.clear();
     }
 }
@@ -83,61 +82,64 @@ impl ClothSolver {
         let last = self.felt.by.replace(felt);
         let last_carried = self.felt.carried.take();
         let n = self.particles.len();
-        let from = std::mem::take(&mut self.felt.from);
-        self.felt.from.clone_from(&self.particles.position);
-        let Some(last) = last.filter(|_| from.len() == n && shares != (0.0, 0.0)) else {
-            return;
-        };
-        let carried = felt.share(shares);
-        let targets = self.in_the_frame(&from, felt, last, last_carried, shares, dt);
-        self.move_rigidly(carried, true);
-        // Each free particle moves from where it was carried to its blended target.
-        let h = self.clock.h;
-        let p = &mut self.particles;
-        for (i, target) in targets.into_iter().enumerate() {
-            if p.inv_mass[i] != 0.0 {
-                p.velocity[i] = (target - p.position[i]) / dt;
-                p.previous[i] = p.position[i] - p.velocity[i] * h;
+        // Where each particle starts this step, for the next; the last step's starts,
+        // which become each particle's target here (no allocation once warm).
+        let mut from = std::mem::take(&mut self.felt.from);
+        let mut now = std::mem::take(&mut self.felt.spare);
+        now.clone_from(&self.particles.position);
+        self.felt.from = now;
+        if let Some(last) = last.filter(|_| from.len() == n && shares != (0.0, 0.0)) {
+            let carried = felt.share(shares);
+            self.aim_in_the_frame(&mut from, felt, last, last_carried, shares, dt);
+            self.move_rigidly(carried, true);
+            // Each free particle moves from where it was carried to its blended target.
+            let h = self.clock.h;
+            let p = &mut self.particles;
+            for (i, &target) in from.iter().enumerate() {
+                if p.inv_mass[i] != 0.0 {
+                    p.velocity[i] = (target - p.position[i]) / dt;
+                    p.previous[i] = p.position[i] - p.velocity[i] * h;
+                }
             }
+            self.felt.carried = Some(carried);
         }
-        self.felt.carried = Some(carried);
+        self.felt.spare = from;
     }
 
-    /// Where each particle would be a step from now: as in world space (its velocity
-    /// carried on, with what last step's share `last_carried` carried it by), moved the
-    /// shares `(linear, angular)` of the way to where the frame (moving by `last`, then
-    /// `felt`) takes it, its motion relative to the frame carried on.
-    fn in_the_frame(
+    /// Replaces where each particle started the last step (`from`) with where it would
+    /// be a step from now: as in world space (its velocity carried on, with what last
+    /// step's share `last_carried` carried it by), moved the shares `(linear, angular)`
+    /// of the way to where the frame (moving by `last`, then `felt`) takes it, its motion
+    /// relative to the frame carried on.
+    fn aim_in_the_frame(
         &self,
-        from: &[Vec3],
+        from: &mut [Vec3],
         felt: RigidMove,
         last: RigidMove,
         last_carried: Option<RigidMove>,
         (linear, angular): (f32, f32),
         dt: f32,
-    ) -> Vec<Vec3> {
+    ) {
         // The change in the frame's displacement: the whole of its linear part.
         let accelerated = (felt.to_centre - felt.from_centre) - (last.to_centre - last.from_centre);
         let carried = last_carried.unwrap_or(RigidMove::IDENTITY);
         let h = self.clock.h;
         let verlet = self.params.integrator == Integrator::Verlet;
         let p = &self.particles;
-        (0..p.len())
-            .map(|i| {
-                let x = p.position[i];
-                // Verlet's velocity is its last displacement (the constraints' share in
-                // it), which the carry last step is not part of.
-                let v = if verlet {
-                    (x - p.previous[i]) / h
-                } else {
-                    p.velocity[i]
-                };
-                let world = carried.apply(x) + v * dt;
-                let local = felt.apply(2.0 * x - last.apply(from[i]));
-                let turned = local - world - accelerated;
-                world + linear * accelerated + angular * turned
-            })
-            .collect()
+        for (i, start) in from.iter_mut().enumerate() {
+            let x = p.position[i];
+            // Verlet's velocity is its last displacement (the constraints' share in it),
+            // which the carry last step is not part of.
+            let v = if verlet {
+                (x - p.previous[i]) / h
+            } else {
+                p.velocity[i]
+            };
+            let world = carried.apply(x) + v * dt;
+            let local = felt.apply(2.0 * x - last.apply(*start));
+            let turned = local - world - accelerated;
+            *start = world + linear * accelerated + angular * turned;
+        }
     }
 }
 
