@@ -42,9 +42,18 @@ pub fn begin_cloths(cloths: &mut [(&mut ClothSolver, bool)], dt: f32) {
 /// One thread ([`set_parallel`](super::set_parallel)`(false)`) runs them all here.
 pub fn run_cloths(cloths: &mut [&mut ClothSolver], env: &Environment) {
     let left = |c: &ClothSolver| c.report.substeps.saturating_sub(c.report.taken);
+    if cloths.iter().filter(|c| left(c) > 0).count() <= 1 {
+        // One cloth at work: on this thread (its own kernels use the pool).
+        for cloth in cloths.iter_mut() {
+            for _ in 0..left(cloth) {
+                cloth.substep(env);
+            }
+        }
+        return;
+    }
     let threads = super::threads();
-    if threads <= 1 || cloths.iter().filter(|c| left(c) > 0).count() <= 1 {
-        // One cloth at work (its own kernels use the pool), or one thread: here.
+    if threads <= 1 {
+        // One thread: here, one after another (those in contact together).
         let (touching, alone): (Vec<_>, Vec<_>) = cloths
             .iter_mut()
             .map(|c| &mut **c)
