@@ -36,6 +36,20 @@ struct BodySource<'a> {
     back: Option<&'a ClothBackStop>,
 }
 
+impl<'a> BodySource<'a> {
+    /// The entity's skin (or the one taken off it when it was last built, kept in its
+    /// `body`), and its painted max distance and back stop.
+    fn of(
+        skin: Option<&'a SkinnedMesh>,
+        body: Option<&'a ClothBody>,
+        max: Option<&'a ClothMaxDistance>,
+        back: Option<&'a ClothBackStop>,
+    ) -> Self {
+        let skin = skin.or(body.and_then(|b| b.skin.as_ref().map(|s| &s.mesh)));
+        BodySource { skin, max, back }
+    }
+}
+
 /// A built cloth: its solver, its mesh, and for a mesh-shaped cloth its body.
 struct BuiltCloth {
     solver: solver::ClothSolver,
@@ -309,17 +323,12 @@ pub(crate) fn build_cloths(
         (skin, body, max, back),
     ) in &mut cloths
     {
+        // Where it is now (the fixed step runs before this frame's transforms propagate).
         let frame = transforms
             .compute_global_transform(entity)
-            .map(|g| g.affine())
-            .unwrap_or_default();
-        // A reloaded garment or a changed max distance rebuilds, as a changed shape does
-        // (both read every time: `|`, not `||`).
-        let forced = garment
-            .as_mut()
-            .is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed))
-            | max.as_ref().is_some_and(|m| m.is_changed())
-            | back.as_ref().is_some_and(|b| b.is_changed());
+            .map(|g| g.affine());
+        let frame = frame.unwrap_or_default();
+        let forced = reloaded_or_repainted(garment.as_mut(), max.as_ref(), back.as_ref());
         // The pins it has: `Auto` pins nothing on an attached cloth.
         let pins = cloth.pins.when_attached(attached);
         let forced = forced || sim.as_ref().is_some_and(|s| s.built_from.1 != *pins);
@@ -343,21 +352,28 @@ pub(crate) fn build_cloths(
                 continue;
             }
         };
-        let body_source = BodySource {
-            // The entity's skin, or the one taken off it when it was last built.
-            skin: skin.or(body.and_then(|b| b.skin.as_ref().map(|s| &s.mesh))),
-            max: max.as_deref(),
-            back: back.as_deref(),
-        };
+        let body_source = BodySource::of(skin, body, max.as_deref(), back.as_deref());
         match build_one(cloth, frame, layout_source, body_source) {
-            Ok(Some(built)) => {
-                let source = source_handle;
-                insert_built(&mut commands, entity, cloth, built, &mut meshes, source);
+            Ok(Some(b)) => {
+                insert_built(&mut commands, entity, cloth, b, &mut meshes, source_handle)
             }
             Ok(None) => {}
             Err(e) => invalidate(&mut commands, entity, e),
         }
     }
+}
+
+/// Whether a reloaded garment or a repainted max distance or back stop rebuilds the
+/// cloth, as a changed shape does (each read every time: `|`, not `||`, so the garment's
+/// flag is taken).
+fn reloaded_or_repainted(
+    garment: Option<&mut Mut<ClothGarment>>,
+    max: Option<&Ref<ClothMaxDistance>>,
+    back: Option<&Ref<ClothBackStop>>,
+) -> bool {
+    garment.is_some_and(|g| std::mem::take(&mut g.bypass_change_detection().changed))
+        | max.is_some_and(|m| m.is_changed())
+        | back.is_some_and(|b| b.is_changed())
 }
 
 /// Whether a cloth must be built (again): always when it has no simulation, unless it was

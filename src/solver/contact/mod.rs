@@ -415,21 +415,7 @@ impl World<'_> {
             // Of that, no more than the cap this substep: the rest waits for the next.
             shift += n * before;
             if before > self.depenetration {
-                x -= n * before;
-                shift -= n * before;
-                let out = self.way_out(k, x, n, before, &exit);
-                x += out;
-                shift += out;
-                // A particle on its way out keeps no motion back in: what the cloth's
-                // constraints pulled it in by is taken out of its velocity, or they would
-                // pump momentum into it every substep that moving `previous` with it
-                // hides, and launch its neighbours.
-                let d = out.normalize_or_zero();
-                let into = (x - self.start(k, previous + shift)).dot(d);
-                if into < 0.0 {
-                    shift += d * into;
-                    add_push(pushes, k, -d * into);
-                }
+                (x, shift) = self.capped_exit((k, n, before), x, previous, shift, &exit, pushes);
             }
             add_push(pushes, k, push - n * before);
             // Stopped where its path met the surface, its motion into the surface ends
@@ -449,6 +435,32 @@ impl World<'_> {
         x += friction;
         add_push(pushes, k, friction);
         Some((x, previous))
+    }
+
+    /// A particle at `x` that was `before` deep in collider `k` (outward normal `n`) at
+    /// the substep's start, more than the cap, its `previous` shifted by `shift`: instead
+    /// of the whole way out along `n`, it moves out by the cap ([`Self::way_out`]), and
+    /// keeps no motion back in (what the cloth's constraints pulled it in by is taken out
+    /// of its velocity, or they would pump momentum into it every substep that moving
+    /// `previous` with it hides, and launch its neighbours). Its new position and shift.
+    fn capped_exit(
+        &self,
+        (k, n, before): (usize, Vec3, f32),
+        x: Vec3,
+        previous: Vec3,
+        shift: Vec3,
+        exit: &impl Fn() -> Option<Vec3>,
+        pushes: &mut Vec<(usize, Vec3)>,
+    ) -> (Vec3, Vec3) {
+        let out = self.way_out(k, x - n * before, n, before, exit);
+        let (x, mut shift) = (x - n * before + out, shift - n * before + out);
+        let d = out.normalize_or_zero();
+        let into = (x - self.start(k, previous + shift)).dot(d);
+        if into < 0.0 {
+            shift += d * into;
+            add_push(pushes, k, -d * into);
+        }
+        (x, shift)
     }
 
     /// How a particle at `x`, `before` deep in collider `k` (outward normal `n`) since
