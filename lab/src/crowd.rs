@@ -125,6 +125,11 @@ impl Drawn {
     }
 }
 
+/// The crowd's cloths' parameters.
+pub fn crowd_params() -> ClothParams {
+    ClothParams::default()
+}
+
 /// A grid's rest positions in its own frame (x across, y down from 0), `k` times finer.
 fn grid_points(w: u32, h: u32, spacing: f32, k: u32) -> Vec<Vec3> {
     let (fw, fh) = ((w - 1) * k + 1, (h - 1) * k + 1);
@@ -510,8 +515,11 @@ pub struct CrowdCost {
     pub pool: PartCosts,
     /// Teleports in the pool's run.
     pub teleports: usize,
-    /// The largest structural strain at the end, and whether every cloth stayed stable.
-    pub strain: f32,
+    /// The largest structural strain of any cloth in a frame, over the pool's timed
+    /// frames: median, min, max.
+    pub strain: [f64; 3],
+    /// The substeps of the cloths' last step: fewest, most.
+    pub substeps: (u32, u32),
     /// Whether every cloth stayed stable in both runs.
     pub stable: bool,
 }
@@ -539,6 +547,7 @@ fn spread(mut v: Vec<f64>) -> [f64; 3] {
 pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize) -> CrowdCost {
     let mut crowds = [Crowd::new(size, params), Crowd::new(size, params)];
     let mut costs: [Vec<FrameCost>; 2] = [Vec::new(), Vec::new()];
+    let mut strains = Vec::new();
     for f in 0..warm + frames {
         for (k, crowd) in crowds.iter_mut().enumerate() {
             let pool = k == 1;
@@ -546,6 +555,9 @@ pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize
             let cost = crowd.frame(pool);
             if f >= warm {
                 costs[k].push(cost);
+                if pool {
+                    strains.push(crowd.health().0 as f64);
+                }
             }
         }
     }
@@ -565,7 +577,10 @@ pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize
         one_thread: parts[0],
         pool: parts[1],
         teleports: crowds[1].teleports,
-        strain: health[0].0.max(health[1].0),
+        strain: spread(strains),
+        substeps: crowds[1].cloths().fold((u32::MAX, 0), |(least, most), c| {
+            (least.min(c.substeps()), most.max(c.substeps()))
+        }),
         stable: health[0].1 && health[1].1,
     }
 }

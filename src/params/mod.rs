@@ -19,7 +19,7 @@ mod self_collision;
 mod springs;
 mod wind_zone;
 
-pub use environment::{Air, Environment, Wind, WindAt, WindField};
+pub use environment::{Air, AirUpdate, Environment, Wind, WindAt, WindField};
 pub use following::{Inertia, Teleport, TeleportMode};
 pub use models::{
     GoalUpdate, Model, ModelKind, PatchParams, PatchTargets, RotationMethod, ShapeMatchingParams,

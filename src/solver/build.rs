@@ -47,7 +47,7 @@ impl ClothSolver {
             drivers_motion: None,
             felt: Default::default(),
             wind: Default::default(),
-            air: Vec::new(),
+            air: Default::default(),
         };
         cloth.clock.substeps = 1;
         if params.fabric.is_some() {

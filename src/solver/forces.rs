@@ -7,7 +7,7 @@ use super::parallel;
 use super::state::ParticleChunk;
 use super::{ClothSolver, Particles, SpringKind, Springs};
 use crate::error::ClothError;
-use crate::params::{Air, Environment, WindZone, ZoneAt};
+use crate::params::{Air, AirUpdate, Environment, WindZone, ZoneAt};
 
 /// The wind zones blowing on a cloth ([`ClothSolver::set_wind_zones`]).
 #[derive(Clone, Debug, Default)]
@@ -20,6 +20,49 @@ pub(super) struct Blowing {
     at: Vec<Vec3>,
     /// The zones at the step's time (kept for its storage).
     now: Vec<ZoneAt>,
+}
+
+/// Each particle's share of the air's force as last worked out on the triangles
+/// ([`AirUpdate`]): at the velocity it had then, with the drag's rate and its derivative
+/// along the triangles' normals.
+#[derive(Clone, Debug, Default)]
+pub(super) struct AirLoad {
+    /// The force, N.
+    force: Vec<Vec3>,
+    /// The drag rate `Σ ½ ρ C_d A |w·n| / 3`, N·s/m (of the backward-Euler factor).
+    rate: Vec<f32>,
+    /// `D = Σ ρ C_d A |w·n| n nᵀ / 3`, N·s/m, as (xx, yy, zz, xy, xz, yz).
+    slope: Vec<[f32; 6]>,
+    /// The velocity it was worked out at, m/s.
+    velocity: Vec<Vec3>,
+    /// Worked out in this step (cleared as each step starts).
+    pub(super) current: bool,
+}
+
+impl AirLoad {
+    fn clear(&mut self, n: usize) {
+        for v in [&mut self.force, &mut self.velocity] {
+            v.clear();
+            v.resize(n, Vec3::ZERO);
+        }
+        self.rate.clear();
+        self.rate.resize(n, 0.0);
+        self.slope.clear();
+        self.slope.resize(n, [0.0; 6]);
+    }
+
+    /// Particle `i`'s force at velocity `v`: `f₀ − D (v − v₀)`.
+    #[inline(always)]
+    fn at(&self, i: usize, v: Vec3) -> Vec3 {
+        let [xx, yy, zz, xy, xz, yz] = self.slope[i];
+        let d = v - self.velocity[i];
+        let change = Vec3::new(
+            xx * d.x + xy * d.y + xz * d.z,
+            xy * d.x + yy * d.y + yz * d.z,
+            xz * d.x + yz * d.y + zz * d.z,
+        );
+        self.force[i] - change
+    }
 }
 
 impl ClothSolver {
@@ -122,13 +165,34 @@ impl ClothSolver {
 
     /// Adds the air's force on every shown triangle, a third to each corner, each
     /// particle's share scaled by the backward-Euler factor of its drag rate (see
-    /// [`Air`]).
+    /// [`Air`]): worked out on the triangles at the step's first substep and taken
+    /// linearised in the velocity at the others, or worked out every substep
+    /// ([`AirUpdate`]).
     fn air_forces(&mut self, air: &Air) {
-        let (h, time) = (self.clock.h, self.clock.time);
-        let (s, p) = (&self.structure, &mut self.particles);
-        let scratch = &mut self.air;
-        scratch.clear();
-        scratch.resize(p.len(), (Vec3::ZERO, 0.0));
+        let n = self.particles.len();
+        let load = &self.air;
+        if !load.current || load.force.len() != n || air.update == AirUpdate::Substep {
+            self.air_on_triangles(air);
+        }
+        let (h, load, p) = (self.clock.h, &self.air, &mut self.particles);
+        for i in 0..n {
+            let w = p.inv_mass[i];
+            if w != 0.0 {
+                p.force[i] += load.at(i, p.velocity[i]) / (1.0 + h * load.rate[i] * w);
+            }
+        }
+    }
+
+    /// Works out each particle's share of the air's force on the shown triangles, its
+    /// drag rate and the rate's change along their normals, at the cloth's shape and
+    /// velocity now.
+    fn air_on_triangles(&mut self, air: &Air) {
+        let time = self.clock.time;
+        let (s, p) = (&self.structure, &self.particles);
+        let load = &mut self.air;
+        load.clear(p.len());
+        load.velocity.copy_from_slice(&p.velocity);
+        load.current = true;
         let half_rho = 0.5 * air.density;
         let flow = air.at_time(time);
         let zones = &self.wind.at;
@@ -160,15 +224,23 @@ impl ClothSolver {
             let lift = half_rho * air.lift * area * wn * across.length() * lift_dir;
             let share = (drag + lift) / 3.0;
             let rate = half_rho * air.drag * area * wn.abs() / 3.0;
+            // The drag's derivative in the particle's velocity (with its triangle's),
+            // `2 rate n nᵀ`.
+            let (d, m) = (2.0 * rate, normal);
+            let slope = [
+                d * m.x * m.x,
+                d * m.y * m.y,
+                d * m.z * m.z,
+                d * m.x * m.y,
+                d * m.x * m.z,
+                d * m.y * m.z,
+            ];
             for i in [a, b, c] {
-                scratch[i].0 += share;
-                scratch[i].1 += rate;
-            }
-        }
-        for (i, &(force, rate)) in scratch.iter().enumerate() {
-            let w = p.inv_mass[i];
-            if w != 0.0 {
-                p.force[i] += force / (1.0 + h * rate * w);
+                load.force[i] += share;
+                load.rate[i] += rate;
+                for (sum, add) in load.slope[i].iter_mut().zip(slope) {
+                    *sum += add;
+                }
             }
         }
     }

@@ -57,7 +57,7 @@ pub use steps::{StageTimes, StepReport};
 pub use substeps::unit_hash;
 pub use topology::{SpringKind, Springs};
 
-use bevy::math::{Affine3A, Vec3};
+use bevy::math::Affine3A;
 
 use crate::error::ClothError;
 use crate::params::{ClothParams, Model};
@@ -100,9 +100,9 @@ pub struct ClothSolver {
     /// The part of it the cloth felt and where it started, while its
     /// [`Inertia`](crate::params::Inertia) is scaled.
     felt: drivers::inertia::Felt,
-    /// Each particle's share of the air's force and its drag rate's numerator, this
-    /// substep (`forces.rs`; kept for its storage).
-    air: Vec<(Vec3, f32)>,
+    /// Each particle's share of the air's force, as worked out on the triangles
+    /// (`forces.rs`).
+    air: forces::AirLoad,
     /// The wind zones that reach it.
     wind: forces::Blowing,
 }

@@ -262,6 +262,7 @@ impl ClothSolver {
         let p = &self.particles.position;
         self.drivers.begin_step(p, &self.structure.local_rest);
         self.blow_at_particles();
+        self.air.current = false;
         self.structure.torn_this_step.clear();
         self.contact
             .collider_impulses
