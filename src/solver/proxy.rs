@@ -97,21 +97,128 @@ fn nearest_squared(p: Vec3, [a, b, c]: [Vec3; 3]) -> f32 {
     (p - (a + ab * v + ac * w)).length_squared()
 }
 
-/// The triangle of `usable` (corners, centre, reach) over `x` nearest `p`; those whose
-/// sphere is farther than the nearest so far are passed over.
-fn nearest_triangle(x: &[Vec3], usable: &[([u32; 3], Vec3, f32)], p: Vec3) -> [u32; 3] {
-    let (mut best, mut best_d2) = (usable[0].0, f32::INFINITY);
-    for &(t, centre, reach) in usable {
-        let far = p.distance(centre) - reach;
-        if far > 0.0 && far * far >= best_d2 {
-            continue;
+/// The usable triangles (corners, centre, reach) bucketed by their centres in a uniform
+/// grid, so that a vertex's nearest triangle is searched among its neighbours, ring by
+/// ring of cells outward, instead of among all of them.
+struct Buckets<'a> {
+    usable: &'a [([u32; 3], Vec3, f32)],
+    low: Vec3,
+    cell: f32,
+    dims: [i32; 3],
+    /// Each cell's first entry in `items` (one more than the cells: the end).
+    start: Vec<u32>,
+    /// Triangles (indices into `usable`), cell by cell, in index order within each.
+    items: Vec<u32>,
+    /// The largest reach.
+    reach: f32,
+}
+
+impl<'a> Buckets<'a> {
+    fn new(usable: &'a [([u32; 3], Vec3, f32)]) -> Self {
+        let (mut low, mut high) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for &(_, centre, _) in usable {
+            (low, high) = (low.min(centre), high.max(centre));
         }
-        let d2 = nearest_squared(p, t.map(|i| x[i as usize]));
-        if d2 < best_d2 {
-            (best, best_d2) = (t, d2);
+        let reach = usable.iter().map(|u| u.2).fold(0.0, f32::max);
+        // Cells about two reaches wide (a triangle or two each on a cloth), widened
+        // until there are at most four cells a triangle.
+        let extent = (high - low).max(Vec3::splat(f32::EPSILON));
+        let mut cell = (2.0 * reach).max(extent.max_element() * 1e-3);
+        let dims_of = |cell: f32| (extent / cell).floor().as_ivec3() + 1;
+        while dims_of(cell).as_i64vec3().element_product() > 4 * usable.len() as i64 + 8 {
+            cell *= 1.5;
+        }
+        let dims = dims_of(cell).to_array();
+        let mut buckets = Buckets {
+            usable,
+            low,
+            cell,
+            dims,
+            start: Vec::new(),
+            items: Vec::new(),
+            reach,
+        };
+        let cells = (dims[0] * dims[1] * dims[2]) as usize;
+        let of: Vec<usize> = usable
+            .iter()
+            .map(|u| buckets.index(buckets.cell_of(u.1)))
+            .collect();
+        let mut count = vec![0u32; cells + 1];
+        for &c in &of {
+            count[c + 1] += 1;
+        }
+        for c in 0..cells {
+            count[c + 1] += count[c];
+        }
+        buckets.start = count.clone();
+        buckets.items = vec![0; usable.len()];
+        for (t, &c) in of.iter().enumerate() {
+            buckets.items[count[c] as usize] = t as u32;
+            count[c] += 1;
+        }
+        buckets
+    }
+
+    /// The cell `p` is in, or nearest it.
+    fn cell_of(&self, p: Vec3) -> [i32; 3] {
+        let c = ((p - self.low) / self.cell).floor().as_ivec3();
+        [0, 1, 2].map(|k| c[k].clamp(0, self.dims[k] - 1))
+    }
+
+    fn index(&self, [x, y, z]: [i32; 3]) -> usize {
+        ((z * self.dims[1] + y) * self.dims[0] + x) as usize
+    }
+
+    /// The triangle over `x` nearest `p` (of those equally near, the first), as a search
+    /// over every one finds it.
+    fn nearest(&self, x: &[Vec3], p: Vec3) -> [u32; 3] {
+        let home = self.cell_of(p);
+        let (mut best, mut best_d2) = (u32::MAX, f32::INFINITY);
+        let most = self.dims.into_iter().max().unwrap_or(1);
+        for ring in 0..=most {
+            // Every centre in this ring or beyond is at least `(ring − 1)·cell` from
+            // `p` (or from its nearest point in the grid's box, which is nearer), its
+            // triangle at least `reach` less.
+            let gap = (ring as f32 - 1.0) * self.cell - self.reach;
+            if best != u32::MAX && gap > 0.0 && gap * gap > best_d2 {
+                break;
+            }
+            self.visit_ring(home, ring, |t| {
+                let (corners, centre, reach) = self.usable[t as usize];
+                let far = p.distance(centre) - reach;
+                if far > 0.0 && far * far > best_d2 {
+                    return;
+                }
+                let d2 = nearest_squared(p, corners.map(|i| x[i as usize]));
+                if d2 < best_d2 || (d2 == best_d2 && t < best) {
+                    (best, best_d2) = (t, d2);
+                }
+            });
+        }
+        self.usable[best as usize].0
+    }
+
+    /// Calls `visit` with each triangle in the cells `ring` cells from `home` (in every
+    /// direction, the shell of a cube).
+    fn visit_ring(&self, home: [i32; 3], ring: i32, mut visit: impl FnMut(u32)) {
+        let range = |k: usize| (home[k] - ring).max(0)..=(home[k] + ring).min(self.dims[k] - 1);
+        for z in range(2) {
+            for y in range(1) {
+                for x in range(0) {
+                    let shell = [x - home[0], y - home[1], z - home[2]]
+                        .iter()
+                        .any(|d| d.abs() == ring);
+                    if !shell {
+                        continue;
+                    }
+                    let c = self.index([x, y, z]);
+                    for &t in &self.items[self.start[c] as usize..self.start[c + 1] as usize] {
+                        visit(t);
+                    }
+                }
+            }
         }
     }
-    best
 }
 
 impl ProxyBinding {
@@ -139,13 +246,14 @@ impl ProxyBinding {
         if usable.is_empty() {
             return None;
         }
+        let buckets = Buckets::new(&usable);
         let mut index_of = std::collections::HashMap::new();
         let mut used: Vec<[u32; 3]> = Vec::new();
         let bound = render
             .iter()
             .enumerate()
             .map(|(v, &p)| {
-                let best = nearest_triangle(x, &usable, p);
+                let best = buckets.nearest(x, p);
                 let (along, across, normal) = frame(x, best).expect("usable");
                 let (weights, height) = project(p, best.map(|i| x[i as usize]), normal);
                 let tangent = tangents.and_then(|t| t.get(v)).map_or(Vec4::ZERO, |t| {
@@ -264,6 +372,61 @@ mod tests {
             );
             assert!(Vec3::from(out_n[v]).distance(turn * Vec3::Z) < 1e-5);
             assert!(Vec3::from_slice(&out_t[v][..3]).distance(turn * Vec3::X) < 1e-5);
+        }
+    }
+
+    /// The search ring by ring through the cells finds the triangle a search over every
+    /// triangle finds (of those equally near, the first): for points on a crumpled sheet's
+    /// corners and edges (where two or more triangles are equally near), above it,
+    /// beside it and far off it.
+    #[test]
+    fn the_bucketed_search_finds_the_nearest_triangle() {
+        let (w, h) = (13u32, 9u32);
+        let x: Vec<Vec3> = (0..w * h)
+            .map(|v| {
+                let (i, j) = ((v % w) as f32, (v / w) as f32);
+                Vec3::new(0.1 * i, 0.1 * j, 0.03 * (1.7 * i).sin() * (0.9 * j).cos())
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let v = j * w + i;
+                triangles.push([v, v + 1, v + w]);
+                triangles.push([v + 1, v + w + 1, v + w]);
+            }
+        }
+        let usable: Vec<([u32; 3], Vec3, f32)> = triangles
+            .iter()
+            .map(|&t| {
+                let p = t.map(|i| x[i as usize]);
+                let centre = (p[0] + p[1] + p[2]) / 3.0;
+                let reach = p.iter().map(|q| q.distance(centre)).fold(0.0, f32::max);
+                (t, centre, reach)
+            })
+            .collect();
+        let buckets = Buckets::new(&usable);
+        let every = |p: Vec3| {
+            let d2 = |t: [u32; 3]| nearest_squared(p, t.map(|i| x[i as usize]));
+            usable
+                .iter()
+                .map(|u| u.0)
+                .reduce(|best, t| if d2(t) < d2(best) { t } else { best })
+                .unwrap()
+        };
+        let mut points: Vec<Vec3> = x.clone();
+        points.extend(x.windows(2).map(|p| (p[0] + p[1]) * 0.5));
+        for k in 0..400 {
+            let f = k as f32;
+            let spread = if k % 4 == 0 { 8.0 } else { 1.5 };
+            points.push(Vec3::new(
+                spread * ((0.37 * f).sin() * 0.5 + 0.3),
+                spread * ((0.71 * f).cos() * 0.5 + 0.3),
+                0.2 * spread * (1.3 * f).sin(),
+            ));
+        }
+        for p in points {
+            assert_eq!(buckets.nearest(&x, p), every(p), "{p}");
         }
     }
 }
