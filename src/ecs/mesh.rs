@@ -1,12 +1,13 @@
 //! The cloth's render mesh: built once, then rewritten in place after each fixed step.
 
 use bevy::asset::RenderAssetUsages;
+use bevy::ecs::system::SystemState;
 use bevy::math::Vec3;
 use bevy::mesh::{Indices, Mesh, PrimitiveTopology, VertexAttributeValues};
-use bevy::prelude::{Assets, Fixed, Mesh3d, Query, Res, ResMut, Time, Visibility};
+use bevy::prelude::{Assets, Fixed, Local, Mesh3d, Query, Res, ResMut, Time, Visibility, World};
 
 use crate::ecs::cloth::{ClothInterpolation, ClothSimulation};
-use crate::ecs::proxy::{ProxyBound, write_proxy};
+use crate::ecs::proxy::{ProxyBound, give_to_mesh, place_proxy};
 
 use crate::error::ClothError;
 use crate::solver;
@@ -177,22 +178,46 @@ pub fn mesh_triangles(mesh: &Mesh) -> Result<MeshSource, ClothError> {
 /// With [`ClothInterpolation`] on, a cloth that moved in its last step is written every
 /// frame, between where that step began and where it ended (its normals are the step's
 /// end's, computed once a step).
-fn write_meshes(
-    mut meshes: ResMut<Assets<Mesh>>,
-    interpolation: Option<Res<ClothInterpolation>>,
-    fixed: Res<Time<Fixed>>,
-    mut cloths: Query<(
-        &mut ClothSimulation,
-        &Mesh3d,
-        Option<&Visibility>,
-        Option<&mut ProxyBound>,
-    )>,
-) {
+///
+/// Each cloth's normals and its proxy's vertices are worked out side by side on the
+/// compute pool, then handed to the meshes one after another.
+fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>>) {
+    let state = state.get_or_insert_with(|| SystemState::new(world));
+    let Ok((mut meshes, interpolation, fixed, mut cloths)) = state.get_mut(world) else {
+        return; // no fixed clock or no mesh assets: nothing is drawn
+    };
     let blend = interpolation.is_some_and(|i| i.0);
     let t = fixed.overstep_fraction().clamp(0.0, 1.0);
+    let due = |sim: &ClothSimulation, visibility: Option<&Visibility>| {
+        (sim.mesh_dirty || blend && sim.blending) && visibility != Some(&Visibility::Hidden)
+    };
+    // Each cloth's own work side by side: its normals once a step, and a proxy's render
+    // vertices placed in its own buffers (a crowd's proxies took a fifth of its step
+    // when placed one after another). An exclusive system, so that the calling thread
+    // works beside the compute pool's (on two cores Bevy gives the pool one thread).
+    let work: Vec<_> = cloths
+        .iter_mut()
+        .filter(|(sim, _, visibility, _)| due(sim, *visibility))
+        .map(|(sim, _, _, proxy)| {
+            let n = proxy.as_ref().map_or(0, |p| p.len()) + sim.solver.particle_count();
+            (n as u64, (sim, proxy))
+        })
+        .collect();
+    solver::in_lots(work, |lot| {
+        for (mut sim, proxy) in lot {
+            let sim = &mut *sim;
+            if sim.mesh_dirty {
+                sim.solver.normals_into(&mut sim.normals);
+            }
+            if let Some(mut bound) = proxy {
+                let from = (blend && sim.blending).then_some((sim.previous.as_slice(), t));
+                place_proxy(&sim.solver, &mut bound, &sim.normals, from);
+            }
+        }
+    });
+    // Then into the meshes, one after another (the assets are one resource).
     for (mut sim, mesh3d, visibility, proxy) in &mut cloths {
-        let blending = blend && sim.blending;
-        if !(sim.mesh_dirty || blending) || visibility == Some(&Visibility::Hidden) {
+        if !due(&sim, visibility) {
             continue;
         }
         let Some(mut mesh) = meshes.get_mut(&mesh3d.0) else {
@@ -200,18 +225,32 @@ fn write_meshes(
         };
         let sim = &mut *sim;
         let faces_changed = sim.solver.take_faces_changed();
-        if sim.mesh_dirty {
-            sim.solver.normals_into(&mut sim.normals);
-        }
-        let from = blending.then_some((sim.previous.as_slice(), t));
+        let from = (blend && sim.blending).then_some((sim.previous.as_slice(), t));
         match proxy {
             // A proxy's triangles are its own: torn faces stay drawn.
-            Some(mut bound) => write_proxy(&mut mesh, &sim.solver, &mut bound, &sim.normals, from),
+            Some(mut bound) => give_to_mesh(&mut mesh, &mut bound),
             None => write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from),
         }
         sim.mesh_dirty = false;
     }
 }
+
+/// What [`write_meshes`] reads and writes.
+type Drawing = (
+    ResMut<'static, Assets<Mesh>>,
+    Option<Res<'static, ClothInterpolation>>,
+    Res<'static, Time<Fixed>>,
+    Query<
+        'static,
+        'static,
+        (
+            &'static mut ClothSimulation,
+            &'static Mesh3d,
+            Option<&'static Visibility>,
+            Option<&'static mut ProxyBound>,
+        ),
+    >,
+);
 
 /// Drawing: once a frame (in `PostUpdate`, [`ClothSystems::WriteMesh`]), each cloth's
 /// positions and normals written into its mesh in place, between the last two fixed

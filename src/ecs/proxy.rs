@@ -26,12 +26,24 @@ pub struct ClothProxy {
 }
 
 /// A proxy bound to its cloth, with the frame's scratch (the simulation's positions and
-/// normals in the cloth's frame).
+/// normals in the cloth's frame) and the render vertices placed on them, written by
+/// [`place_proxy`] (each cloth on its own, side by side) and then handed to the mesh by
+/// [`give_to_mesh`].
 #[derive(Component, Debug)]
 pub(crate) struct ProxyBound {
-    pub(crate) binding: ProxyBinding,
-    pub(crate) local: Vec<Vec3>,
-    pub(crate) normals: Vec<Vec3>,
+    binding: ProxyBinding,
+    local: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    /// The render vertices' positions, normals and (when the mesh has them) tangents:
+    /// swapped with the mesh's own buffers each frame, so nothing is copied or allocated.
+    placed: Placed,
+}
+
+#[derive(Debug, Default)]
+struct Placed {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    tangents: Option<Vec<[f32; 4]>>,
 }
 
 /// Proxy meshes: [`ClothProxy`] cloths drawn with their own finer meshes. In
@@ -86,7 +98,8 @@ fn bind_proxies(
         };
         match bind(mesh, &sim.solver) {
             Ok(binding) => {
-                let n = sim.solver.particle_count();
+                let (n, m) = (sim.solver.particle_count(), binding.len());
+                let tangents = mesh.attribute(Mesh::ATTRIBUTE_TANGENT).is_some();
                 // Drawn on it from the next write, moving or not.
                 sim.mesh_dirty = true;
                 commands.entity(entity).insert((
@@ -94,6 +107,11 @@ fn bind_proxies(
                         binding,
                         local: vec![Vec3::ZERO; n],
                         normals: vec![Vec3::ZERO; n],
+                        placed: Placed {
+                            positions: vec![[0.0; 3]; m],
+                            normals: vec![[0.0; 3]; m],
+                            tangents: tangents.then(|| vec![[0.0; 4]; m]),
+                        },
                     },
                     Mesh3d(proxy.mesh.clone()),
                 ));
@@ -136,11 +154,18 @@ fn bind(mesh: &Mesh, cloth: &crate::solver::ClothSolver) -> Result<ProxyBinding,
     .ok_or_else(|| bad("the simulation has no triangles to bind it to"))
 }
 
-/// Writes a proxied cloth's render mesh: its simulation's positions (drawn a fraction
-/// `t` of the way from `from` when blending) and `normals` taken into its frame, and
-/// each render vertex placed on them.
-pub(crate) fn write_proxy(
-    mesh: &mut Mesh,
+impl ProxyBound {
+    /// Its render vertices.
+    pub(crate) fn len(&self) -> usize {
+        self.binding.len()
+    }
+}
+
+/// Places a proxied cloth's render vertices in its own buffers: its simulation's
+/// positions (drawn a fraction `t` of the way from `from` when blending) and `normals`
+/// taken into its frame, and each render vertex placed on them. Reads nothing but the
+/// cloth, so the cloths are placed side by side.
+pub(crate) fn place_proxy(
     cloth: &crate::solver::ClothSolver,
     bound: &mut ProxyBound,
     normals: &[Vec3],
@@ -152,6 +177,7 @@ pub(crate) fn write_proxy(
         binding,
         local,
         normals: local_normals,
+        placed,
     } = bound;
     for (i, out) in local.iter_mut().enumerate() {
         let p = match blend {
@@ -163,30 +189,39 @@ pub(crate) fn write_proxy(
     for (out, n) in local_normals.iter_mut().zip(normals) {
         *out = to_local.transform_vector3(*n).normalize_or(Vec3::Z);
     }
-    let mut positions = match mesh.remove_attribute(Mesh::ATTRIBUTE_POSITION) {
-        Some(VertexAttributeValues::Float32x3(p)) => p,
-        _ => return,
-    };
-    let mut out_normals = match mesh.remove_attribute(Mesh::ATTRIBUTE_NORMAL) {
-        Some(VertexAttributeValues::Float32x3(n)) => n,
-        _ => Vec::new(),
-    };
-    let mut tangents = match mesh.remove_attribute(Mesh::ATTRIBUTE_TANGENT) {
-        Some(VertexAttributeValues::Float32x4(t)) => Some(t),
-        _ => None,
-    };
-    if positions.len() == binding.len() && out_normals.len() == binding.len() {
-        binding.place(
-            local,
-            local_normals,
-            &mut positions,
-            &mut out_normals,
-            tangents.as_deref_mut().filter(|t| t.len() == binding.len()),
-        );
+    binding.place(
+        local,
+        local_normals,
+        &mut placed.positions,
+        &mut placed.normals,
+        placed.tangents.as_deref_mut(),
+    );
+}
+
+/// Hands the render vertices [`place_proxy`] placed to `mesh`, swapping its buffers
+/// for them (its old ones are placed on next time). A mesh whose vertices are no longer
+/// the bound ones (another mesh under the same handle) is left as it is.
+pub(crate) fn give_to_mesh(mesh: &mut Mesh, bound: &mut ProxyBound) {
+    let m = bound.binding.len();
+    let placed = &mut bound.placed;
+    let fits = |a: Option<&VertexAttributeValues>| a.is_some_and(|a| a.len() == m);
+    if !fits(mesh.attribute(Mesh::ATTRIBUTE_POSITION))
+        || !fits(mesh.attribute(Mesh::ATTRIBUTE_NORMAL))
+    {
+        return;
     }
-    mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, positions);
-    mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, out_normals);
-    if let Some(t) = tangents {
-        mesh.insert_attribute(Mesh::ATTRIBUTE_TANGENT, t);
+    let swap = |mesh: &mut Mesh, attribute, mine: &mut Vec<[f32; 3]>| {
+        if let Some(VertexAttributeValues::Float32x3(theirs)) = mesh.attribute_mut(attribute) {
+            std::mem::swap(theirs, mine);
+        }
+    };
+    swap(mesh, Mesh::ATTRIBUTE_POSITION, &mut placed.positions);
+    swap(mesh, Mesh::ATTRIBUTE_NORMAL, &mut placed.normals);
+    if let (Some(VertexAttributeValues::Float32x4(theirs)), Some(mine)) = (
+        mesh.attribute_mut(Mesh::ATTRIBUTE_TANGENT),
+        placed.tangents.as_mut(),
+    ) && theirs.len() == m
+    {
+        std::mem::swap(theirs, mine);
     }
 }

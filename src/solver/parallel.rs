@@ -123,3 +123,34 @@ pub(super) fn any<T: Send>(
     });
     found.into_inner()
 }
+
+/// Shares `items` (each with its work) among the threads in balanced lots, the longest
+/// first, each to the least loaded (Graham 1969: within 4/3 of the best split), and
+/// runs `run` on each lot, one task a lot on the compute pool. With one thread, or one
+/// item, all run here.
+pub(crate) fn in_lots<T: Send>(mut items: Vec<(u64, T)>, run: impl Fn(Vec<T>) + Sync) {
+    let threads = threads();
+    if threads <= 1 || items.len() <= 1 {
+        run(items.into_iter().map(|(_, item)| item).collect());
+        return;
+    }
+    items.sort_by_key(|(w, _)| std::cmp::Reverse(*w));
+    let mut lots: Vec<(u64, Vec<T>)> = (0..threads).map(|_| (0, Vec::new())).collect();
+    for (w, item) in items {
+        let least = lots
+            .iter_mut()
+            .min_by_key(|(load, _)| *load)
+            .expect("a thread");
+        least.0 += w;
+        least.1.push(item);
+    }
+    // Every lot a task; the calling thread takes one while it waits on the scope (run
+    // inline instead, before the scope ticks, it measured 1.48× against 1.79× for 20
+    // cloths on two cores).
+    let run = &run;
+    pool().scope(|scope| {
+        for (_, lot) in lots.into_iter().filter(|(_, l)| !l.is_empty()) {
+            scope.spawn(async move { run(lot) });
+        }
+    });
+}
