@@ -97,6 +97,21 @@ fn nearest_squared(p: Vec3, [a, b, c]: [Vec3; 3]) -> f32 {
     (p - (a + ab * v + ac * w)).length_squared()
 }
 
+/// Each triangle of `triangles` over `x` that has an area: its corners, centre and reach
+/// (the farthest corner from the centre), for a quick rejection.
+fn usable(x: &[Vec3], triangles: &[[u32; 3]]) -> Vec<([u32; 3], Vec3, f32)> {
+    triangles
+        .iter()
+        .filter(|&&t| frame(x, t).is_some())
+        .map(|&t| {
+            let p = t.map(|i| x[i as usize]);
+            let centre = (p[0] + p[1] + p[2]) / 3.0;
+            let reach = p.iter().map(|q| q.distance(centre)).fold(0.0, f32::max);
+            (t, centre, reach)
+        })
+        .collect()
+}
+
 /// The usable triangles (corners, centre, reach) bucketed by their centres in a uniform
 /// grid, so that a vertex's nearest triangle is searched among its neighbours, ring by
 /// ring of cells outward, instead of among all of them.
@@ -232,17 +247,7 @@ impl ProxyBinding {
         render: &[Vec3],
         tangents: Option<&[Vec4]>,
     ) -> Option<Self> {
-        // Each usable triangle's corners, centre and reach, for a quick rejection.
-        let usable: Vec<([u32; 3], Vec3, f32)> = triangles
-            .iter()
-            .filter(|&&t| frame(x, t).is_some())
-            .map(|&t| {
-                let p = t.map(|i| x[i as usize]);
-                let centre = (p[0] + p[1] + p[2]) / 3.0;
-                let reach = p.iter().map(|q| q.distance(centre)).fold(0.0, f32::max);
-                (t, centre, reach)
-            })
-            .collect();
+        let usable = usable(x, triangles);
         if usable.is_empty() {
             return None;
         }
@@ -396,15 +401,8 @@ mod tests {
                 triangles.push([v + 1, v + w + 1, v + w]);
             }
         }
-        let usable: Vec<([u32; 3], Vec3, f32)> = triangles
-            .iter()
-            .map(|&t| {
-                let p = t.map(|i| x[i as usize]);
-                let centre = (p[0] + p[1] + p[2]) / 3.0;
-                let reach = p.iter().map(|q| q.distance(centre)).fold(0.0, f32::max);
-                (t, centre, reach)
-            })
-            .collect();
+        let usable = usable(&x, &triangles);
+        assert_eq!(usable.len(), triangles.len());
         let buckets = Buckets::new(&usable);
         let every = |p: Vec3| {
             let d2 = |t: [u32; 3]| nearest_squared(p, t.map(|i| x[i as usize]));
