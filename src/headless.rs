@@ -14,7 +14,7 @@ use serde::Serialize;
 
 use crate::ClothPlugin;
 use crate::error::ClothError;
-use crate::params::Environment;
+use crate::params::{Environment, WindZone};
 use crate::scene::ClothScene;
 use crate::solver::{self, Collider};
 
@@ -71,6 +71,8 @@ pub struct SceneRun {
     pub environment: Environment,
     /// The step, s.
     pub timestep: f32,
+    /// The wind zones, on the run's clock.
+    pub wind_zones: Vec<WindZone>,
 }
 
 impl SceneRun {
@@ -81,6 +83,9 @@ impl SceneRun {
             .iter()
             .map(|c| c.collider.to_world(&GlobalTransform::from(c.transform())))
             .collect();
+        for zone in &scene.wind_zones {
+            zone.validate()?;
+        }
         let mut cloths = Vec::with_capacity(scene.cloths.len());
         for entry in &scene.cloths {
             let mut cloth = entry.cloth.build(entry.transform().compute_affine())?;
@@ -91,6 +96,7 @@ impl SceneRun {
             cloths,
             environment: scene.environment,
             timestep: scene.timestep,
+            wind_zones: scene.wind_zones.clone(),
         })
     }
 
@@ -111,6 +117,15 @@ impl SceneRun {
         let mut times = crate::stats::StepTimes::default();
         for step in 1..=steps {
             let start = Instant::now();
+            if !self.wind_zones.is_empty() {
+                for (_, cloth) in &mut self.cloths {
+                    let time = cloth.time();
+                    // Checked in `new`; a zone spoilt since is refused, and said.
+                    if let Err(e) = cloth.set_wind_zones(&self.wind_zones, time) {
+                        warn!("wind zones not taken: {e}");
+                    }
+                }
+            }
             if self.cloths.len() > 1 {
                 let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
                 solver::collide_cloths(&mut all);

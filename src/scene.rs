@@ -22,7 +22,7 @@ use bevy::ecs::entity::Entity;
 use bevy::ecs::name::Name;
 use bevy::ecs::system::Commands;
 
-use crate::params::Environment;
+use crate::params::{Environment, WindZone};
 use crate::{Cloth, ClothCollider, ClothEnvironment, ClothLod, ClothStats};
 
 /// A scene: the cloths, their world and the timestep.
@@ -40,6 +40,12 @@ pub struct ClothScene {
     /// Solids the cloths are kept out of (a mannequin, a ground).
     #[serde(default)]
     pub colliders: Vec<SceneCollider>,
+    /// Regions of moving air ([`WindZone`]), blowing through the air model on every
+    /// cloth they reach: `wind_zones: [(shape: Sphere(radius: 2.0), centre: (0, 1, 0),
+    /// velocity: (6, 0, 0), falloff: 0.25)]`. Spawned as
+    /// [`ClothWindZone`](crate::ClothWindZone) entities.
+    #[serde(default)]
+    pub wind_zones: Vec<WindZone>,
 }
 
 /// A collider in a scene, with where it is and whether it is drawn.
@@ -201,6 +207,14 @@ impl ClothScene {
             })
             .collect();
         commands.insert_resource(ClothEnvironment(self.environment));
+        for zone in &self.wind_zones {
+            commands.spawn((
+                crate::ClothWindZone::from_world(zone),
+                bevy::transform::components::Transform::from_translation(zone.centre)
+                    .with_rotation(zone.rotation),
+                Name::new("wind zone"),
+            ));
+        }
         let cloths = self
             .cloths
             .iter()
@@ -366,6 +380,7 @@ impl ClothScene {
         [
             ("cloths", self.cloths.len()),
             ("colliders", self.colliders.len()),
+            ("wind_zones", self.wind_zones.len()),
         ]
         .into_iter()
         .find(|&(_, count)| count > max)
@@ -432,6 +447,13 @@ impl ClothScene {
             let field = error_field(&e);
             let after = text.find("colliders").unwrap_or(0);
             let path = format!("colliders[{i}].collider.{field}");
+            return Err(invalid(path, leaf(field), e.to_string(), after));
+        }
+        let mut bad = self.wind_zones.iter().enumerate();
+        if let Some((i, e)) = bad.find_map(|(i, z)| z.validate().err().map(|e| (i, e))) {
+            let field = error_field(&e).trim_start_matches("wind_zone.");
+            let after = text.find("wind_zones").unwrap_or(0);
+            let path = format!("wind_zones[{i}].{field}");
             return Err(invalid(path, leaf(field), e.to_string(), after));
         }
         Ok(())

@@ -418,3 +418,69 @@ fn a_scene_spawns_its_cloths_colliders_and_world() {
     let fixed = app.world().resource::<Time<Fixed>>().timestep();
     assert_eq!(fixed, std::time::Duration::from_millis(16));
 }
+
+/// Two banners, one in a sphere of wind and one 10 m off; `zones` is the scene's
+/// `wind_zones` entry.
+fn banners(zones: &str) -> String {
+    let banner = |x: f32| {
+        format!(
+            "(name: \"at {x}\", translation: ({x}, 2.0, 0.0), cloth: (shape: Grid(width: 10, \
+             height: 8, spacing: 0.05), pins: TopRow)),"
+        )
+    };
+    format!(
+        "(cloths: [{}{}], wind_zones: [{zones}])",
+        banner(0.0),
+        banner(10.0)
+    )
+}
+
+#[test]
+fn a_scene_places_wind_zones_that_blow_in_the_runner_and_spawn_as_entities() {
+    use bevy_cloth::headless::SceneRun;
+    let zone = "(shape: Sphere(radius: 1.5), centre: (0, 1.8, 0), rotation: (0, 0.3826834, 0, \
+                0.9238795), velocity: (0, 0, 6), falloff: 0.25, turbulence: (gust: 0.3, seed: 7))";
+    let windy = parse(&banners(zone)).unwrap();
+    let calm = parse(&banners("")).unwrap();
+    assert_eq!(windy.wind_zones.len(), 1);
+    let run = |scene: &ClothScene| {
+        let mut run = SceneRun::new(scene).unwrap();
+        run.run(120, |_, _| {});
+        run.cloths
+            .iter()
+            .map(|(_, c)| c.positions().to_vec())
+            .collect::<Vec<_>>()
+    };
+    let (windy_x, calm_x) = (run(&windy), run(&calm));
+    let mean_z = |x: &[Vec3]| x.iter().map(|p| p.z).sum::<f32>() / x.len() as f32;
+    let blown = mean_z(&windy_x[0]) - mean_z(&calm_x[0]);
+    eprintln!("the banner in the zone: {blown:.3} m downwind");
+    assert!(blown > 0.05, "moved {blown} m downwind");
+    // The one the zone does not reach moves as in calm air, to the bit.
+    assert_eq!(windy_x[1], calm_x[1]);
+
+    // Spawned, the zone is an entity that places back to the scene's zone.
+    let mut app = app();
+    windy.spawn(&mut app.world_mut().commands());
+    app.world_mut().flush();
+    let mut zones = app
+        .world_mut()
+        .query::<(&ClothWindZone, &bevy::prelude::Transform)>();
+    let (component, transform) = zones.single(app.world()).unwrap();
+    let placed = component.placed(&GlobalTransform::from(*transform));
+    let want = windy.wind_zones[0];
+    assert!(placed.centre.distance(want.centre) < 1e-6);
+    assert!(placed.velocity.distance(want.velocity) < 1e-5, "{placed:?}");
+    assert_eq!(
+        (placed.shape, placed.turbulence),
+        (want.shape, want.turbulence)
+    );
+
+    // A bad zone names its field; a misspelt key is refused.
+    let bad = banners("(shape: Sphere(radius: 1.0), falloff: 2.0)");
+    match parse(&bad).unwrap_err() {
+        SceneError::Invalid { field, .. } => assert_eq!(field, "wind_zones[0].falloff"),
+        other => panic!("{other:?}"),
+    }
+    assert!(parse(&banners("(shape: Global, velocty: (1, 0, 0))")).is_err());
+}

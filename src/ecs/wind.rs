@@ -32,6 +32,18 @@ pub struct ClothWindZone {
 }
 
 impl ClothWindZone {
+    /// `zone` as a component, for an entity at its centre turned by its rotation
+    /// (its velocity taken into that frame, so that [`placed`](Self::placed) gives
+    /// `zone` back).
+    pub fn from_world(zone: &WindZone) -> Self {
+        ClothWindZone {
+            shape: zone.shape,
+            velocity: zone.rotation.inverse() * zone.velocity,
+            falloff: zone.falloff,
+            turbulence: zone.turbulence,
+        }
+    }
+
     /// Air moving at `velocity` everywhere.
     pub fn global(velocity: Vec3) -> Self {
         Self::new(ZoneShape::Global, velocity)

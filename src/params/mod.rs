@@ -47,6 +47,31 @@ pub mod vec3_serde {
     }
 }
 
+/// Serde for `Quat` as an `(x, y, z, w)` tuple (normalised when read).
+pub mod quat_serde {
+    use bevy::math::Quat;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer};
+
+    /// Writes `(x, y, z, w)`.
+    pub fn serialize<S: Serializer>(q: &Quat, s: S) -> Result<S::Ok, S::Error> {
+        (q.x, q.y, q.z, q.w).serialize(s)
+    }
+
+    /// Reads `(x, y, z, w)`; a quaternion of no length is refused.
+    pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<Quat, D::Error> {
+        let (x, y, z, w) = <(f32, f32, f32, f32)>::deserialize(d)?;
+        let q = Quat::from_xyzw(x, y, z, w);
+        let length = q.length();
+        if length > 0.0 && length.is_finite() {
+            Ok(q / length)
+        } else {
+            Err(serde::de::Error::custom(
+                "a rotation (x, y, z, w) of no length",
+            ))
+        }
+    }
+}
+
 /// How positions advance in time.
 ///
 /// For a fixed step `h` the two are the same recurrence in exact arithmetic:

@@ -10,12 +10,15 @@
 
 use bevy::math::{Quat, Vec3};
 use bevy::reflect::Reflect;
+use serde::{Deserialize, Serialize};
+
+use super::{quat_serde, vec3_serde};
 
 use super::check;
 use crate::error::ClothError;
 
 /// Where a wind zone blows.
-#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
 pub enum ZoneShape {
     /// Everywhere, at full strength.
     Global,
@@ -27,12 +30,14 @@ pub enum ZoneShape {
     /// Within a box of these half extents about its centre, turned with its rotation.
     Box {
         /// Half its size along each of its own axes, m.
+        #[serde(with = "vec3_serde")]
         half_extents: Vec3,
     },
 }
 
 /// Gusts and turbulence of a wind zone, from seeded noise.
-#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct Turbulence {
     /// How much the strength swells and drops in time, as a share of it (0: steady; 0.5:
     /// between half and one and a half times).
@@ -102,16 +107,21 @@ impl Turbulence {
 /// A region of moving air, placed in the world: its velocity, at full strength inside
 /// and fading over the outer `falloff` share of its size to nothing at its edge, swelled
 /// by gusts and stirred by turbulence. Cloths take the zones that reach them
-/// (`ClothSolver::set_wind_zones`; the plugin's `ClothWindZone`).
-#[derive(Clone, Copy, Debug, PartialEq, Reflect)]
+/// (`ClothSolver::set_wind_zones`; the plugin's `ClothWindZone`; a scene file's
+/// `wind_zones`).
+#[derive(Clone, Copy, Debug, PartialEq, Reflect, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
 pub struct WindZone {
     /// Where it blows.
     pub shape: ZoneShape,
     /// Its centre, m.
+    #[serde(with = "vec3_serde")]
     pub centre: Vec3,
-    /// Its turn (a box's axes).
+    /// Its turn (a box's axes), as a quaternion `(x, y, z, w)`.
+    #[serde(with = "quat_serde")]
     pub rotation: Quat,
     /// The air's velocity at full strength, m/s.
+    #[serde(with = "vec3_serde")]
     pub velocity: Vec3,
     /// The outer share of its size (of the radius, or of each half extent) over which it
     /// fades to nothing, 0 to 1 (0: a hard edge). A global zone does not fade.
