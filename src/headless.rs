@@ -100,6 +100,32 @@ impl SceneRun {
         })
     }
 
+    /// One step of every cloth: the wind zones handed over, cloths in contact met, then
+    /// all stepped as the plugin steps them.
+    fn step(&mut self) {
+        if !self.wind_zones.is_empty() {
+            for (_, cloth) in &mut self.cloths {
+                let time = cloth.time();
+                // Checked in `new`; a zone spoilt since is refused, and said.
+                if let Err(e) = cloth.set_wind_zones(&self.wind_zones, time) {
+                    warn!("wind zones not taken: {e}");
+                }
+            }
+        }
+        if self.cloths.len() > 1 {
+            let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
+            solver::collide_cloths(&mut all);
+        }
+        // As the plugin steps them: cloths in contact together, the rest side by side.
+        let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
+        solver::begin_cloths(&mut all, self.timestep);
+        let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| c).collect();
+        solver::run_cloths(&mut all, &self.environment);
+        for (_, cloth) in &mut self.cloths {
+            cloth.end_step();
+        }
+    }
+
     /// Runs `steps` steps, calling `each` after every step with the step number (1-based),
     /// and returns the summary.
     pub fn run(
@@ -117,27 +143,7 @@ impl SceneRun {
         let mut times = crate::stats::StepTimes::default();
         for step in 1..=steps {
             let start = Instant::now();
-            if !self.wind_zones.is_empty() {
-                for (_, cloth) in &mut self.cloths {
-                    let time = cloth.time();
-                    // Checked in `new`; a zone spoilt since is refused, and said.
-                    if let Err(e) = cloth.set_wind_zones(&self.wind_zones, time) {
-                        warn!("wind zones not taken: {e}");
-                    }
-                }
-            }
-            if self.cloths.len() > 1 {
-                let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
-                solver::collide_cloths(&mut all);
-            }
-            // As the plugin steps them: cloths in contact together, the rest side by side.
-            let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
-            solver::begin_cloths(&mut all, self.timestep);
-            let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| c).collect();
-            solver::run_cloths(&mut all, &env);
-            for (_, cloth) in &mut self.cloths {
-                cloth.end_step();
-            }
+            self.step();
             times.push(start.elapsed().as_secs_f64() * 1e3);
             each(step, &self.cloths);
         }

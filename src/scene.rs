@@ -442,21 +442,27 @@ impl ClothScene {
             }
             search_from = entry_start + 1;
         }
+        if let Some((section, path, field, message)) = self.world_error() {
+            let after = text.find(section).unwrap_or(0);
+            return Err(invalid(path, leaf(field), message, after));
+        }
+        Ok(())
+    }
+
+    /// The first collider or wind zone that fails its check: its section, its path, its
+    /// field and the message.
+    fn world_error(&self) -> Option<(&'static str, String, &'static str, String)> {
         let mut bad = self.colliders.iter().enumerate();
         if let Some((i, e)) = bad.find_map(|(i, c)| c.collider.validate().err().map(|e| (i, e))) {
             let field = error_field(&e);
-            let after = text.find("colliders").unwrap_or(0);
             let path = format!("colliders[{i}].collider.{field}");
-            return Err(invalid(path, leaf(field), e.to_string(), after));
+            return Some(("colliders", path, field, e.to_string()));
         }
         let mut bad = self.wind_zones.iter().enumerate();
-        if let Some((i, e)) = bad.find_map(|(i, z)| z.validate().err().map(|e| (i, e))) {
-            let field = error_field(&e).trim_start_matches("wind_zone.");
-            let after = text.find("wind_zones").unwrap_or(0);
-            let path = format!("wind_zones[{i}].{field}");
-            return Err(invalid(path, leaf(field), e.to_string(), after));
-        }
-        Ok(())
+        let (i, e) = bad.find_map(|(i, z)| z.validate().err().map(|e| (i, e)))?;
+        let field = error_field(&e).trim_start_matches("wind_zone.");
+        let path = format!("wind_zones[{i}].{field}");
+        Some(("wind_zones", path, field, e.to_string()))
     }
 }
 
