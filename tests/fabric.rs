@@ -118,6 +118,18 @@ fn models_without_springs_and_clothes_without_triangles_refuse_a_fabric() {
     assert!(matches!(e, ClothError::FabricNeedsSurface), "{e}");
 }
 
+/// A world with `air` and none of the seeds' per-particle wind.
+fn in_air(air: Air) -> Environment {
+    Environment {
+        air: Some(air),
+        wind: Wind {
+            strength: 0.0,
+            ..Wind::default()
+        },
+        ..Environment::default()
+    }
+}
+
 /// A level `side × side` sheet of 1 m of `fabric` (mass-spring), free, in `air`, stepped
 /// `steps` steps of 16 ms from rest.
 fn level_sheet(fabric: Fabric, side: u32, air: Air, steps: usize, pins: ClothPins) -> ClothSolver {
@@ -138,14 +150,7 @@ fn level_sheet(fabric: Fabric, side: u32, air: Air, steps: usize, pins: ClothPin
         Affine3A::IDENTITY
     };
     let mut cloth = shape.build_solver(&pins, &params, frame).unwrap();
-    let env = Environment {
-        air: Some(air),
-        wind: Wind {
-            strength: 0.0,
-            ..Wind::default()
-        },
-        ..Environment::default()
-    };
+    let env = in_air(air);
     for _ in 0..steps {
         cloth.step(0.016, &env);
     }
@@ -184,14 +189,7 @@ fn a_falling_sheet_speeds_up_as_drag_and_weight_say_with_the_air_once_a_step_or_
         };
         let terminal = (2.0 * fabric.areal_density * 9.81 / (air.density * air.drag)).sqrt();
         let mut cloth = level_sheet(fabric, 11, air, 0, ClothPins::None);
-        let env = Environment {
-            air: Some(air),
-            wind: Wind {
-                strength: 0.0,
-                ..Wind::default()
-            },
-            ..Environment::default()
-        };
+        let env = in_air(air);
         let mut worst = 0.0f32;
         for step in 1..=62 {
             cloth.step(0.016, &env);

@@ -125,11 +125,6 @@ impl Drawn {
     }
 }
 
-/// The crowd's cloths' parameters.
-pub fn crowd_params() -> ClothParams {
-    ClothParams::default()
-}
-
 /// A grid's rest positions in its own frame (x across, y down from 0), `k` times finer.
 fn grid_points(w: u32, h: u32, spacing: f32, k: u32) -> Vec<Vec3> {
     let (fw, fh) = ((w - 1) * k + 1, (h - 1) * k + 1);

@@ -191,32 +191,39 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
     let due = |sim: &ClothSimulation, visibility: Option<&Visibility>| {
         (sim.mesh_dirty || blend && sim.blending) && visibility != Some(&Visibility::Hidden)
     };
-    // Each cloth's own work side by side: its normals once a step, and a proxy's render
-    // vertices placed in its own buffers (a crowd's proxies took a fifth of its step
-    // when placed one after another). An exclusive system, so that the calling thread
-    // works beside the compute pool's (on two cores Bevy gives the pool one thread).
-    let work: Vec<_> = cloths
-        .iter_mut()
-        .filter(|(sim, _, visibility, _)| due(sim, *visibility))
-        .map(|(sim, _, _, proxy)| {
-            let n = proxy.as_ref().map_or(0, |p| p.len()) + sim.solver.particle_count();
-            (n as u64, (sim, proxy))
-        })
-        .collect();
-    solver::in_lots(work, |lot| {
-        for (mut sim, proxy) in lot {
-            let sim = &mut *sim;
-            if sim.mesh_dirty {
-                sim.solver.normals_into(&mut sim.normals);
-            }
-            if let Some(mut bound) = proxy {
-                let from = (blend && sim.blending).then_some((sim.previous.as_slice(), t));
-                place_proxy(&sim.solver, &mut bound, &sim.normals, from);
-            }
+    // Each cloth's own work: its normals once a step, and a proxy's render vertices
+    // placed in its own buffers.
+    let prepare = |sim: &mut ClothSimulation, proxy: Option<&mut ProxyBound>| {
+        if sim.mesh_dirty {
+            sim.solver.normals_into(&mut sim.normals);
         }
-    });
+        if let Some(bound) = proxy {
+            place_proxy(&sim.solver, bound, &sim.normals, blended(sim, blend, t));
+        }
+    };
+    // Several cloths: side by side (a crowd's proxies took a fifth of its step when
+    // placed one after another). An exclusive system, so that the calling thread works
+    // beside the compute pool's (on two cores Bevy gives the pool one thread). One cloth:
+    // below, with nothing allocated.
+    let side_by_side =
+        solver::threads() > 1 && cloths.iter().filter(|(sim, _, v, _)| due(sim, *v)).count() > 1;
+    if side_by_side {
+        let work: Vec<_> = cloths
+            .iter_mut()
+            .filter(|(sim, _, visibility, _)| due(sim, *visibility))
+            .map(|(sim, _, _, proxy)| {
+                let n = proxy.as_ref().map_or(0, |p| p.len()) + sim.solver.particle_count();
+                (n as u64, (sim, proxy))
+            })
+            .collect();
+        solver::in_lots(work, |lot| {
+            for (mut sim, mut proxy) in lot {
+                prepare(&mut sim, proxy.as_deref_mut());
+            }
+        });
+    }
     // Then into the meshes, one after another (the assets are one resource).
-    for (mut sim, mesh3d, visibility, proxy) in &mut cloths {
+    for (mut sim, mesh3d, visibility, mut proxy) in &mut cloths {
         if !due(&sim, visibility) {
             continue;
         }
@@ -224,15 +231,26 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
             continue;
         };
         let sim = &mut *sim;
+        if !side_by_side {
+            prepare(sim, proxy.as_deref_mut());
+        }
         let faces_changed = sim.solver.take_faces_changed();
-        let from = (blend && sim.blending).then_some((sim.previous.as_slice(), t));
         match proxy {
             // A proxy's triangles are its own: torn faces stay drawn.
             Some(mut bound) => give_to_mesh(&mut mesh, &mut bound),
-            None => write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from),
+            None => {
+                let from = blended(sim, blend, t);
+                write_blended(&mut mesh, &sim.solver, &sim.normals, faces_changed, from);
+            }
         }
         sim.mesh_dirty = false;
     }
+}
+
+/// Where `sim` is drawn from when it is blended between its last two steps (`blend`
+/// on and it moved), `t` of the way: the positions as its last step began.
+fn blended(sim: &ClothSimulation, blend: bool, t: f32) -> Option<(&[Vec3], f32)> {
+    (blend && sim.blending).then_some((sim.previous.as_slice(), t))
 }
 
 /// What [`write_meshes`] reads and writes.

@@ -39,6 +39,7 @@ pub(crate) struct ProxyBound {
     placed: Placed,
 }
 
+/// A proxy's render vertices as last placed, in buffers of the mesh's own kinds.
 #[derive(Debug, Default)]
 struct Placed {
     positions: Vec<[f32; 3]>,
