@@ -191,16 +191,6 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
     let due = |sim: &ClothSimulation, visibility: Option<&Visibility>| {
         (sim.mesh_dirty || blend && sim.blending) && visibility != Some(&Visibility::Hidden)
     };
-    // Each cloth's own work: its normals once a step, and a proxy's render vertices
-    // placed in its own buffers.
-    let prepare = |sim: &mut ClothSimulation, proxy: Option<&mut ProxyBound>| {
-        if sim.mesh_dirty {
-            sim.solver.normals_into(&mut sim.normals);
-        }
-        if let Some(bound) = proxy {
-            place_proxy(&sim.solver, bound, &sim.normals, blended(sim, blend, t));
-        }
-    };
     // Several cloths: side by side (a crowd's proxies took a fifth of its step when
     // placed one after another). An exclusive system, so that the calling thread works
     // beside the compute pool's (on two cores Bevy gives the pool one thread). One cloth:
@@ -218,7 +208,7 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
             .collect();
         solver::in_lots(work, |lot| {
             for (mut sim, mut proxy) in lot {
-                prepare(&mut sim, proxy.as_deref_mut());
+                prepare(&mut sim, proxy.as_deref_mut(), blend, t);
             }
         });
     }
@@ -232,7 +222,7 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
         };
         let sim = &mut *sim;
         if !side_by_side {
-            prepare(sim, proxy.as_deref_mut());
+            prepare(sim, proxy.as_deref_mut(), blend, t);
         }
         let faces_changed = sim.solver.take_faces_changed();
         match proxy {
@@ -244,6 +234,17 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
             }
         }
         sim.mesh_dirty = false;
+    }
+}
+
+/// A cloth's own drawing work: its normals once a step, and its proxy's render vertices
+/// placed in the proxy's own buffers.
+fn prepare(sim: &mut ClothSimulation, proxy: Option<&mut ProxyBound>, blend: bool, t: f32) {
+    if sim.mesh_dirty {
+        sim.solver.normals_into(&mut sim.normals);
+    }
+    if let Some(bound) = proxy {
+        place_proxy(&sim.solver, bound, &sim.normals, blended(sim, blend, t));
     }
 }
 
