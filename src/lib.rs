@@ -68,8 +68,9 @@ pub mod prelude {
         ClothBecameInvalid, ClothBuilt, ClothCollider, ClothColliderBecameInvalid,
         ClothColliderInvalid, ClothColliderSpan, ClothCulling, ClothEnvironment, ClothFellAsleep,
         ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
-        ClothProxy, ClothSimulation, ClothSleep, ClothStats, ClothSubstep, ClothSubstepSystems,
-        ClothSystems, ClothTeleport, ClothTeleported, ClothTorn, ClothWake, ClothWindZone,
+        ClothProxy, ClothProxyEntity, ClothSimulation, ClothSleep, ClothStats, ClothSubstep,
+        ClothSubstepSystems, ClothSystems, ClothTeleport, ClothTeleported, ClothTorn, ClothWake,
+        ClothWindZone,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;

@@ -1008,13 +1008,20 @@ mod walk_gltf {
     /// The panel's vertices in the bind pose: position, joints' weights (hips, knee) and
     /// maximum distance (0 on the waist row, 1.5 cm more each row down).
     pub fn vertices() -> Vec<(Vec3, [f32; 2], f32)> {
+        vertices_at(1)
+    }
+
+    /// The panel `finer` times as fine each way (1: the simulation's), its weights and
+    /// distances the same functions of the place.
+    pub fn vertices_at(finer: u32) -> Vec<(Vec3, [f32; 2], f32)> {
+        let (columns, rows) = ((COLUMNS - 1) * finer + 1, (ROWS - 1) * finer + 1);
         let mut v = Vec::new();
-        for j in 0..ROWS {
-            for i in 0..COLUMNS {
-                let knee = ((j as f32 - 2.0) / 4.0).clamp(0.0, 1.0);
-                let p =
-                    ARMATURE + HIPS + Vec3::new((i as f32 - 2.5) * STEP, -(j as f32) * STEP, 0.1);
-                v.push((p, [1.0 - knee, knee], 0.015 * j as f32));
+        for j in 0..rows {
+            for i in 0..columns {
+                let (u, w) = (i as f32 / finer as f32, j as f32 / finer as f32);
+                let knee = ((w - 2.0) / 4.0).clamp(0.0, 1.0);
+                let p = ARMATURE + HIPS + Vec3::new((u - 2.5) * STEP, -w * STEP, 0.1);
+                v.push((p, [1.0 - knee, knee], 0.015 * w));
             }
         }
         v
@@ -1065,10 +1072,10 @@ mod walk_gltf {
         }
     }
 
-    /// Writes `walk.gltf` and `walk.bin` into `dir`.
-    pub fn write(dir: &Path) {
-        let vertices = vertices();
-        let mut buffer = Buffer::default();
+    /// The panel `finer` times as fine as the simulation's, skinned, as a glTF primitive
+    /// whose accessors are added to `buffer`.
+    fn primitive(buffer: &mut Buffer, finer: u32) -> Value {
+        let vertices = vertices_at(finer);
         let positions: Vec<f32> = vertices.iter().flat_map(|v| v.0.to_array()).collect();
         let (lo, hi) = vertices.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), v| {
             (lo.min(v.0), hi.max(v.0))
@@ -1094,15 +1101,46 @@ mod walk_gltf {
         let weight = buffer.floats(&weights, "VEC4", 4, json!({}));
         let distances: Vec<f32> = vertices.iter().map(|v| v.2).collect();
         let distance = buffer.floats(&distances, "SCALAR", 1, json!({}));
+        let (columns, rows) = ((COLUMNS - 1) * finer + 1, (ROWS - 1) * finer + 1);
         let mut indices = Vec::new();
-        for j in 0..ROWS - 1 {
-            for i in 0..COLUMNS - 1 {
-                let a = j * COLUMNS + i;
-                indices.extend([a, a + COLUMNS, a + 1, a + 1, a + COLUMNS, a + COLUMNS + 1]);
+        for j in 0..rows - 1 {
+            for i in 0..columns - 1 {
+                let a = j * columns + i;
+                indices.extend([a, a + columns, a + 1, a + 1, a + columns, a + columns + 1]);
             }
         }
         let index_bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
         let index = buffer.add(&index_bytes, 5125, "SCALAR", indices.len(), json!({}));
+        json!({
+            "attributes": {
+                "POSITION": position,
+                "NORMAL": normal,
+                "JOINTS_0": joint,
+                "WEIGHTS_0": weight,
+                "_MAX_DISTANCE": distance,
+            },
+            "indices": index,
+        })
+    }
+
+    /// Writes `walk.gltf` and `walk.bin` into `dir`: the character and its skirt, and with
+    /// `render` a second mesh of the skirt that many times finer, `Skirt.render`, skinned
+    /// to the same joints (the simulation and render meshes of one file).
+    pub fn write(dir: &Path, render: Option<u32>) {
+        let mut buffer = Buffer::default();
+        let mut meshes = vec![json!({"name": "Skirt", "primitives": [primitive(&mut buffer, 1)]})];
+        let mut nodes = vec![
+            json!({"name": "Armature", "translation": ARMATURE.to_array(), "children": [1, 3]}),
+            json!({"name": "Hips", "translation": HIPS.to_array(), "children": [2]}),
+            json!({"name": "Knee", "translation": KNEE.to_array()}),
+            json!({"name": "Skirt", "mesh": 0, "skin": 0}),
+        ];
+        if let Some(finer) = render {
+            let primitive = primitive(&mut buffer, finer);
+            meshes.push(json!({"name": "Skirt.render", "primitives": [primitive]}));
+            nodes.push(json!({"name": "Skirt.render", "mesh": 1, "skin": 0}));
+            nodes[0]["children"] = json!([1, 3, 4]);
+        }
         let inverse: Vec<f32> = inverse_bindposes()
             .iter()
             .flat_map(|m| m.to_cols_array())
@@ -1121,23 +1159,9 @@ mod walk_gltf {
             "asset": {"version": "2.0", "generator": "bevy_cloth tests"},
             "scene": 0,
             "scenes": [{"name": "Character", "nodes": [0]}],
-            "nodes": [
-                {"name": "Armature", "translation": ARMATURE.to_array(), "children": [1, 3]},
-                {"name": "Hips", "translation": HIPS.to_array(), "children": [2]},
-                {"name": "Knee", "translation": KNEE.to_array()},
-                {"name": "Skirt", "mesh": 0, "skin": 0},
-            ],
+            "nodes": nodes,
             "skins": [{"joints": [1, 2], "inverseBindMatrices": bindposes}],
-            "meshes": [{"name": "Skirt", "primitives": [{
-                "attributes": {
-                    "POSITION": position,
-                    "NORMAL": normal,
-                    "JOINTS_0": joint,
-                    "WEIGHTS_0": weight,
-                    "_MAX_DISTANCE": distance,
-                },
-                "indices": index,
-            }]}],
+            "meshes": meshes,
             "animations": [{
                 "name": "Walk",
                 "channels": [
@@ -1248,7 +1272,7 @@ fn walk_a_gltf_character(
     use std::time::Duration;
 
     let dir = std::env::temp_dir().join(format!("bevy_cloth_gltf_{}_{name}", std::process::id()));
-    walk_gltf::write(&dir);
+    walk_gltf::write(&dir, None);
     let mut app = gltf_app(&dir, schedule);
     // The plugin draws between steps exactly when they are fixed ones.
     let fixed = app.world().resource::<ClothInterpolation>().0;
@@ -1441,6 +1465,130 @@ fn on_the_fixed_clock_a_gltf_character_is_read_a_frame_late() {
         "the waist lags the body drawn by a frame's motion: {} m",
         walk.waist_off_drawn
     );
+}
+
+/// A glTF file with the skirt's simulation mesh and a render mesh of it 3 × 3 times finer
+/// (`Skirt` and `Skirt.render`, both skinned): the simulation mesh made the cloth and
+/// drawn with the render mesh through `ClothProxyEntity`. The render entity is hidden, the
+/// cloth draws its mesh, and after 110 frames of the walk every render vertex is on its
+/// bound point of its simulation triangle (1e-5 m) though the skirt swung.
+#[test]
+fn a_gltf_skirt_is_drawn_with_the_finer_render_mesh_of_its_file() {
+    use bevy::animation::graph::AnimationGraphHandle;
+    use bevy::gltf::{GltfAssetLabel, GltfMeshName};
+    use bevy::world_serialization::{WorldAssetRoot, WorldInstanceReady};
+    use bevy_cloth::solver::ProxyBinding;
+
+    let dir = std::env::temp_dir().join(format!("bevy_cloth_gltf_{}_proxy", std::process::id()));
+    walk_gltf::write(&dir, Some(3));
+    let mut app = gltf_app(&dir, PostUpdate);
+    let server = app.world().resource::<AssetServer>().clone();
+    let scene = server.load(GltfAssetLabel::Scene(0).from_asset("walk.gltf"));
+    let clip = server.load(GltfAssetLabel::Animation(0).from_asset("walk.gltf"));
+    let (graph, walk) = AnimationGraph::from_clip(clip);
+    let graph = app
+        .world_mut()
+        .resource_mut::<Assets<AnimationGraph>>()
+        .add(graph);
+    app.world_mut()
+        .spawn(WorldAssetRoot(scene.clone()))
+        .observe(
+            move |ready: On<WorldInstanceReady>,
+                  children: Query<&Children>,
+                  meshes: Query<&GltfMeshName>,
+                  mut players: Query<&mut AnimationPlayer>,
+                  mut commands: Commands| {
+                let named = |name: &str| {
+                    children
+                        .iter_descendants(ready.entity)
+                        .find(|&e| meshes.get(e).is_ok_and(|m| m.0 == name))
+                };
+                let (Some(simulated), Some(render)) = (named("Skirt"), named("Skirt.render"))
+                else {
+                    panic!("the file has both meshes");
+                };
+                commands.entity(simulated).insert((
+                    Cloth::from_mesh().with_pins(ClothPins::None),
+                    ClothProxyEntity(render),
+                ));
+                for entity in children.iter_descendants(ready.entity) {
+                    if let Ok(mut player) = players.get_mut(entity) {
+                        player.play(walk);
+                        commands
+                            .entity(entity)
+                            .insert(AnimationGraphHandle(graph.clone()));
+                    }
+                }
+            },
+        );
+    // Until the cloth is built and draws the render entity's mesh.
+    let (cloth, render) = (0..600)
+        .find_map(|_| {
+            app.update();
+            std::thread::sleep(std::time::Duration::from_millis(2)); // the glTF loads
+            let world = app.world_mut();
+            let mut cloths = world.query::<(Entity, &ClothProxyEntity, &Mesh3d)>();
+            let (cloth, render, drawn) = cloths.iter(world).next()?;
+            let render = render.0;
+            let bound = world.get::<Mesh3d>(render).is_some_and(|m| m.0 == drawn.0);
+            bound.then_some((cloth, render))
+        })
+        .expect("the glTF loaded and its cloth was bound to its render mesh");
+    for _ in 0..110 {
+        app.update();
+    }
+    let world = app.world();
+    assert_eq!(
+        world.get::<Visibility>(render),
+        Some(&Visibility::Hidden),
+        "the render entity is hidden: the cloth draws it"
+    );
+    let sim = world.get::<ClothSimulation>(cloth).unwrap();
+    let handle = &world.get::<Mesh3d>(cloth).unwrap().0;
+    let fine: Vec<Vec3> = walk_gltf::vertices_at(3).iter().map(|v| v.0).collect();
+    let binding = ProxyBinding::bind(
+        sim.solver.rest_positions(),
+        sim.solver.triangles(),
+        &fine,
+        None,
+    )
+    .unwrap();
+    let to_local = sim.solver.frame().inverse();
+    let local: Vec<Vec3> = sim
+        .solver
+        .positions()
+        .iter()
+        .map(|&x| to_local.transform_point3(x))
+        .collect();
+    let drawn = match world
+        .resource::<Assets<Mesh>>()
+        .get(handle)
+        .unwrap()
+        .attribute(Mesh::ATTRIBUTE_POSITION)
+    {
+        Some(VertexAttributeValues::Float32x3(p)) => p.clone(),
+        _ => panic!("the render mesh has positions"),
+    };
+    let farthest = drawn
+        .iter()
+        .enumerate()
+        .map(|(v, p)| Vec3::from(*p).distance(binding.point(&local, v)))
+        .fold(0.0, f32::max);
+    let moved = drawn
+        .iter()
+        .zip(&fine)
+        .map(|(p, r)| Vec3::from(*p).distance(*r))
+        .fold(0.0, f32::max);
+    let _ = std::fs::remove_dir_all(&dir);
+    eprintln!(
+        "{} render vertices for {} particles: farthest from its bound point {farthest:e} m; \
+         moved up to {moved:.3} m",
+        drawn.len(),
+        local.len()
+    );
+    assert_eq!(drawn.len(), fine.len(), "the render mesh is drawn");
+    assert!(farthest < 1e-5, "{farthest} m");
+    assert!(moved > 0.5, "the skirt walked: {moved} m");
 }
 
 /// Where the walking body of [`animated`] puts `local` at time `t`, after it has been

@@ -37,7 +37,7 @@ pub use events::{
 pub use lod::{ClothLod, ClothLodPlugin};
 pub use mesh::ClothMeshPlugin;
 pub use plugin::{ClothCorePlugin, ClothPlugin, ClothPrepareSystems, ClothSystems};
-pub use proxy::{ClothProxy, ClothProxyPlugin};
+pub use proxy::{ClothProxy, ClothProxyEntity, ClothProxyPlugin};
 pub use skin::{
     ATTRIBUTE_BACK_STOP, ATTRIBUTE_MAX_DISTANCE, ClothBackStop, ClothMaxDistance, ClothSkinPlugin,
 };

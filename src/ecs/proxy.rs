@@ -3,7 +3,11 @@
 use bevy::mesh::{Mesh, VertexAttributeValues};
 use bevy::prelude::*;
 
-use crate::ecs::cloth::{ClothSimulation, pause_invalid};
+use bevy::math::{Affine3A, Vec3A};
+use bevy::mesh::skinning::SkinnedMesh;
+use bevy::transform::TransformSystems;
+
+use crate::ecs::cloth::{ClothInvalid, ClothSimulation, pause_invalid};
 use crate::ecs::events::ClothBuilt;
 use crate::error::ClothError;
 use crate::solver::ProxyBinding;
@@ -24,6 +28,22 @@ pub struct ClothProxy {
     /// The render mesh.
     pub mesh: Handle<Mesh>,
 }
+
+/// Draws a cloth with another entity's mesh: the render mesh of a pair exported in one
+/// file (a glTF with a coarse simulation mesh and a fine render mesh, each found by its
+/// `GltfMeshName`), as Chaos Cloth and Magica Cloth pair a render mesh with the mesh they
+/// simulate. Once that entity's `Mesh3d` is loaded, the cloth gets a [`ClothProxy`] of it
+/// and the entity is hidden: the cloth draws it.
+///
+/// Frames: when the render entity is skinned, its positions are in the skin's bind space,
+/// as a skinned simulation mesh's are, and are bound as they are (glTF ignores a skinned
+/// mesh node's own transform). Otherwise they are carried from the render entity's frame
+/// into the cloth entity's, in a copy of the mesh when the two are placed apart. An entity
+/// that is gone or has no `Mesh3d` is refused: the cloth is paused with
+/// [`ClothError::BadMesh`].
+#[derive(Component, Clone, Copy, Debug, PartialEq, Eq, Reflect)]
+#[reflect(Component)]
+pub struct ClothProxyEntity(pub Entity);
 
 /// A proxy bound to its cloth, with the frame's scratch (the simulation's positions and
 /// normals in the cloth's frame) and the render vertices placed on them, written by
@@ -55,10 +75,16 @@ pub struct ClothProxyPlugin;
 impl Plugin for ClothProxyPlugin {
     fn build(&self, app: &mut App) {
         app.register_type::<ClothProxy>()
+            .register_type::<ClothProxyEntity>()
             .add_observer(rebind_on_build)
             .add_systems(
                 PostUpdate,
-                bind_proxies.before(crate::ClothSystems::WriteMesh),
+                (
+                    adopt_proxy_entities.after(TransformSystems::Propagate),
+                    bind_proxies,
+                )
+                    .chain()
+                    .before(crate::ClothSystems::WriteMesh),
             );
     }
 }
@@ -72,6 +98,70 @@ fn rebind_on_build(
     if proxies.contains(built.entity) {
         commands.entity(built.entity).remove::<ProxyBound>();
     }
+}
+
+/// Gives each [`ClothProxyEntity`] cloth a [`ClothProxy`] of that entity's mesh once it is
+/// loaded (in the cloth's frame), and hides the entity.
+#[allow(clippy::type_complexity)]
+fn adopt_proxy_entities(
+    mut commands: Commands,
+    mut meshes: ResMut<Assets<Mesh>>,
+    cloths: Query<
+        (Entity, &ClothProxyEntity, &GlobalTransform),
+        (
+            Or<(Without<ClothProxy>, Changed<ClothProxyEntity>)>,
+            Without<ClothInvalid>,
+        ),
+    >,
+    renders: Query<(&Mesh3d, &GlobalTransform, Has<SkinnedMesh>)>,
+) {
+    for (entity, source, frame) in &cloths {
+        let Ok((render, placed, skinned)) = renders.get(source.0) else {
+            let reason = format!("proxy entity {}: it has no Mesh3d", source.0);
+            pause_invalid(&mut commands, entity, ClothError::BadMesh { reason });
+            continue;
+        };
+        let Some(mesh) = meshes.get(&render.0) else {
+            continue; // still loading
+        };
+        // The render entity's frame seen from the cloth's.
+        let apart = frame.affine().inverse() * placed.affine();
+        let mesh = if skinned || apart.abs_diff_eq(Affine3A::IDENTITY, 1e-6) {
+            render.0.clone()
+        } else {
+            let carried = carried(mesh, apart);
+            meshes.add(carried)
+        };
+        commands.entity(entity).insert(ClothProxy { mesh });
+        commands.entity(source.0).insert(Visibility::Hidden);
+    }
+}
+
+/// A copy of `mesh` with its positions, normals and tangents moved by `by`.
+fn carried(mesh: &Mesh, by: Affine3A) -> Mesh {
+    let mut mesh = mesh.clone();
+    let turn = by.matrix3;
+    let normal = turn.inverse().transpose();
+    // A mirroring move flips the tangents' handedness.
+    let handed = turn.determinant().signum();
+    if let Some(VertexAttributeValues::Float32x3(p)) = mesh.attribute_mut(Mesh::ATTRIBUTE_POSITION)
+    {
+        for p in p.iter_mut() {
+            *p = by.transform_point3(Vec3::from(*p)).to_array();
+        }
+    }
+    if let Some(VertexAttributeValues::Float32x3(n)) = mesh.attribute_mut(Mesh::ATTRIBUTE_NORMAL) {
+        for n in n.iter_mut() {
+            *n = (normal * Vec3A::from(*n)).normalize_or_zero().to_array();
+        }
+    }
+    if let Some(VertexAttributeValues::Float32x4(t)) = mesh.attribute_mut(Mesh::ATTRIBUTE_TANGENT) {
+        for t in t.iter_mut() {
+            let turned = (turn * Vec3A::new(t[0], t[1], t[2])).normalize_or_zero();
+            *t = [turned.x, turned.y, turned.z, t[3] * handed];
+        }
+    }
+    mesh
 }
 
 /// Binds each built cloth's [`ClothProxy`] once its mesh is loaded, and draws the cloth
@@ -224,5 +314,51 @@ pub(crate) fn give_to_mesh(mesh: &mut Mesh, bound: &mut ProxyBound) {
     ) && theirs.len() == m
     {
         std::mem::swap(theirs, mine);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bevy::asset::RenderAssetUsages;
+    use bevy::mesh::PrimitiveTopology;
+
+    /// A mesh carried by a stretching, mirroring move keeps its normals perpendicular to
+    /// its moved surface and flips its tangents' handedness.
+    #[test]
+    fn a_carried_mesh_keeps_its_normals_on_its_surface() {
+        let mut mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::all());
+        let flat = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 1.0]];
+        let a = Vec3::from(flat[1]) - Vec3::from(flat[0]);
+        let b = Vec3::from(flat[2]) - Vec3::from(flat[0]);
+        let n = a.cross(b).normalize();
+        mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, flat);
+        mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, vec![n.to_array(); 3]);
+        mesh.insert_attribute(Mesh::ATTRIBUTE_TANGENT, vec![[1.0, 0.0, 0.0, 1.0]; 3]);
+        let by = Affine3A::from_scale_rotation_translation(
+            Vec3::new(-1.0, 3.0, 0.5),
+            Quat::from_rotation_y(0.7),
+            Vec3::new(2.0, -1.0, 4.0),
+        );
+        let moved = carried(&mesh, by);
+        let Some(VertexAttributeValues::Float32x3(p)) = moved.attribute(Mesh::ATTRIBUTE_POSITION)
+        else {
+            panic!("positions")
+        };
+        let Some(VertexAttributeValues::Float32x3(normals)) =
+            moved.attribute(Mesh::ATTRIBUTE_NORMAL)
+        else {
+            panic!("normals")
+        };
+        let Some(VertexAttributeValues::Float32x4(t)) = moved.attribute(Mesh::ATTRIBUTE_TANGENT)
+        else {
+            panic!("tangents")
+        };
+        let [p0, p1, p2] = [p[0], p[1], p[2]].map(Vec3::from);
+        assert!(p0.abs_diff_eq(Vec3::new(2.0, -1.0, 4.0), 1e-6));
+        let normal = Vec3::from(normals[0]);
+        assert!((normal.length() - 1.0).abs() < 1e-5);
+        assert!(normal.dot(p1 - p0).abs() < 1e-5 && normal.dot(p2 - p0).abs() < 1e-5);
+        assert_eq!(t[0][3], -1.0, "a mirror flips the handedness");
     }
 }
