@@ -39,6 +39,11 @@ impl ModelSteps for MassSpring {
     }
 }
 
+/// A spring whose squared length is under this share of its squared limit is within it
+/// whatever the rounding of the square and the square root (a few units in the last place
+/// of `f32`).
+const WITHIN_SQUARED: f32 = 1.0 - 1e-5;
+
 impl ClothSolver {
     /// Provot (1995): springs longer than `(1 + limit)·l0` are shortened to that length,
     /// each end moved by its share of inverse mass (Sladović 2014 eq. 2); Gauss–Seidel sweeps
@@ -111,15 +116,22 @@ impl ClothSolver {
                     continue;
                 }
                 let (a, b) = (s.a[idx] as usize, s.b[idx] as usize);
+                let d = p.position[b] - p.position[a];
+                let max = (1.0 + limit) * s.rest_length[idx];
+                // Most springs are within their limit: the squared length tells them apart
+                // without a square root (a margin under the rounding of both sides, so
+                // the springs corrected are exactly those with `len > max`).
+                let squared = d.length_squared();
+                if squared <= WITHIN_SQUARED * max * max {
+                    continue;
+                }
+                let len = squared.sqrt();
+                if len <= max {
+                    continue;
+                }
                 let (wa, wb) = (p.inv_mass[a], p.inv_mass[b]);
                 let w = wa + wb;
                 if w == 0.0 {
-                    continue;
-                }
-                let d = p.position[b] - p.position[a];
-                let len = d.length();
-                let max = (1.0 + limit) * s.rest_length[idx];
-                if len <= max {
                     continue;
                 }
                 if TRACK {
