@@ -199,7 +199,9 @@ fn setup(
         // The cape: its top row attached to the shoulders, where it is at spawn.
         let behind = at.transform_point(Vec3::new(0.0, SHOULDERS, -BODY_RADIUS - 0.03));
         commands.spawn((
-            Cloth::grid(cw, ch, spacing).with_pins(ClothPins::None),
+            Cloth::grid(cw, ch, spacing)
+                .with_pins(ClothPins::None)
+                .with_params(params()),
             Transform::from_translation(behind).with_rotation(at.rotation),
             ClothAttachments(vec![ClothAttachment::indices(body, top_row.clone())]),
             ClothProxy {
@@ -212,7 +214,9 @@ fn setup(
         // The skirt: a mesh at the hips, following them within its painted distances.
         let skirt = commands
             .spawn((
-                Cloth::from_mesh().with_pins(ClothPins::None),
+                Cloth::from_mesh()
+                    .with_pins(ClothPins::None)
+                    .with_params(params()),
                 Mesh3d(meshes.add(cone_mesh(around, down, 1))),
                 ClothMaxDistance::PerVertex(distances.clone()),
                 ClothBackStop::Uniform {
@@ -265,5 +269,15 @@ fn walk(time: Res<Time>, mut characters: Query<(&mut Walk, &mut Transform)>) {
             walk.away = !walk.away;
         }
         *transform = walk.transform(t);
+    }
+}
+
+/// The crowd's cloths: the default mass-spring, its strain limiter stopping once every
+/// spring is within 1% of its limit rather than always taking its four sweeps (most of the
+/// crowd is calm: the same strain at 0.8 of the cost, measured by `cloth crowd`).
+fn params() -> ClothParams {
+    ClothParams {
+        strain_limit_tolerance: Some(0.01),
+        ..default()
     }
 }

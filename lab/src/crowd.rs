@@ -11,7 +11,7 @@ use std::time::Instant;
 use bevy::math::{Affine3A, Quat, Vec3};
 use serde::Serialize;
 
-use bevy_cloth::layout::shape::ClothPins;
+use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{ClothParams, Environment, Turbulence, WindZone, ZoneShape};
 use bevy_cloth::solver::shapes::Capsule;
 use bevy_cloth::solver::{
@@ -192,10 +192,10 @@ pub struct Crowd {
 }
 
 /// The rest shapes every character's cloths share: the cape's and the skirt's rest
-/// positions in the body's frame, their finer drawn points and their triangles, and the
+/// positions in the body's frame, their finer drawn points and their layouts, and the
 /// skirt's painted distances.
 struct Shapes {
-    cape: (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>),
+    cape: (Vec<Vec3>, Vec<Vec3>, Layout),
     skirt: (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>),
     skirt_radius: Vec<f32>,
     cape_top: u32,
@@ -219,8 +219,17 @@ impl Shapes {
                 .collect()
         };
         let (skirt_rest, skirt_triangles) = cone(around, down, 1);
+        // The cape is the grid the example's `Cloth::grid` lays out (its structural,
+        // shear and bend springs), its particles where `on_back` puts them.
+        let shape = ClothShape::Grid {
+            width: cw,
+            height: ch,
+            spacing,
+        };
+        let mut cape_grid = shape.layout().expect("a grid");
+        cape_grid.positions = on_back(1);
         Shapes {
-            cape: (on_back(1), on_back(size.refine), grid_triangles(cw, ch)),
+            cape: (on_back(1), on_back(size.refine), cape_grid),
             skirt: (
                 skirt_rest,
                 cone(around, down, size.refine).0,
@@ -248,10 +257,11 @@ impl Character {
         };
         let pose = walk.pose(0.0);
         let frame = Affine3A::from_rotation_translation(pose.0, pose.1);
-        let (cape_rest, cape_fine, cape_triangles) = &shapes.cape;
+        let (cape_rest, cape_fine, cape_grid) = &shapes.cape;
         let (skirt_rest, skirt_fine, skirt_triangles) = &shapes.skirt;
-        let mut cape = solver_of(cape_rest, cape_triangles, params, frame);
-        let mut skirt = solver_of(skirt_rest, skirt_triangles, params, frame);
+        let mut cape = solver_of(cape_grid.clone(), params, frame);
+        let skirt_layout = Layout::from_mesh(skirt_rest, skirt_triangles).expect("a mesh");
+        let mut skirt = solver_of(skirt_layout, params, frame);
         let targets: Vec<Vec3> = skirt_rest
             .iter()
             .map(|&p| frame.transform_point3(p))
@@ -467,27 +477,18 @@ impl Crowd {
     }
 }
 
-/// The triangles of a `w × h` grid.
-fn grid_triangles(w: u32, h: u32) -> Vec<[u32; 3]> {
-    let mut t = Vec::new();
-    for j in 0..h - 1 {
-        for i in 0..w - 1 {
-            let v = j * w + i;
-            t.push([v, v + w, v + 1]);
-            t.push([v + 1, v + w, v + w + 1]);
-        }
+/// The crowd's cloths, as the example's: the default mass-spring, its strain limiter
+/// stopping once every spring is within 1% of its limit rather than always taking its
+/// four sweeps (most of the crowd is calm).
+pub fn params() -> ClothParams {
+    ClothParams {
+        strain_limit_tolerance: Some(0.01),
+        ..ClothParams::default()
     }
-    t
 }
 
-/// A solver of `rest` (in the body's frame) and its triangles, placed by `frame`.
-fn solver_of(
-    rest: &[Vec3],
-    triangles: &[[u32; 3]],
-    params: &ClothParams,
-    frame: Affine3A,
-) -> ClothSolver {
-    let layout = Layout::from_mesh(rest, triangles).expect("a mesh");
+/// A solver of `layout` (in the body's frame), placed by `frame`.
+fn solver_of(layout: Layout, params: &ClothParams, frame: Affine3A) -> ClothSolver {
     let pins = ClothPins::None.resolve_for(&layout).expect("no pins");
     ClothSolver::new(layout, &pins, params, frame).expect("valid")
 }

@@ -24,7 +24,7 @@ pub(crate) struct CrowdArgs {
     pub(crate) json: bool,
     /// Every cloth's parameters, as a scene file writes them (RON, fields left out take
     /// their defaults), e.g. `(model: Xpbd((max_stretch_error: 0.03)))`. Default: the
-    /// default parameters (mass-spring).
+    /// example's (`crowd::params`: mass-spring, the limiter with a 1% tolerance).
     #[arg(long)]
     pub(crate) params: Option<String>,
 }
@@ -41,7 +41,7 @@ pub(crate) fn crowd(args: CrowdArgs) -> Result<(), String> {
             params.validate().map_err(|e| format!("--params: {e}"))?;
             params
         }
-        None => ClothParams::default(),
+        None => crowd::params(),
     };
     let cost = crowd::measure(size, &params, args.warm as usize, args.frames as usize);
     let health = cost.strain[2];
