@@ -3,6 +3,8 @@
 //! following its bones, mesh vertex indices through the welding.
 //! `cargo test --test character`.
 
+mod common;
+
 use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::params::{Environment, Model};
 use bevy_cloth::prelude::*;
@@ -982,6 +984,25 @@ mod walk_gltf {
 
     use super::{COLUMNS, ROWS, STEP};
 
+    /// The file's walk, loaded as an animation graph of one clip: the graph and its node.
+    pub fn animation(
+        app: &mut bevy::prelude::App,
+    ) -> (
+        bevy::prelude::Handle<bevy::prelude::AnimationGraph>,
+        bevy::prelude::AnimationNodeIndex,
+    ) {
+        use bevy::gltf::GltfAssetLabel;
+        use bevy::prelude::*;
+        let server = app.world().resource::<AssetServer>().clone();
+        let clip = server.load(GltfAssetLabel::Animation(0).from_asset("walk.gltf"));
+        let (graph, walk) = AnimationGraph::from_clip(clip);
+        let graph = app
+            .world_mut()
+            .resource_mut::<Assets<AnimationGraph>>()
+            .add(graph);
+        (graph, walk)
+    }
+
     const ARMATURE: Vec3 = Vec3::new(0.5, 0.0, 0.0);
     const HIPS: Vec3 = Vec3::new(0.0, 1.0, 0.0);
     const KNEE: Vec3 = Vec3::new(0.0, -0.16, 0.0);
@@ -1278,12 +1299,7 @@ fn walk_a_gltf_character(
     let fixed = app.world().resource::<ClothInterpolation>().0;
     let server = app.world().resource::<AssetServer>().clone();
     let scene = server.load(GltfAssetLabel::Scene(0).from_asset("walk.gltf"));
-    let clip = server.load(GltfAssetLabel::Animation(0).from_asset("walk.gltf"));
-    let (graph, walk) = AnimationGraph::from_clip(clip);
-    let graph = app
-        .world_mut()
-        .resource_mut::<Assets<AnimationGraph>>()
-        .add(graph);
+    let (graph, walk) = walk_gltf::animation(&mut app);
     app.world_mut()
         .spawn(WorldAssetRoot(scene.clone()))
         .observe(
@@ -1484,12 +1500,7 @@ fn a_gltf_skirt_is_drawn_with_the_finer_render_mesh_of_its_file() {
     let mut app = gltf_app(&dir, PostUpdate);
     let server = app.world().resource::<AssetServer>().clone();
     let scene = server.load(GltfAssetLabel::Scene(0).from_asset("walk.gltf"));
-    let clip = server.load(GltfAssetLabel::Animation(0).from_asset("walk.gltf"));
-    let (graph, walk) = AnimationGraph::from_clip(clip);
-    let graph = app
-        .world_mut()
-        .resource_mut::<Assets<AnimationGraph>>()
-        .add(graph);
+    let (graph, walk) = walk_gltf::animation(&mut app);
     app.world_mut()
         .spawn(WorldAssetRoot(scene.clone()))
         .observe(
@@ -1553,38 +1564,14 @@ fn a_gltf_skirt_is_drawn_with_the_finer_render_mesh_of_its_file() {
         None,
     )
     .unwrap();
-    let to_local = sim.solver.frame().inverse();
-    let local: Vec<Vec3> = sim
-        .solver
-        .positions()
-        .iter()
-        .map(|&x| to_local.transform_point3(x))
-        .collect();
-    let drawn = match world
-        .resource::<Assets<Mesh>>()
-        .get(handle)
-        .unwrap()
-        .attribute(Mesh::ATTRIBUTE_POSITION)
-    {
-        Some(VertexAttributeValues::Float32x3(p)) => p.clone(),
-        _ => panic!("the render mesh has positions"),
-    };
-    let farthest = drawn
-        .iter()
-        .enumerate()
-        .map(|(v, p)| Vec3::from(*p).distance(binding.point(&local, v)))
-        .fold(0.0, f32::max);
-    let moved = drawn
-        .iter()
-        .zip(&fine)
-        .map(|(p, r)| Vec3::from(*p).distance(*r))
-        .fold(0.0, f32::max);
+    let drawn = common::mesh_positions(&app, handle);
+    let (farthest, moved) = common::proxy_offsets(&sim.solver, &binding, &drawn, &fine);
     let _ = std::fs::remove_dir_all(&dir);
     eprintln!(
         "{} render vertices for {} particles: farthest from its bound point {farthest:e} m; \
          moved up to {moved:.3} m",
         drawn.len(),
-        local.len()
+        sim.solver.particle_count()
     );
     assert_eq!(drawn.len(), fine.len(), "the render mesh is drawn");
     assert!(farthest < 1e-5, "{farthest} m");

@@ -6,7 +6,7 @@ use bevy::mesh::{Mesh, VertexAttributeValues};
 use bevy::prelude::*;
 use bevy_cloth::params::{Environment, Integrator, Model, SpringFamily, SpringParams, Substeps};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{ClothSolver, SpringKind};
+use bevy_cloth::solver::{ClothSolver, ProxyBinding, SpringKind};
 
 /// A cloth of 6 × 6 particles 4 cm apart, without air drag, and where it lies flat (in
 /// xz) with its middle at `centre`: on a platform's top at y = 0.1, `centre.y` = 0.106 puts
@@ -253,4 +253,32 @@ pub fn corner_hung_grid_with(width: u32, height: u32, params: &ClothParams) -> C
     }
     .build_solver(&ClothPins::TopCorners, params, Affine3A::IDENTITY)
     .unwrap()
+}
+
+/// How a proxy-drawn cloth's render mesh (its positions `drawn`) sits on `binding`: the
+/// farthest any vertex is from its bound point over `solver`'s particles (taken into the
+/// cloth's frame), and the most any has moved from `start`.
+pub fn proxy_offsets(
+    solver: &ClothSolver,
+    binding: &ProxyBinding,
+    drawn: &[[f32; 3]],
+    start: &[Vec3],
+) -> (f32, f32) {
+    let to_local = solver.frame().inverse();
+    let local: Vec<Vec3> = solver
+        .positions()
+        .iter()
+        .map(|&x| to_local.transform_point3(x))
+        .collect();
+    let farthest = drawn
+        .iter()
+        .enumerate()
+        .map(|(v, p)| Vec3::from(*p).distance(binding.point(&local, v)))
+        .fold(0.0, f32::max);
+    let moved = drawn
+        .iter()
+        .zip(start)
+        .map(|(p, r)| Vec3::from(*p).distance(*r))
+        .fold(0.0, f32::max);
+    (farthest, moved)
 }

@@ -204,24 +204,8 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
     let binding =
         bevy_cloth::solver::ProxyBinding::bind(&rest, sim.solver.triangles(), &render_x, None)
             .unwrap();
-    let to_local = sim.solver.frame().inverse();
-    let local: Vec<Vec3> = sim
-        .solver
-        .positions()
-        .iter()
-        .map(|&x| to_local.transform_point3(x))
-        .collect();
     let drawn = mesh_positions(&app, &handle);
-    let farthest = drawn
-        .iter()
-        .enumerate()
-        .map(|(v, p)| Vec3::from(*p).distance(binding.point(&local, v)))
-        .fold(0.0, f32::max);
-    let moved = drawn
-        .iter()
-        .zip(&render_x)
-        .map(|(p, r)| Vec3::from(*p).distance(*r))
-        .fold(0.0, f32::max);
+    let (farthest, moved) = proxy_offsets(&sim.solver, &binding, &drawn, &render_x);
     eprintln!(
         "{} render vertices: farthest from its bound point {farthest:e} m; moved up to {moved:.3} m",
         drawn.len()
