@@ -191,12 +191,12 @@ pub struct Crowd {
     pub teleports: usize,
 }
 
-/// The rest shapes every character's cloths share: the cape's and the skirt's rest
-/// positions in the body's frame, their finer drawn points and their layouts, and the
-/// skirt's painted distances.
+/// The rest shapes every character's cloths share: the cape's and the skirt's layouts
+/// (their rest positions in the body's frame), their finer drawn points, and the skirt's
+/// painted distances.
 struct Shapes {
-    cape: (Vec<Vec3>, Vec<Vec3>, Layout),
-    skirt: (Vec<Vec3>, Vec<Vec3>, Vec<[u32; 3]>),
+    cape: (Layout, Vec<Vec3>),
+    skirt: (Layout, Vec<Vec3>),
     skirt_radius: Vec<f32>,
     cape_top: u32,
 }
@@ -229,11 +229,10 @@ impl Shapes {
         let mut cape_grid = shape.layout().expect("a grid");
         cape_grid.positions = on_back(1);
         Shapes {
-            cape: (on_back(1), on_back(size.refine), cape_grid),
+            cape: (cape_grid, on_back(size.refine)),
             skirt: (
-                skirt_rest,
+                Layout::from_mesh(&skirt_rest, &skirt_triangles).expect("a mesh"),
                 cone(around, down, size.refine).0,
-                skirt_triangles,
             ),
             skirt_radius: (0..around * down)
                 .map(|k| 0.2 * ((k / around) as f32 / (down - 1) as f32).powi(2))
@@ -257,11 +256,11 @@ impl Character {
         };
         let pose = walk.pose(0.0);
         let frame = Affine3A::from_rotation_translation(pose.0, pose.1);
-        let (cape_rest, cape_fine, cape_grid) = &shapes.cape;
-        let (skirt_rest, skirt_fine, skirt_triangles) = &shapes.skirt;
-        let mut cape = solver_of(cape_grid.clone(), params, frame);
-        let skirt_layout = Layout::from_mesh(skirt_rest, skirt_triangles).expect("a mesh");
-        let mut skirt = solver_of(skirt_layout, params, frame);
+        let (cape_layout, cape_fine) = &shapes.cape;
+        let (skirt_layout, skirt_fine) = &shapes.skirt;
+        let (cape_rest, skirt_rest) = (&cape_layout.positions, &skirt_layout.positions);
+        let mut cape = solver_of(cape_layout.clone(), params, frame);
+        let mut skirt = solver_of(skirt_layout.clone(), params, frame);
         let targets: Vec<Vec3> = skirt_rest
             .iter()
             .map(|&p| frame.transform_point3(p))
