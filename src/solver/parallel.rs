@@ -78,6 +78,12 @@ pub(super) fn for_each<T: Send>(
     for_each_from(PARALLEL_FROM, len, pieces, work);
 }
 
+/// Whether a kernel of `len` elements with threshold `from` runs in order on the calling
+/// thread (as [`for_each_from`] decides), where a kernel may take a serial shortcut.
+pub(super) fn on_this_thread(from: usize, len: usize) -> bool {
+    len < from || !PARALLEL.load(Ordering::Relaxed)
+}
+
 /// [`for_each`] for a kernel whose own measurements put its threshold at `from` elements.
 pub(super) fn for_each_from<T: Send>(
     from: usize,
@@ -85,7 +91,7 @@ pub(super) fn for_each_from<T: Send>(
     pieces: impl Iterator<Item = T>,
     work: impl Fn(T) + Sync,
 ) {
-    if len < from || !PARALLEL.load(Ordering::Relaxed) {
+    if on_this_thread(from, len) {
         pieces.for_each(work);
         return;
     }

@@ -145,9 +145,16 @@ impl ClothSolver {
     /// cloth (whose tasks are the only allocation).
     pub fn normals_into(&self, out: &mut [Vec3]) {
         let x = &self.particles.position;
-        // Gathered per particle over its triangles in increasing order: the same sums, in
-        // the same order, as scattering each triangle's normal onto its corners, and a
-        // particle's normal is written by one piece only.
+        // On one thread each triangle is scattered onto its corners; over the pool each
+        // particle gathers its own triangles (written by one piece only). Both add in
+        // increasing triangle order: the same sums, to the bit.
+        if parallel::on_this_thread(parallel::PARALLEL_FROM, out.len()) {
+            self.structure.normal_sums_into(x, out);
+            for n in out.iter_mut() {
+                *n = n.normalize_or(Vec3::Z);
+            }
+            return;
+        }
         parallel::for_each_indexed(out, |i, n| {
             *n = self.structure.normal_sum(x, i).normalize_or(Vec3::Z);
         });

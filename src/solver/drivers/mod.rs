@@ -143,9 +143,11 @@ impl MotionConstraints {
         if self.back_stop.is_empty() || self.next.len() != self.back_stop.len() {
             return;
         }
-        let next = &self.next;
-        self.normal_next
-            .extend((0..next.len()).map(|i| structure.normal_sum(next, i).normalize_or_zero()));
+        self.normal_next.resize(self.next.len(), Vec3::ZERO);
+        structure.normal_sums_into(&self.next, &mut self.normal_next);
+        for n in &mut self.normal_next {
+            *n = n.normalize_or_zero();
+        }
     }
 }
 
