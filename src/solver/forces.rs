@@ -202,12 +202,15 @@ impl ClothSolver {
             }
             let [a, b, c] = corners.map(|i| i as usize);
             let (xa, xb, xc) = (p.position[a], p.position[b], p.position[c]);
+            // `cross` is `2A n`: every term below is written in it and `w`, with one
+            // square root (of `|cross|² |w|²`) where the unit normal, the area, the unit
+            // flow and the lift's direction took four, a triangle's chain of them the
+            // air's cost.
             let cross = (xb - xa).cross(xc - xa);
-            let twice_area = cross.length();
-            if twice_area <= 0.0 {
+            let cross2 = cross.length_squared();
+            if cross2 <= 0.0 {
                 continue;
             }
-            let (area, normal) = (0.5 * twice_area, cross / twice_area);
             let centre = (xa + xb + xc) / 3.0;
             let moving = (p.velocity[a] + p.velocity[b] + p.velocity[c]) / 3.0;
             let blowing = if zones.is_empty() {
@@ -216,17 +219,26 @@ impl ClothSolver {
                 (zones[a] + zones[b] + zones[c]) / 3.0
             };
             let w = flow.vector_at(centre) + blowing - moving;
-            let wn = w.dot(normal);
-            let across = w - wn * normal;
-            let drag = half_rho * air.drag * area * wn * wn.abs() * normal;
-            let flow_dir = w.normalize_or_zero();
-            let lift_dir = (normal - normal.dot(flow_dir) * flow_dir).normalize_or_zero();
-            let lift = half_rho * air.lift * area * wn * across.length() * lift_dir;
-            let share = (drag + lift) / 3.0;
-            let rate = half_rho * air.drag * area * wn.abs() / 3.0;
+            // `w·n 2A`; `w·n |w·n| A n = wc |wc| cross / (2 |cross|²)`.
+            let (wc, w2) = (w.dot(cross), w.length_squared());
+            let over_cross2 = 1.0 / cross2;
+            let drag = air.drag * wc * wc.abs() * over_cross2 * cross;
+            // `(w·n) |w × n| A ℓ = (w·n) A (|w|² n − (w·n) w) / |w|`
+            // `= wc (|w|² cross − wc w) / (2 |cross| |w|)`.
+            // `|wc| ≤ |cross| |w|`: the quotient is at most 1, and `|cross| |w|` is 0
+            // only where the lift vanishes.
+            let reach = (cross2 * w2).sqrt();
+            let lift = if reach > 0.0 {
+                air.lift * (wc / reach) * (w2 * cross - wc * w)
+            } else {
+                Vec3::ZERO
+            };
+            // The ½ of the area and the third to each corner.
+            let share = half_rho * (drag + lift) / 6.0;
+            let rate = half_rho * air.drag * wc.abs() / 6.0;
             // The drag's derivative in the particle's velocity (with its triangle's),
             // `2 rate n nᵀ`.
-            let (d, m) = (2.0 * rate, normal);
+            let (d, m) = (2.0 * rate * over_cross2, cross);
             let slope = [
                 d * m.x * m.x,
                 d * m.y * m.y,
@@ -321,6 +333,79 @@ mod tests {
     use bevy::math::DVec3;
 
     use super::*;
+
+    /// The air's load on a crumpled, moving grid in a breeze is the flat-plate force of
+    /// [`Air`] on each triangle (drag `½ ρ C_d A (w·n)|w·n| n`, lift `½ ρ C_l A (w·n)
+    /// |w × n| ℓ`), a third to each corner, and its drag rate `½ ρ C_d A |w·n| / 3`: as
+    /// written there, with unit normals and directions, in `f64`.
+    #[test]
+    fn the_air_on_each_triangle_is_the_flat_plate_force() {
+        use crate::layout::shape::ClothPins;
+        use crate::layout::shape::ClothShape;
+        let shape = ClothShape::Grid {
+            width: 4,
+            height: 3,
+            spacing: 0.1,
+        };
+        let mut cloth = shape
+            .build_solver(
+                &ClothPins::None,
+                &crate::params::ClothParams::default(),
+                bevy::math::Affine3A::IDENTITY,
+            )
+            .unwrap();
+        let n = cloth.particles.len();
+        for i in 0..n {
+            let f = i as f32;
+            cloth.particles.position[i] += Vec3::new(0.01 * f.sin(), 0.0, 0.04 * (1.7 * f).cos());
+            cloth.particles.velocity[i] = Vec3::new(0.3 * (0.7 * f).cos(), -0.2, 0.5 * f.sin());
+        }
+        // A breeze along each of three directions (the last nearly in the cloth's plane).
+        for velocity in [
+            Vec3::new(0.0, 0.0, 3.0),
+            Vec3::new(1.0, -2.0, 0.5),
+            Vec3::new(4.0, 0.0, 0.05),
+        ] {
+            let air = Air {
+                velocity,
+                ..Air::default()
+            };
+            cloth.air_on_triangles(&air);
+            let (mut force, mut rate) = (vec![DVec3::ZERO; n], vec![0.0f64; n]);
+            let (x, v) = (&cloth.particles.position, &cloth.particles.velocity);
+            let half_rho = 0.5 * air.density as f64;
+            for t in &cloth.structure.triangles {
+                let [a, b, c] = t.map(|i| i as usize);
+                let cross = (x[b] - x[a]).as_dvec3().cross((x[c] - x[a]).as_dvec3());
+                let (area, normal) = (0.5 * cross.length(), cross.normalize());
+                let moving = (v[a] + v[b] + v[c]).as_dvec3() / 3.0;
+                let w = velocity.as_dvec3() - moving;
+                let wn = w.dot(normal);
+                let drag = half_rho * air.drag as f64 * area * wn * wn.abs() * normal;
+                let lift_dir = (normal - normal.dot(w.normalize()) * w.normalize()).normalize();
+                let lift =
+                    half_rho * air.lift as f64 * area * wn * w.cross(normal).length() * lift_dir;
+                for i in [a, b, c] {
+                    force[i] += (drag + lift) / 3.0;
+                    rate[i] += half_rho * air.drag as f64 * area * wn.abs() / 3.0;
+                }
+            }
+            for i in 0..n {
+                let got = cloth.air.force[i].as_dvec3();
+                assert!(
+                    (got - force[i]).length() <= 1e-5 * force[i].length().max(1e-6),
+                    "{velocity} {i}: {got} against {}",
+                    force[i]
+                );
+                let r = cloth.air.rate[i] as f64;
+                assert!(
+                    (r - rate[i]).abs() <= 1e-5 * rate[i],
+                    "{i}: {r} against {}",
+                    rate[i]
+                );
+            }
+        }
+    }
 
     /// One spring's force against Hooke's law with damping along the spring, in `f64`:
     /// `F = (k (|d| − l0) + c (v_b − v_a)·d̂) d̂` on the first end, its opposite on the

@@ -108,13 +108,12 @@ fn a_banner_in_a_wind_zone_moves_and_one_outside_does_not() {
 }
 
 /// The zone's gusts and turbulence swell and stir the force: the banner's hem swings
-/// over a wider range than in a steady zone (where a banner flutters too).
+/// over a wider range than in a steady zone (where a banner flutters too). A flutter's
+/// range over 2 s is chaotic (the air's rounding alone moved the steady one from 0.104
+/// to 0.127 m), so each is the median of five zones, 8 m/s ± 2%, with five seeds of
+/// turbulence.
 #[test]
 fn gusts_keep_a_banner_moving() {
-    let steady = WindZone {
-        turbulence: Turbulence::default(),
-        ..zone()
-    };
     let spread = |zone: WindZone| {
         let mut cloth = banner(Vec3::new(0.0, 2.0, 0.0));
         let (env, dt) = (Environment::default(), 1.0 / 60.0);
@@ -130,8 +129,27 @@ fn gusts_keep_a_banner_moving() {
         }
         high - low
     };
-    let (steady, gusty) = (spread(steady), spread(zone()));
-    eprintln!("the hem's swing over the last 2 s: steady {steady:.3} m, gusty {gusty:.3} m");
+    let median = |gusty: bool| {
+        let mut spreads: Vec<f32> = (0..5)
+            .map(|k| {
+                let mut zone = zone();
+                zone.velocity *= 0.98 + 0.01 * k as f32;
+                zone.turbulence.seed += k;
+                if !gusty {
+                    zone.turbulence = Turbulence::default();
+                }
+                spread(zone)
+            })
+            .collect();
+        eprintln!("{spreads:.3?}");
+        spreads.sort_by(f32::total_cmp);
+        spreads[2]
+    };
+    let (steady, gusty) = (median(false), median(true));
+    eprintln!(
+        "the hem's swing over the last 2 s, median of five: steady {steady:.3} m, gusty \
+         {gusty:.3} m"
+    );
     assert!(gusty > 1.5 * steady && gusty > 0.05);
 }
 
