@@ -340,8 +340,7 @@ mod tests {
     /// written there, with unit normals and directions, in `f64`.
     #[test]
     fn the_air_on_each_triangle_is_the_flat_plate_force() {
-        use crate::layout::shape::ClothPins;
-        use crate::layout::shape::ClothShape;
+        use crate::layout::shape::{ClothPins, ClothShape};
         let shape = ClothShape::Grid {
             width: 4,
             height: 3,

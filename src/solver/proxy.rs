@@ -401,6 +401,26 @@ fn scaled_or(v: Vec3, rcp: f32, fallback: Vec3) -> Vec3 {
 mod tests {
     use super::*;
 
+    /// A `w × h` sheet of 0.1 m cells, crumpled `bend` m out of its plane, and its
+    /// triangles (two a cell).
+    fn sheet(w: u32, h: u32, bend: f32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+        let x = (0..w * h)
+            .map(|v| {
+                let (i, j) = ((v % w) as f32, (v / w) as f32);
+                Vec3::new(0.1 * i, 0.1 * j, bend * (1.7 * i).sin() * (0.9 * j).cos())
+            })
+            .collect();
+        let mut triangles = Vec::new();
+        for j in 0..h - 1 {
+            for i in 0..w - 1 {
+                let v = j * w + i;
+                triangles.push([v, v + 1, v + w]);
+                triangles.push([v + 1, v + w + 1, v + w]);
+            }
+        }
+        (x, triangles)
+    }
+
     /// A render vertex on, above and beyond a triangle is put back where it was over the
     /// rest it was bound on, and moves rigidly with the triangle.
     #[test]
@@ -442,23 +462,7 @@ mod tests {
     #[test]
     fn placing_in_batches_is_placing_one_by_one() {
         let (w, h) = (5u32, 4u32);
-        let sheet = |bend: f32| -> Vec<Vec3> {
-            (0..w * h)
-                .map(|v| {
-                    let (i, j) = ((v % w) as f32, (v / w) as f32);
-                    Vec3::new(0.1 * i, 0.1 * j, bend * (1.7 * i).sin() * (0.9 * j).cos())
-                })
-                .collect()
-        };
-        let rest = sheet(0.0);
-        let mut triangles = Vec::new();
-        for j in 0..h - 1 {
-            for i in 0..w - 1 {
-                let v = j * w + i;
-                triangles.push([v, v + 1, v + w]);
-                triangles.push([v + 1, v + w + 1, v + w]);
-            }
-        }
+        let (rest, triangles) = sheet(w, h, 0.0);
         // The first two over the corner whose normals have no length.
         let render: Vec<Vec3> = (0..19)
             .map(|k| match k {
@@ -483,7 +487,7 @@ mod tests {
             })
             .collect();
         let mut binding = ProxyBinding::bind(&rest, &triangles, &render, Some(&tangents)).unwrap();
-        let x = sheet(0.04);
+        let x = sheet(w, h, 0.04).0;
         let normals: Vec<Vec3> = (0..w * h)
             .map(|v| match (v % w, v / w) {
                 (0..2, 0..2) => Vec3::ZERO,
@@ -520,21 +524,7 @@ mod tests {
     /// beside it and far off it.
     #[test]
     fn the_bucketed_search_finds_the_nearest_triangle() {
-        let (w, h) = (13u32, 9u32);
-        let x: Vec<Vec3> = (0..w * h)
-            .map(|v| {
-                let (i, j) = ((v % w) as f32, (v / w) as f32);
-                Vec3::new(0.1 * i, 0.1 * j, 0.03 * (1.7 * i).sin() * (0.9 * j).cos())
-            })
-            .collect();
-        let mut triangles = Vec::new();
-        for j in 0..h - 1 {
-            for i in 0..w - 1 {
-                let v = j * w + i;
-                triangles.push([v, v + 1, v + w]);
-                triangles.push([v + 1, v + w + 1, v + w]);
-            }
-        }
+        let (x, triangles) = sheet(13, 9, 0.03);
         let usable = usable(&x, &triangles);
         assert_eq!(usable.len(), triangles.len());
         let buckets = Buckets::new(&usable);
