@@ -193,7 +193,6 @@ impl ClothSolver {
         load.clear(p.len());
         load.velocity.copy_from_slice(&p.velocity);
         load.current = true;
-        let half_rho = 0.5 * air.density;
         let flow = air.at_time(time);
         let zones = &self.wind.at;
         for (t, corners) in s.triangles.iter().enumerate() {
@@ -202,13 +201,8 @@ impl ClothSolver {
             }
             let [a, b, c] = corners.map(|i| i as usize);
             let (xa, xb, xc) = (p.position[a], p.position[b], p.position[c]);
-            // `cross` is `2A n`: every term below is written in it and `w`, with one
-            // square root (of `|cross|² |w|²`) where the unit normal, the area, the unit
-            // flow and the lift's direction took four, a triangle's chain of them the
-            // air's cost.
             let cross = (xb - xa).cross(xc - xa);
-            let cross2 = cross.length_squared();
-            if cross2 <= 0.0 {
+            if cross.length_squared() <= 0.0 {
                 continue;
             }
             let centre = (xa + xb + xc) / 3.0;
@@ -219,34 +213,7 @@ impl ClothSolver {
                 (zones[a] + zones[b] + zones[c]) / 3.0
             };
             let w = flow.vector_at(centre) + blowing - moving;
-            // `w·n 2A`; `w·n |w·n| A n = wc |wc| cross / (2 |cross|²)`.
-            let (wc, w2) = (w.dot(cross), w.length_squared());
-            let over_cross2 = 1.0 / cross2;
-            let drag = air.drag * wc * wc.abs() * over_cross2 * cross;
-            // `(w·n) |w × n| A ℓ = (w·n) A (|w|² n − (w·n) w) / |w|`
-            // `= wc (|w|² cross − wc w) / (2 |cross| |w|)`.
-            // `|wc| ≤ |cross| |w|`: the quotient is at most 1, and `|cross| |w|` is 0
-            // only where the lift vanishes.
-            let reach = (cross2 * w2).sqrt();
-            let lift = if reach > 0.0 {
-                air.lift * (wc / reach) * (w2 * cross - wc * w)
-            } else {
-                Vec3::ZERO
-            };
-            // The ½ of the area and the third to each corner.
-            let share = half_rho * (drag + lift) / 6.0;
-            let rate = half_rho * air.drag * wc.abs() / 6.0;
-            // The drag's derivative in the particle's velocity (with its triangle's),
-            // `2 rate n nᵀ`.
-            let (d, m) = (2.0 * rate * over_cross2, cross);
-            let slope = [
-                d * m.x * m.x,
-                d * m.y * m.y,
-                d * m.z * m.z,
-                d * m.x * m.y,
-                d * m.x * m.z,
-                d * m.y * m.z,
-            ];
+            let (share, rate, slope) = corner_load(air, cross, w);
             for i in [a, b, c] {
                 load.force[i] += share;
                 load.rate[i] += rate;
@@ -294,6 +261,45 @@ impl ClothSolver {
     }
 }
 
+/// A triangle's air load on each of its corners: a third of its flat-plate force, its
+/// drag rate and the rate's derivative in velocity `2 rate n nᵀ` (as xx, yy, zz, xy, xz,
+/// yz), for the triangle's area vector `cross = 2A n` (not zero) and the air's velocity
+/// `w` relative to it. Every term is written in `cross` and `w`, with one square root
+/// (of `|cross|² |w|²`) where the unit normal, the area, the unit flow and the lift's
+/// direction took four, a triangle's chain of them the air's cost.
+#[inline(always)]
+fn corner_load(air: &Air, cross: Vec3, w: Vec3) -> (Vec3, f32, [f32; 6]) {
+    let half_rho = 0.5 * air.density;
+    let cross2 = cross.length_squared();
+    // `w·n 2A`; `w·n |w·n| A n = wc |wc| cross / (2 |cross|²)`.
+    let (wc, w2) = (w.dot(cross), w.length_squared());
+    let over_cross2 = 1.0 / cross2;
+    let drag = air.drag * wc * wc.abs() * over_cross2 * cross;
+    // `(w·n) |w × n| A ℓ = (w·n) A (|w|² n − (w·n) w) / |w|`
+    // `= wc (|w|² cross − wc w) / (2 |cross| |w|)`.
+    // `|wc| ≤ |cross| |w|`: the quotient is at most 1, and `|cross| |w|` is 0 only where
+    // the lift vanishes.
+    let reach = (cross2 * w2).sqrt();
+    let lift = if reach > 0.0 {
+        air.lift * (wc / reach) * (w2 * cross - wc * w)
+    } else {
+        Vec3::ZERO
+    };
+    // The ½ of the area and the third to each corner.
+    let share = half_rho * (drag + lift) / 6.0;
+    let rate = half_rho * air.drag * wc.abs() / 6.0;
+    let (d, m) = (2.0 * rate * over_cross2, cross);
+    let slope = [
+        d * m.x * m.x,
+        d * m.y * m.y,
+        d * m.z * m.z,
+        d * m.x * m.y,
+        d * m.x * m.z,
+        d * m.y * m.z,
+    ];
+    (share, rate, slope)
+}
+
 /// Hooke springs `F = k (|l| − l0) l/|l|` (Maslova eq. 1.4) plus damping along the
 /// spring, over the springs `range` of `s`, each scaled by `scale(spring)`. Each spring
 /// pushes its ends with equal and opposite forces; dividing by each end's mass in
@@ -334,6 +340,31 @@ mod tests {
 
     use super::*;
 
+    /// Each particle's third of its triangles' flat-plate force and drag rate over `cloth`
+    /// in `air` (uniform), as [`Air`] writes them, with unit vectors, in `f64`.
+    fn flat_plate(cloth: &ClothSolver, air: &Air) -> (Vec<DVec3>, Vec<f64>) {
+        let n = cloth.particles.len();
+        let (mut force, mut rate) = (vec![DVec3::ZERO; n], vec![0.0f64; n]);
+        let (x, v) = (&cloth.particles.position, &cloth.particles.velocity);
+        let half_rho = 0.5 * air.density as f64;
+        for t in &cloth.structure.triangles {
+            let [a, b, c] = t.map(|i| i as usize);
+            let cross = (x[b] - x[a]).as_dvec3().cross((x[c] - x[a]).as_dvec3());
+            let (area, normal) = (0.5 * cross.length(), cross.normalize());
+            let moving = (v[a] + v[b] + v[c]).as_dvec3() / 3.0;
+            let w = air.velocity.as_dvec3() - moving;
+            let wn = w.dot(normal);
+            let drag = half_rho * air.drag as f64 * area * wn * wn.abs() * normal;
+            let lift_dir = (normal - normal.dot(w.normalize()) * w.normalize()).normalize();
+            let lift = half_rho * air.lift as f64 * area * wn * w.cross(normal).length() * lift_dir;
+            for i in [a, b, c] {
+                force[i] += (drag + lift) / 3.0;
+                rate[i] += half_rho * air.drag as f64 * area * wn.abs() / 3.0;
+            }
+        }
+        (force, rate)
+    }
+
     /// The air's load on a crumpled, moving grid in a breeze is the flat-plate force of
     /// [`Air`] on each triangle (drag `½ ρ C_d A (w·n)|w·n| n`, lift `½ ρ C_l A (w·n)
     /// |w × n| ℓ`), a third to each corner, and its drag rate `½ ρ C_d A |w·n| / 3`: as
@@ -370,25 +401,7 @@ mod tests {
                 ..Air::default()
             };
             cloth.air_on_triangles(&air);
-            let (mut force, mut rate) = (vec![DVec3::ZERO; n], vec![0.0f64; n]);
-            let (x, v) = (&cloth.particles.position, &cloth.particles.velocity);
-            let half_rho = 0.5 * air.density as f64;
-            for t in &cloth.structure.triangles {
-                let [a, b, c] = t.map(|i| i as usize);
-                let cross = (x[b] - x[a]).as_dvec3().cross((x[c] - x[a]).as_dvec3());
-                let (area, normal) = (0.5 * cross.length(), cross.normalize());
-                let moving = (v[a] + v[b] + v[c]).as_dvec3() / 3.0;
-                let w = velocity.as_dvec3() - moving;
-                let wn = w.dot(normal);
-                let drag = half_rho * air.drag as f64 * area * wn * wn.abs() * normal;
-                let lift_dir = (normal - normal.dot(w.normalize()) * w.normalize()).normalize();
-                let lift =
-                    half_rho * air.lift as f64 * area * wn * w.cross(normal).length() * lift_dir;
-                for i in [a, b, c] {
-                    force[i] += (drag + lift) / 3.0;
-                    rate[i] += half_rho * air.drag as f64 * area * wn.abs() / 3.0;
-                }
-            }
+            let (force, rate) = flat_plate(&cloth, &air);
             for i in 0..n {
                 let got = cloth.air.force[i].as_dvec3();
                 assert!(
