@@ -202,9 +202,6 @@ impl ClothSolver {
             let [a, b, c] = corners.map(|i| i as usize);
             let (xa, xb, xc) = (p.position[a], p.position[b], p.position[c]);
             let cross = (xb - xa).cross(xc - xa);
-            if cross.length_squared() <= 0.0 {
-                continue;
-            }
             let centre = (xa + xb + xc) / 3.0;
             let moving = (p.velocity[a] + p.velocity[b] + p.velocity[c]) / 3.0;
             let blowing = if zones.is_empty() {
@@ -213,7 +210,9 @@ impl ClothSolver {
                 (zones[a] + zones[b] + zones[c]) / 3.0
             };
             let w = flow.vector_at(centre) + blowing - moving;
-            let (share, rate, slope) = corner_load(air, cross, w);
+            let Some((share, rate, slope)) = corner_load(air, cross, w) else {
+                continue;
+            };
             for i in [a, b, c] {
                 load.force[i] += share;
                 load.rate[i] += rate;
@@ -263,14 +262,17 @@ impl ClothSolver {
 
 /// A triangle's air load on each of its corners: a third of its flat-plate force, its
 /// drag rate and the rate's derivative in velocity `2 rate n nᵀ` (as xx, yy, zz, xy, xz,
-/// yz), for the triangle's area vector `cross = 2A n` (not zero) and the air's velocity
-/// `w` relative to it. Every term is written in `cross` and `w`, with one square root
+/// yz), for the triangle's area vector `cross = 2A n` and the air's velocity `w` relative
+/// to it; `None` for a triangle of no area. Every term is written in `cross` and `w`, with one square root
 /// (of `|cross|² |w|²`) where the unit normal, the area, the unit flow and the lift's
 /// direction took four, a triangle's chain of them the air's cost.
 #[inline(always)]
-fn corner_load(air: &Air, cross: Vec3, w: Vec3) -> (Vec3, f32, [f32; 6]) {
-    let half_rho = 0.5 * air.density;
+fn corner_load(air: &Air, cross: Vec3, w: Vec3) -> Option<(Vec3, f32, [f32; 6])> {
     let cross2 = cross.length_squared();
+    if cross2 <= 0.0 {
+        return None;
+    }
+    let half_rho = 0.5 * air.density;
     // `w·n 2A`; `w·n |w·n| A n = wc |wc| cross / (2 |cross|²)`.
     let (wc, w2) = (w.dot(cross), w.length_squared());
     let over_cross2 = 1.0 / cross2;
@@ -297,7 +299,7 @@ fn corner_load(air: &Air, cross: Vec3, w: Vec3) -> (Vec3, f32, [f32; 6]) {
         d * m.x * m.z,
         d * m.y * m.z,
     ];
-    (share, rate, slope)
+    Some((share, rate, slope))
 }
 
 /// Hooke springs `F = k (|l| − l0) l/|l|` (Maslova eq. 1.4) plus damping along the

@@ -342,6 +342,8 @@ impl ProxyBinding {
             let rcp = length_recips(&blend);
             let mut smooth = [Vec3::ZERO; BATCH];
             for (k, (b, out)) in batch.iter().zip(out_normals).enumerate() {
+                // Looked up again: kept from the loop above in an array of the batch's
+                // normals, drawing measured 5% slower (`cloth crowd`).
                 let normal = frames[b.triangle as usize].2;
                 smooth[k] = scaled_or(blend[k], rcp[k], normal);
                 *out = smooth[k].to_array();
