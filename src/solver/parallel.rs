@@ -3,7 +3,7 @@
 //! element is computed the same way whichever thread takes its piece, so results do not
 //! depend on the number of threads.
 
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 
 use bevy::tasks::{ComputeTaskPool, TaskPool, TaskPoolBuilder};
 
@@ -115,16 +115,17 @@ pub fn for_each_indexed<T: Send>(out: &mut [T], f: impl Fn(usize, &mut T) + Sync
     });
 }
 
-/// As [`for_each`], for work that reports a flag: whether any piece returned `true`.
-pub(super) fn any<T: Send>(
+/// As [`for_each`], for work that reports flags: every piece's, or-ed.
+pub(super) fn or_bits<T: Send>(
     len: usize,
     pieces: impl Iterator<Item = T>,
-    work: impl Fn(T) -> bool + Sync,
-) -> bool {
-    let found = AtomicBool::new(false);
+    work: impl Fn(T) -> u8 + Sync,
+) -> u8 {
+    let found = AtomicU8::new(0);
     for_each(len, pieces, |piece| {
-        if work(piece) {
-            found.store(true, Ordering::Relaxed);
+        let bits = work(piece);
+        if bits != 0 {
+            found.fetch_or(bits, Ordering::Relaxed);
         }
     });
     found.into_inner()
