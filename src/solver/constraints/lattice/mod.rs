@@ -389,6 +389,13 @@ impl Stencil {
         if !moved {
             return (run, within);
         }
+        self.store(p, h);
+        (run, within)
+    }
+
+    /// The lanes back into the particles after [`Self::limit_strain`]'s sweeps: each
+    /// position, and each velocity its summed correction over `h`.
+    fn store(&mut self, p: &mut Particles, h: f32) {
         // The velocity takes the summed corrections, not the difference of the positions
         // before and after: at hundreds of substeps a correction is a few float spacings
         // of a position 2 m from the origin, and that difference was noise (the accuracy
@@ -423,7 +430,6 @@ impl Stencil {
                 }
             },
         );
-        (run, within)
     }
 
     /// One coloured sweep: [`MOVED`] when it corrected a spring, and with `TRACK`
