@@ -5,23 +5,48 @@
 //! Cloth. Pure geometry: it reads positions and normals and writes positions, normals
 //! and tangents.
 
-use bevy::math::{Vec3, Vec4};
+use bevy::math::{Vec3, Vec3A, Vec4};
 
-/// One render vertex's place on the simulation mesh.
+/// One render vertex's place on the simulation mesh: 16 bytes, all that placing reads
+/// of it (the vertices are the most numerous thing drawn, so their bytes are most of
+/// what placing reads from memory).
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Bound {
     /// Its triangle, in [`ProxyBinding::triangles`].
     triangle: u32,
-    /// The triangle's corners.
-    corners: [u32; 3],
-    /// The barycentric weights of the vertex's projection on the triangle's plane (they
-    /// sum to 1; outside `[0, 1]` for a vertex beyond the triangle's edge).
-    weights: [f32; 3],
+    /// The barycentric weights of its projection on the triangle's plane of the second
+    /// and third corners (the first's is one less both; outside `[0, 1]` for a vertex
+    /// beyond the triangle's edge).
+    weights: [f32; 2],
     /// Its height above the plane along the triangle's normal, m.
     height: f32,
-    /// Its tangent in the triangle's frame (along the first edge, across it, along the
-    /// normal), and the bitangent's sign.
-    tangent: Vec4,
+}
+
+/// A triangle as placing reads it this frame: its first corner and its two edges from
+/// it, its unit normal, and its corners' normals the same way (the first, and the others
+/// less it), so that a vertex on it is two multiply-adds from each. Worked out once a
+/// frame for the four or so vertices on each triangle, in four-lane vectors (`Vec3A`):
+/// a vertex's sums are then one vector instruction each, not three.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Face {
+    origin: Vec3A,
+    edges: [Vec3A; 2],
+    normal: Vec3A,
+    normals: [Vec3A; 3],
+}
+
+impl Face {
+    /// The point at `weights` on the triangle, `height` along its normal.
+    #[inline(always)]
+    fn point(&self, [v, w]: [f32; 2], height: f32) -> Vec3A {
+        self.origin + v * self.edges[0] + w * self.edges[1] + height * self.normal
+    }
+
+    /// The blend of its corners' normals at `weights`.
+    #[inline(always)]
+    fn blend(&self, [v, w]: [f32; 2]) -> Vec3A {
+        self.normals[0] + v * self.normals[1] + w * self.normals[2]
+    }
 }
 
 /// Every render vertex bound to a simulation triangle ([`ProxyBinding::bind`]), and
@@ -29,10 +54,15 @@ struct Bound {
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ProxyBinding {
     bound: Vec<Bound>,
+    /// Each vertex's tangent in its triangle's frame (along the first edge, across it,
+    /// along the normal), and the bitangent's sign; none when bound without tangents.
+    tangents: Vec<Vec4>,
     /// The triangles some vertex is bound to.
     triangles: Vec<[u32; 3]>,
-    /// Each of those triangles' frame this frame (scratch of [`ProxyBinding::place`]).
-    frames: Vec<(Vec3, Vec3, Vec3)>,
+    /// Each of those triangles this frame (scratch of [`ProxyBinding::place`]).
+    faces: Vec<Face>,
+    /// And its first edge's direction and the direction across it, for the tangents.
+    frames: Vec<(Vec3, Vec3)>,
 }
 
 /// The frame of triangle `t` of `x`: its first edge's direction, the direction across it
@@ -45,9 +75,9 @@ fn frame(x: &[Vec3], [a, b, c]: [u32; 3]) -> Option<(Vec3, Vec3, Vec3)> {
     Some((along, normal.cross(along), normal))
 }
 
-/// The barycentric weights of `p`'s projection onto the plane of `a b c`, and its height
-/// above that plane along `normal`.
-fn project(p: Vec3, [a, b, c]: [Vec3; 3], normal: Vec3) -> ([f32; 3], f32) {
+/// The barycentric weights of `b` and `c` at `p`'s projection onto the plane of `a b c`,
+/// and its height above that plane along `normal`.
+fn project(p: Vec3, [a, b, c]: [Vec3; 3], normal: Vec3) -> ([f32; 2], f32) {
     let height = (p - a).dot(normal);
     let q = p - height * normal;
     let (e0, e1, e2) = (b - a, c - a, q - a);
@@ -56,7 +86,7 @@ fn project(p: Vec3, [a, b, c]: [Vec3; 3], normal: Vec3) -> ([f32; 3], f32) {
     let denominator = d00 * d11 - d01 * d01;
     let v = (d11 * d20 - d01 * d21) / denominator;
     let w = (d00 * d21 - d01 * d20) / denominator;
-    ([1.0 - v - w, v, w], height)
+    ([v, w], height)
 }
 
 /// The point of triangle `a b c` nearest `p` (Ericson 2005, "Real-Time Collision
@@ -254,35 +284,40 @@ impl ProxyBinding {
         let buckets = Buckets::new(&usable);
         let mut index_of = std::collections::HashMap::new();
         let mut used: Vec<[u32; 3]> = Vec::new();
-        let bound = render
-            .iter()
-            .enumerate()
-            .map(|(v, &p)| {
-                let best = buckets.nearest(x, p);
-                let (along, across, normal) = frame(x, best).expect("usable");
-                let (weights, height) = project(p, best.map(|i| x[i as usize]), normal);
-                let tangent = tangents.and_then(|t| t.get(v)).map_or(Vec4::ZERO, |t| {
+        let mut turned = Vec::new();
+        let mut bound = Vec::with_capacity(render.len());
+        for (v, &p) in render.iter().enumerate() {
+            let best = buckets.nearest(x, p);
+            let (along, across, normal) = frame(x, best).expect("usable");
+            let (weights, height) = project(p, best.map(|i| x[i as usize]), normal);
+            if let Some(tangents) = tangents {
+                turned.push(tangents.get(v).map_or(Vec4::ZERO, |t| {
                     let t3 = t.truncate();
                     Vec4::new(t3.dot(along), t3.dot(across), t3.dot(normal), t.w)
-                });
-                let triangle = *index_of.entry(best).or_insert_with(|| {
-                    used.push(best);
-                    used.len() as u32 - 1
-                });
-                Bound {
-                    triangle,
-                    corners: best,
-                    weights,
-                    height,
-                    tangent,
-                }
-            })
-            .collect();
-        let frames = vec![(Vec3::X, Vec3::Y, Vec3::Z); used.len()];
+                }));
+            }
+            let triangle = *index_of.entry(best).or_insert_with(|| {
+                used.push(best);
+                used.len() as u32 - 1
+            });
+            bound.push(Bound {
+                triangle,
+                weights,
+                height,
+            });
+        }
+        let face = Face {
+            origin: Vec3A::ZERO,
+            edges: [Vec3A::X, Vec3A::Y],
+            normal: Vec3A::Z,
+            normals: [Vec3A::Z, Vec3A::ZERO, Vec3A::ZERO],
+        };
         Some(ProxyBinding {
             bound,
+            tangents: turned,
+            faces: vec![face; used.len()],
+            frames: vec![(Vec3::X, Vec3::Y); used.len()],
             triangles: used,
-            frames,
         })
     }
 
@@ -297,23 +332,23 @@ impl ProxyBinding {
     }
 
     /// Render vertex `v`'s place over `x`: its bound point on its triangle, at its height
-    /// along the triangle's normal (what [`place`](Self::place) writes).
+    /// along the triangle's normal (what [`place`](Self::place) writes, to the bit).
     pub fn point(&self, x: &[Vec3], v: usize) -> Vec3 {
         let b = &self.bound[v];
-        let p = b.corners.map(|i| x[i as usize]);
-        let on = b.weights[0] * p[0] + b.weights[1] * p[1] + b.weights[2] * p[2];
-        let normal = frame(x, b.corners).map_or(Vec3::ZERO, |(_, _, n)| n);
-        on + b.height * normal
+        Face::of(x, self.triangles[b.triangle as usize], &[], Vec3A::ZERO)
+            .point(b.weights, b.height)
+            .into()
     }
 
     /// Places every render vertex over the simulation's positions `x` (and its smooth
     /// vertex `normals`): each at its bound point at its height along its triangle's
     /// normal, its normal the blend of its corners' by its weights, its tangent turned
     /// with its triangle and made square to that normal. `tangents` is written only when
-    /// given. Each triangle's frame is worked out once, then the vertices a batch at a
-    /// time: a batch's normalisations (a square root and a division each) side by side,
-    /// which the compiler issues as vector instructions, where one vertex after another
-    /// waited on each one's in turn (they were two fifths of placing).
+    /// given. Each triangle is worked out once (its [`Face`]), then the vertices a batch
+    /// at a time: a batch's normalisations (a square root and a
+    /// division each) side by side, which the compiler issues as vector instructions,
+    /// where one vertex after another waited on each one's in turn (they were two fifths
+    /// of placing).
     pub fn place(
         &mut self,
         x: &[Vec3],
@@ -322,51 +357,87 @@ impl ProxyBinding {
         out_normals: &mut [[f32; 3]],
         mut tangents: Option<&mut [[f32; 4]]>,
     ) {
-        for (f, &t) in self.frames.iter_mut().zip(&self.triangles) {
-            *f = frame(x, t).unwrap_or(*f);
+        for (face, &t) in self.faces.iter_mut().zip(&self.triangles) {
+            // A triangle of no area this frame keeps its last normal (and frame).
+            *face = Face::of(x, t, normals, face.normal);
         }
-        let frames = &self.frames;
+        if tangents.is_some() {
+            for (f, &t) in self.frames.iter_mut().zip(&self.triangles) {
+                *f = frame(x, t).map_or(*f, |(along, across, _)| (along, across));
+            }
+        }
+        let faces = &self.faces;
         for (c, batch) in self.bound.chunks(BATCH).enumerate() {
             let first = c * BATCH;
             let positions = &mut positions[first..first + batch.len()];
             let out_normals = &mut out_normals[first..first + batch.len()];
-            let mut blend = [Vec3::ZERO; BATCH];
+            let mut blend = [Vec3A::ZERO; BATCH];
             for ((b, out), blend) in batch.iter().zip(positions).zip(&mut blend) {
-                let normal = frames[b.triangle as usize].2;
-                let [i, j, k] = b.corners.map(|i| i as usize);
-                let w = b.weights;
-                let on = w[0] * x[i] + w[1] * x[j] + w[2] * x[k];
-                *out = (on + b.height * normal).to_array();
-                *blend = w[0] * normals[i] + w[1] * normals[j] + w[2] * normals[k];
+                let face = &faces[b.triangle as usize];
+                *out = Vec3::from(face.point(b.weights, b.height)).to_array();
+                *blend = face.blend(b.weights);
             }
             let rcp = length_recips(&blend);
-            let mut smooth = [Vec3::ZERO; BATCH];
+            let mut smooth = [Vec3A::ZERO; BATCH];
             for (k, (b, out)) in batch.iter().zip(out_normals).enumerate() {
                 // Looked up again: kept from the loop above in an array of the batch's
                 // normals, drawing measured 5% slower (`cloth crowd`).
-                let normal = frames[b.triangle as usize].2;
+                let normal = faces[b.triangle as usize].normal;
                 smooth[k] = scaled_or(blend[k], rcp[k], normal);
-                *out = smooth[k].to_array();
+                *out = Vec3::from(smooth[k]).to_array();
             }
-            let Some(tangents) = tangents.as_deref_mut() else {
-                continue;
-            };
-            // At right angles to the drawn (smooth) normal (Gram–Schmidt).
-            let mut square = [Vec3::ZERO; BATCH];
-            for (k, b) in batch.iter().enumerate() {
-                let (along, across, normal) = frames[b.triangle as usize];
-                let t = b.tangent;
-                let turned = t.x * along + t.y * across + t.z * normal;
-                square[k] = turned - turned.dot(smooth[k]) * smooth[k];
+            if let Some(tangents) = tangents.as_deref_mut() {
+                let tangents = &mut tangents[first..first + batch.len()];
+                self.turn_tangents(first, batch, &smooth, tangents);
             }
-            let rcp = length_recips(&square);
-            let tangents = &mut tangents[first..first + batch.len()];
-            for (k, (b, out)) in batch.iter().zip(tangents).enumerate() {
-                let along = frames[b.triangle as usize].0;
-                *out = scaled_or(square[k], rcp[k], along)
-                    .extend(b.tangent.w)
-                    .to_array();
-            }
+        }
+    }
+
+    /// Writes the tangents of the `batch` of vertices from `first`, turned with their
+    /// triangles and made square to their drawn normals `smooth` (Gram–Schmidt).
+    #[inline(always)]
+    fn turn_tangents(
+        &self,
+        first: usize,
+        batch: &[Bound],
+        smooth: &[Vec3A; BATCH],
+        out: &mut [[f32; 4]],
+    ) {
+        let tangent = |k: usize| self.tangents.get(first + k).copied().unwrap_or(Vec4::ZERO);
+        let mut square = [Vec3A::ZERO; BATCH];
+        for (k, b) in batch.iter().enumerate() {
+            let (along, across) = self.frames[b.triangle as usize];
+            let (along, across) = (Vec3A::from(along), Vec3A::from(across));
+            let normal = self.faces[b.triangle as usize].normal;
+            let t = tangent(k);
+            let turned = t.x * along + t.y * across + t.z * normal;
+            square[k] = turned - turned.dot(smooth[k]) * smooth[k];
+        }
+        let rcp = length_recips(&square);
+        for (k, (b, out)) in batch.iter().zip(out).enumerate() {
+            let along = self.frames[b.triangle as usize].0.into();
+            *out = Vec3::from(scaled_or(square[k], rcp[k], along))
+                .extend(tangent(k).w)
+                .to_array();
+        }
+    }
+}
+
+impl Face {
+    /// Triangle `[a, b, c]` over `x` with its corners' `normals` (none: zero), and
+    /// `fallback` for its normal if it has no area (the same bits as [`frame`]'s).
+    #[inline(always)]
+    fn of(x: &[Vec3], [a, b, c]: [u32; 3], normals: &[Vec3], fallback: Vec3A) -> Face {
+        let [a, b, c] = [a, b, c].map(|i| i as usize);
+        let origin = Vec3A::from(x[a]);
+        let edges = [Vec3A::from(x[b]) - origin, Vec3A::from(x[c]) - origin];
+        let corner = |i: usize| normals.get(i).map_or(Vec3A::ZERO, |&n| n.into());
+        let n0 = corner(a);
+        Face {
+            origin,
+            edges,
+            normal: edges[0].cross(edges[1]).try_normalize().unwrap_or(fallback),
+            normals: [n0, corner(b) - n0, corner(c) - n0],
         }
     }
 }
@@ -376,7 +447,7 @@ const BATCH: usize = 8;
 
 /// `1 / |v|` of each of `v`, as glam's `length_recip` (the same bits), side by side.
 #[inline(always)]
-fn length_recips(v: &[Vec3; BATCH]) -> [f32; BATCH] {
+fn length_recips(v: &[Vec3A; BATCH]) -> [f32; BATCH] {
     let mut squared = [0.0; BATCH];
     for (s, v) in squared.iter_mut().zip(v) {
         *s = v.dot(*v);
@@ -391,7 +462,7 @@ fn length_recips(v: &[Vec3; BATCH]) -> [f32; BATCH] {
 /// `v` scaled by its `rcp` (`1 / |v|`), or `fallback` when it has no length: glam's
 /// `normalize_or`, with the reciprocal worked out beforehand.
 #[inline(always)]
-fn scaled_or(v: Vec3, rcp: f32, fallback: Vec3) -> Vec3 {
+fn scaled_or(v: Vec3A, rcp: f32, fallback: Vec3A) -> Vec3A {
     if rcp.is_finite() && rcp > 0.0 {
         v * rcp
     } else {
@@ -500,13 +571,14 @@ mod tests {
             (vec![[0.0; 3]; 19], vec![[0.0; 3]; 19], vec![[0.0; 4]; 19]);
         binding.place(&x, &normals, &mut out, &mut out_n, Some(&mut out_t));
         for (v, b) in binding.bound.iter().enumerate() {
-            let (along, across, normal) = frame(&x, b.corners).unwrap();
-            let [i, j, k] = b.corners.map(|i| i as usize);
-            let w = b.weights;
-            let on = w[0] * x[i] + w[1] * x[j] + w[2] * x[k];
-            let smooth =
-                (w[0] * normals[i] + w[1] * normals[j] + w[2] * normals[k]).normalize_or(normal);
-            let t = b.tangent;
+            let corners = binding.triangles[b.triangle as usize];
+            let (along, across, normal) = frame(&x, corners).unwrap();
+            let [i, j, k] = corners.map(|i| i as usize);
+            let [p, q] = b.weights;
+            let on = x[i] + p * (x[j] - x[i]) + q * (x[k] - x[i]);
+            let blend = normals[i] + p * (normals[j] - normals[i]) + q * (normals[k] - normals[i]);
+            let smooth = blend.normalize_or(normal);
+            let t = binding.tangents[v];
             let turned = t.x * along + t.y * across + t.z * normal;
             let tangent = (turned - turned.dot(smooth) * smooth).normalize_or(along);
             assert_eq!(out[v], (on + b.height * normal).to_array(), "{v}");
@@ -515,7 +587,8 @@ mod tests {
         }
         // Both stand-ins were taken for the second vertex: its corners' normals and its
         // tangent have no length.
-        let (along, _, normal) = frame(&x, binding.bound[1].corners).unwrap();
+        let corners = binding.triangles[binding.bound[1].triangle as usize];
+        let (along, _, normal) = frame(&x, corners).unwrap();
         assert_eq!(out_n[1], normal.to_array());
         assert_eq!(Vec3::from_slice(&out_t[1][..3]), along);
     }
