@@ -344,8 +344,8 @@ impl ProxyBinding {
     /// vertex `normals`): each at its bound point at its height along its triangle's
     /// normal, its normal the blend of its corners' by its weights, its tangent turned
     /// with its triangle and made square to that normal. `tangents` is written only when
-    /// given. Each triangle is worked out once (its [`Face`]), then the vertices a batch
-    /// at a time: a batch's normalisations (a square root and a
+    /// given. Each triangle is worked out once (its first corner, edges, normal and
+    /// corners' normals, in four-lane vectors), then the vertices a batch at a time: a batch's normalisations (a square root and a
     /// division each) side by side, which the compiler issues as vector instructions,
     /// where one vertex after another waited on each one's in turn (they were two fifths
     /// of placing).
