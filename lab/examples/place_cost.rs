@@ -8,49 +8,61 @@
 
 use std::time::Instant;
 
-use bevy::math::Vec3;
+use bevy::math::{Affine3A, Vec3};
+use bevy_cloth::prelude::*;
 use bevy_cloth::solver::ProxyBinding;
 
-/// A `w × h` grid of `spacing` m cells, `k` times finer, crumpled `bend` m by `phase`.
-fn grid(w: u32, h: u32, spacing: f32, k: u32, bend: f32, phase: f32) -> Vec<Vec3> {
+/// The points of a `w × h` grid's `rest`, `k` times finer each way (bilinear in its cells).
+fn refined(rest: &[Vec3], w: u32, h: u32, k: u32) -> Vec<Vec3> {
     let (fw, fh) = ((w - 1) * k + 1, (h - 1) * k + 1);
-    let step = spacing / k as f32;
+    let at = |i: u32, j: u32| rest[(j.min(h - 1) * w + i.min(w - 1)) as usize];
     (0..fw * fh)
         .map(|v| {
-            let (i, j) = ((v % fw) as f32 * step, (v / fw) as f32 * step);
-            Vec3::new(i, -j, bend * (9.0 * i + phase).sin() * (5.0 * j).cos())
+            let (fi, fj) = (v % fw, v / fw);
+            let (i, j) = (fi / k, fj / k);
+            let (s, t) = ((fi % k) as f32 / k as f32, (fj % k) as f32 / k as f32);
+            let top = at(i, j).lerp(at(i + 1, j), s);
+            top.lerp(at(i, j + 1).lerp(at(i + 1, j + 1), s), t)
         })
         .collect()
 }
 
-fn triangles(w: u32, h: u32) -> Vec<[u32; 3]> {
-    let mut t = Vec::new();
-    for j in 0..h - 1 {
-        for i in 0..w - 1 {
-            let v = j * w + i;
-            t.push([v, v + 1, v + w]);
-            t.push([v + 1, v + w + 1, v + w]);
-        }
-    }
-    t
-}
-
 fn main() {
-    let (w, h, spacing, k) = (16u32, 24u32, 0.04f32, 3u32);
-    let rest = grid(w, h, spacing, 1, 0.0, 0.0);
-    let fine = grid(w, h, spacing, k, 0.0, 0.0);
-    let tris = triangles(w, h);
+    let (w, h, k) = (16u32, 24u32, 3u32);
+    let cape = ClothShape::Grid {
+        width: w,
+        height: h,
+        spacing: 0.04,
+    }
+    .build_solver(
+        &ClothPins::None,
+        &ClothParams::default(),
+        Affine3A::IDENTITY,
+    )
+    .expect("a grid builds");
+    let (rest, tris) = (cape.rest_positions(), cape.triangles());
+    let fine = refined(rest, w, h, k);
     let mut cloths: Vec<ProxyBinding> = (0..100)
-        .map(|_| ProxyBinding::bind(&rest, &tris, &fine, None).expect("triangles"))
+        .map(|_| ProxyBinding::bind(rest, tris, &fine, None).expect("triangles"))
         .collect();
+    // Crumpled out of the grid's plane, differently each round.
+    let out = (rest[1] - rest[0])
+        .cross(rest[w as usize] - rest[0])
+        .normalize();
     let m = fine.len();
     let (mut positions, mut normals) = (vec![[0.0f32; 3]; m], vec![[0.0f32; 3]; m]);
     let mut times = Vec::new();
     for round in 0..220 {
-        let x = grid(w, h, spacing, 1, 0.05, round as f32 * 0.1);
-        let n: Vec<Vec3> = x
-            .iter()
-            .map(|p| Vec3::new(-0.3 * p.z, 0.1, 1.0).normalize())
+        let phase = round as f32 * 0.1;
+        let bend = |v: usize| {
+            let (i, j) = ((v as u32 % w) as f32, (v as u32 / w) as f32);
+            (0.36 * i + phase).sin() * (0.2 * j).cos()
+        };
+        let x: Vec<Vec3> = (0..rest.len())
+            .map(|v| rest[v] + 0.05 * bend(v) * out)
+            .collect();
+        let n: Vec<Vec3> = (0..rest.len())
+            .map(|v| (out + 0.3 * bend(v) * (rest[1] - rest[0]).normalize()).normalize())
             .collect();
         let start = Instant::now();
         for binding in &mut cloths {
