@@ -305,3 +305,67 @@ fn the_lightest_seed_material_with_drag_is_stable_at_one_substep() {
         );
     }
 }
+
+#[test]
+fn stable_substeps_tame_the_stiffest_lightest_material_on_an_irregular_mesh() {
+    // The power estimate on a mesh (no longer Gershgorin's bound): Maslova's stiffest,
+    // lightest material on a mesh of irregular triangles, tilted and swinging in gusts
+    // at its automatic substeps, stays stable; at one substep it does not.
+    let run = |substeps| {
+        let params = ClothParams {
+            node_mass: 1e-6,
+            springs: SpringParams::from_structural(25_000.0),
+            substeps,
+            ..conservative(Integrator::Verlet)
+        };
+        let mut positions = Vec::new();
+        for v in 0..36u32 {
+            let (i, j) = ((v % 6) as f32, (v / 6) as f32);
+            // Inner vertices moved up to a third of the 5 cm spacing.
+            let inner = (1.0..5.0).contains(&i) && (1.0..5.0).contains(&j);
+            let shift = if inner {
+                Vec3::new((v as f32 * 2.1).sin(), (v as f32 * 3.7).cos(), 0.0) * 0.016
+            } else {
+                Vec3::ZERO
+            };
+            positions.push(Vec3::new(i, -j, 0.0) * 0.05 + shift);
+        }
+        let mut triangles = Vec::new();
+        for j in 0..5u32 {
+            for i in 0..5u32 {
+                let (a, b) = (j * 6 + i, j * 6 + i + 1);
+                let (c, d) = (a + 6, b + 6);
+                if (i + j) % 2 == 0 {
+                    triangles.extend([[a, c, b], [b, c, d]]);
+                } else {
+                    triangles.extend([[a, c, d], [a, d, b]]);
+                }
+            }
+        }
+        let layout = bevy_cloth::solver::Layout::from_mesh(&positions, &triangles).unwrap();
+        let pins = ClothPins::TopCorners.resolve_for(&layout).unwrap();
+        let frame = Affine3A::from_rotation_x(-1.2);
+        let mut cloth = ClothSolver::new(layout, &pins, &params, frame).unwrap();
+        let env = Environment {
+            wind: Wind {
+                direction: Vec3::Z,
+                strength: 1e-6,
+                field: WindField::Trigonometric,
+            },
+            ..no_wind()
+        };
+        for step in 0..1000 {
+            cloth.step(DT, &env);
+            if !cloth.is_stable() {
+                return (false, step, cloth.substeps());
+            }
+        }
+        (true, 1000, cloth.substeps())
+    };
+    let (stable, step, substeps) = run(Substeps::Auto {
+        max: bevy_cloth::limits::MAX_SUBSTEPS,
+    });
+    assert!(stable, "unstable at step {step} with {substeps} substeps");
+    let (stable, ..) = run(Substeps::Fixed(1));
+    assert!(!stable, "one substep of 16 ms should not be stable here");
+}
