@@ -182,14 +182,23 @@ impl WindZone {
         self.turbulence.validate()
     }
 
-    /// Whether it can reach anything within `radius` of `centre`.
+    /// Whether it can reach anything within `radius` of `centre`: whether that ball meets
+    /// the zone's sphere or box. A box is met by the ball's nearest point to it in the
+    /// box's own axes, not by the sphere around the box: a long thin box (a wind along a
+    /// street) reached every cloth within its half-length, each then taking the air model
+    /// for nothing where the box's weight is 0.
     pub fn reaches(&self, centre: Vec3, radius: f32) -> bool {
-        let reach = match self.shape {
-            ZoneShape::Global => return true,
-            ZoneShape::Sphere { radius } => radius,
-            ZoneShape::Box { half_extents } => half_extents.length(),
-        };
-        self.centre.distance(centre) <= reach + radius
+        match self.shape {
+            ZoneShape::Global => true,
+            ZoneShape::Sphere { radius: reach } => self.centre.distance(centre) <= reach + radius,
+            ZoneShape::Box { half_extents } => {
+                let local = self.rotation.inverse() * (centre - self.centre);
+                let outside = (local.abs() - half_extents).max(Vec3::ZERO);
+                // A margin over the rounding of the turn, so that a ball that touches the
+                // box is never told apart from it.
+                outside.length() <= radius + 1e-5 * (1.0 + local.abs().max_element())
+            }
+        }
     }
 
     /// How strongly it blows at `x`, 0 to 1: 1 inside, fading (smoothly) over the outer
@@ -371,5 +380,42 @@ mod tests {
         // Its long axis now runs along z.
         assert!(turned.weight_at(Vec3::new(1.0, 0.0, 2.5)) > 0.0);
         assert_eq!(turned.weight_at(Vec3::new(3.5, 0.0, 0.0)), 0.0);
+    }
+
+    /// A ball reaches a box when it meets the box itself: the turned 6 × 2 × 2 m box
+    /// above (long along z) is reached by a ball beside its long side or past its end
+    /// only when the ball touches it, though each lies within the sphere around it.
+    #[test]
+    fn a_box_is_reached_by_the_balls_that_meet_it() {
+        let long = WindZone {
+            shape: ZoneShape::Box {
+                half_extents: Vec3::new(3.0, 1.0, 1.0),
+            },
+            centre: Vec3::new(1.0, 0.0, 0.0),
+            rotation: Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            ..WindZone::default()
+        };
+        // Beside its long side (x = 2 at its face): 0.5 m off, a ball of 0.4 does not
+        // reach, one of 0.6 does.
+        assert!(!long.reaches(Vec3::new(2.5, 0.0, 1.0), 0.4));
+        assert!(long.reaches(Vec3::new(2.5, 0.0, 1.0), 0.6));
+        // Past its end (z = 3) and its corner.
+        assert!(!long.reaches(Vec3::new(1.0, 0.0, 3.5), 0.4));
+        assert!(long.reaches(Vec3::new(1.0, 0.0, 3.5), 0.6));
+        let corner = Vec3::new(2.0, 1.0, 3.0) + Vec3::ONE * 0.3;
+        assert!(!long.reaches(corner, 0.5));
+        assert!(long.reaches(corner, 0.53));
+        // Inside, and a ball around it.
+        assert!(long.reaches(Vec3::new(1.0, 0.0, 2.0), 0.0));
+        assert!(long.reaches(Vec3::new(9.0, 0.0, 0.0), 9.0));
+        // The sphere around the box (radius 3.3) met each of the balls told apart above.
+        let around = Vec3::new(3.0, 1.0, 1.0).length();
+        for (far, r) in [
+            (Vec3::new(2.5, 0.0, 1.0), 0.4),
+            (Vec3::new(1.0, 0.0, 3.5), 0.4),
+            (corner, 0.5),
+        ] {
+            assert!(far.distance(long.centre) <= around + r);
+        }
     }
 }
