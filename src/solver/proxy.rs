@@ -59,8 +59,9 @@ pub struct ProxyBinding {
     tangents: Vec<Vec4>,
     /// The triangles some vertex is bound to.
     triangles: Vec<[u32; 3]>,
-    /// Each of those triangles this frame (scratch of [`ProxyBinding::place`]).
-    faces: Vec<Face>,
+    /// Each of those triangles' unit normal when last placed: a triangle of no area keeps
+    /// it.
+    normals: Vec<Vec3A>,
     /// And its first edge's direction and the direction across it, for the tangents.
     frames: Vec<(Vec3, Vec3)>,
 }
@@ -306,16 +307,10 @@ impl ProxyBinding {
                 height,
             });
         }
-        let face = Face {
-            origin: Vec3A::ZERO,
-            edges: [Vec3A::X, Vec3A::Y],
-            normal: Vec3A::Z,
-            normals: [Vec3A::Z, Vec3A::ZERO, Vec3A::ZERO],
-        };
         Some(ProxyBinding {
             bound,
             tangents: turned,
-            faces: vec![face; used.len()],
+            normals: vec![Vec3A::Z; used.len()],
             frames: vec![(Vec3::X, Vec3::Y); used.len()],
             triangles: used,
         })
@@ -357,16 +352,37 @@ impl ProxyBinding {
         out_normals: &mut [[f32; 3]],
         mut tangents: Option<&mut [[f32; 4]]>,
     ) {
-        for (face, &t) in self.faces.iter_mut().zip(&self.triangles) {
-            // A triangle of no area this frame keeps its last normal (and frame).
-            *face = Face::of(x, t, normals, face.normal);
-        }
+        FACES.with_borrow_mut(|faces| {
+            faces.clear();
+            faces.extend(
+                self.triangles
+                    .iter()
+                    .zip(&mut self.normals)
+                    .map(|(&t, last)| {
+                        // A triangle of no area this frame keeps its last normal (and frame).
+                        let face = Face::of(x, t, normals, *last);
+                        *last = face.normal;
+                        face
+                    }),
+            );
+            self.place_on(faces, x, positions, out_normals, tangents.as_deref_mut());
+        });
+    }
+
+    /// [`Self::place`] over this frame's `faces` of its triangles.
+    fn place_on(
+        &mut self,
+        faces: &[Face],
+        x: &[Vec3],
+        positions: &mut [[f32; 3]],
+        out_normals: &mut [[f32; 3]],
+        mut tangents: Option<&mut [[f32; 4]]>,
+    ) {
         if tangents.is_some() {
             for (f, &t) in self.frames.iter_mut().zip(&self.triangles) {
                 *f = frame(x, t).map_or(*f, |(along, across, _)| (along, across));
             }
         }
-        let faces = &self.faces;
         for (c, batch) in self.bound.chunks(BATCH).enumerate() {
             let first = c * BATCH;
             let positions = &mut positions[first..first + batch.len()];
@@ -388,7 +404,7 @@ impl ProxyBinding {
             }
             if let Some(tangents) = tangents.as_deref_mut() {
                 let tangents = &mut tangents[first..first + batch.len()];
-                self.turn_tangents(first, batch, &smooth, tangents);
+                self.turn_tangents(faces, (first, batch), &smooth, tangents);
             }
         }
     }
@@ -398,8 +414,8 @@ impl ProxyBinding {
     #[inline(always)]
     fn turn_tangents(
         &self,
-        first: usize,
-        batch: &[Bound],
+        faces: &[Face],
+        (first, batch): (usize, &[Bound]),
         smooth: &[Vec3A; BATCH],
         out: &mut [[f32; 4]],
     ) {
@@ -408,7 +424,7 @@ impl ProxyBinding {
         for (k, b) in batch.iter().enumerate() {
             let (along, across) = self.frames[b.triangle as usize];
             let (along, across) = (Vec3A::from(along), Vec3A::from(across));
-            let normal = self.faces[b.triangle as usize].normal;
+            let normal = faces[b.triangle as usize].normal;
             let t = tangent(k);
             let turned = t.x * along + t.y * across + t.z * normal;
             square[k] = turned - turned.dot(smooth[k]) * smooth[k];
@@ -440,6 +456,14 @@ impl Face {
             normals: [n0, corner(b) - n0, corner(c) - n0],
         }
     }
+}
+
+thread_local! {
+    /// This thread's faces of the binding it is placing ([`ProxyBinding::place`]), worked
+    /// out afresh each call: one buffer a thread, warm in its cache, where one a binding
+    /// (112 bytes a triangle, 8 MB for the crowd's hundred cloths) was read back from
+    /// memory every frame only to be overwritten.
+    static FACES: std::cell::RefCell<Vec<Face>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// Render vertices placed together by [`ProxyBinding::place`].
