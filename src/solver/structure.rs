@@ -37,6 +37,10 @@ pub(super) struct Structure {
     /// The cloth's characteristic length L (mean structural rest length), for the
     /// shape-matching force law.
     pub length_scale: f32,
+    /// The longest rest length of a structural or shear spring: an edge of the cloth, what
+    /// a collider must be thinner than to need the edge pass (rest lengths of these
+    /// springs do not change after the build).
+    pub longest_edge: f32,
     pub torn_this_step: Vec<u32>,
     pub torn_count: usize,
     /// The quadratic bending model's hinges (`bending.rs`): built once a fabric is set
@@ -101,6 +105,10 @@ impl Structure {
         } else {
             springs.rest_length[structural.clone()].iter().sum::<f32>() / structural.len() as f32
         };
+        let longest_edge = super::contact::EDGES
+            .iter()
+            .flat_map(|&kind| springs.rest_length[springs.ranges[kind as usize].clone()].iter())
+            .fold(0.0f32, |m, &l| m.max(l));
         Structure {
             hinges: Hinges::default(),
             area: particle_areas(&triangles, &local),
@@ -123,6 +131,7 @@ impl Structure {
             seam_start,
             stencil,
             length_scale,
+            longest_edge,
             torn_count: 0,
         }
     }

@@ -293,7 +293,7 @@ impl Rope {
 }
 
 /// The springs the edge pass keeps out of thin colliders.
-const EDGES: [SpringKind; 2] = [SpringKind::Structural, SpringKind::Shear];
+pub(in crate::solver) const EDGES: [SpringKind; 2] = [SpringKind::Structural, SpringKind::Shear];
 
 /// A thin solid's axis (a capsule's, a cylinder's: [`Shape::axis`]) and its reach
 /// (radius plus thickness), or `None` for another shape.
@@ -657,11 +657,7 @@ impl ClothSolver {
         self.disturbed |= self.contact.change_reaches(&cloth);
         // The thin colliders, for the edge pass: thicker than the cloth's longest edge,
         // the particles catch a collider themselves.
-        let springs = &self.structure.springs;
-        let longest = EDGES
-            .iter()
-            .flat_map(|&kind| springs.rest_length[springs.ranges[kind as usize].clone()].iter())
-            .fold(0.0f32, |m, &l| m.max(l));
+        let longest = self.structure.longest_edge;
         let contact = &mut self.contact;
         contact.thin.clear();
         let thin = |c: &Collider| axis(c).is_some_and(|(_, _, reach)| 2.0 * reach < longest);
