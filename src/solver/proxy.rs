@@ -350,7 +350,7 @@ impl ProxyBinding {
         normals: &[Vec3],
         positions: &mut [[f32; 3]],
         out_normals: &mut [[f32; 3]],
-        mut tangents: Option<&mut [[f32; 4]]>,
+        tangents: Option<&mut [[f32; 4]]>,
     ) {
         FACES.with_borrow_mut(|faces| {
             faces.clear();
@@ -365,7 +365,7 @@ impl ProxyBinding {
                         face
                     }),
             );
-            self.place_on(faces, x, positions, out_normals, tangents.as_deref_mut());
+            self.place_on(faces, x, positions, out_normals, tangents);
         });
     }
 

@@ -634,7 +634,7 @@ impl Projection {
     /// Whether any spring from `a` to `a + step`, for `a` in `from`, is one that
     /// [`Self::project`] would correct (`rest` and `weight` indexed by `a`): the same
     /// test in the same arithmetic, over lanes, with no branch a spring, so that the
-    /// springs of a calm stretch of cloth are told within at a few a vector instruction.
+    /// springs of a calm stretch of cloth are told within four to a vector instruction.
     /// Springs of one colour share no particle, so a colour none of whose springs is
     /// over is left exactly as its projections would leave it.
     #[inline(always)]
@@ -657,8 +657,10 @@ impl Projection {
                     let d = [xb - xa, yb - ya, zb - za];
                     let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                     let max = (1.0 + self.limit) * r;
-                    // As `project`'s test, a NaN length counted over; no branch, so it vectorises.
-                    over | ((*w != 0.0) as u32 & !(len2 <= max * max) as u32)
+                    // Not `project`'s `len2 <= max²`: over it, or NaN (counted over there
+                    // too). No branch, so it vectorises.
+                    let past = (len2 > max * max) | len2.is_nan();
+                    over | ((*w != 0.0) as u32 & past as u32)
                 });
         over != 0
     }
@@ -706,11 +708,11 @@ impl Projection {
         springs: &Down<'_>,
     ) -> u8 {
         let mut bits = 0;
-        if let Some((rest, weight)) = springs.down {
-            if self.any_over(g, top..top + width, width, (rest, weight)) {
-                for a in top..top + width {
-                    bits |= self.project::<TRACK>(g, a, a + width, rest[a], weight[a]);
-                }
+        if let Some((rest, weight)) = springs.down
+            && self.any_over(g, top..top + width, width, (rest, weight))
+        {
+            for a in top..top + width {
+                bits |= self.project::<TRACK>(g, a, a + width, rest[a], weight[a]);
             }
         }
         let Some(((r_rest, r_weight), (l_rest, l_weight))) = springs.diagonals else {
