@@ -61,7 +61,7 @@ pub struct ProxyBinding {
     triangles: Vec<[u32; 3]>,
     /// Each of those triangles' unit normal when last placed: a triangle of no area keeps
     /// it.
-    normals: Vec<Vec3A>,
+    last_normals: Vec<Vec3A>,
     /// And its first edge's direction and the direction across it, for the tangents.
     frames: Vec<(Vec3, Vec3)>,
 }
@@ -310,7 +310,7 @@ impl ProxyBinding {
         Some(ProxyBinding {
             bound,
             tangents: turned,
-            normals: vec![Vec3A::Z; used.len()],
+            last_normals: vec![Vec3A::Z; used.len()],
             frames: vec![(Vec3::X, Vec3::Y); used.len()],
             triangles: used,
         })
@@ -357,7 +357,7 @@ impl ProxyBinding {
             faces.extend(
                 self.triangles
                     .iter()
-                    .zip(&mut self.normals)
+                    .zip(&mut self.last_normals)
                     .map(|(&t, last)| {
                         // A triangle of no area this frame keeps its last normal (and frame).
                         let face = Face::of(x, t, normals, *last);

@@ -546,6 +546,15 @@ fn chunks6<'a>(
 }
 
 impl Projection {
+    /// Whether a spring of `rest` at squared length `len2` is past its limit
+    /// `(1 + limit)·rest`, a NaN length counted past: the one test of [`Self::project`]
+    /// and [`Self::any_over`], without a branch so that the second vectorises.
+    #[inline(always)]
+    fn past_limit(&self, len2: f32, rest: f32) -> bool {
+        let max = (1.0 + self.limit) * rest;
+        (len2 > max * max) | len2.is_nan()
+    }
+
     /// Shortens the spring from `a` to `b` (indices in `g`) to `(1 + limit)·rest` when it
     /// is longer, each end moved by its share of inverse mass (Sladović 2014 eq. 2); nothing
     /// when it is within, torn (`weight` 0) or held at both ends. Most springs are within,
@@ -564,10 +573,10 @@ impl Projection {
         let [x, y, z] = &mut g.x;
         let d = [x[b] - x[a], y[b] - y[a], z[b] - z[a]];
         let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-        let max = (1.0 + self.limit) * rest;
-        if weight == 0.0 || wa + wb == 0.0 || len2 <= max * max {
+        if weight == 0.0 || wa + wb == 0.0 || !self.past_limit(len2, rest) {
             return 0;
         }
+        let max = (1.0 + self.limit) * rest;
         let len = len2.sqrt();
         let factor = (len - max) / (len * (wa + wb));
         let [dx, dy, dz] = &mut g.dx;
@@ -632,8 +641,8 @@ impl Projection {
     }
 
     /// Whether any spring from `a` to `a + step`, for `a` in `from`, is one that
-    /// [`Self::project`] would correct (`rest` and `weight` indexed by `a`): the same
-    /// test in the same arithmetic, over lanes, with no branch a spring, so that the
+    /// [`Self::project`] would correct (`rest` and `weight` indexed by `a`): its test
+    /// ([`Self::past_limit`]) over lanes, with no branch a spring, so that the
     /// springs of a calm stretch of cloth are told within four to a vector instruction.
     /// Springs of one colour share no particle, so a colour none of whose springs is
     /// over is left exactly as its projections would leave it.
@@ -656,11 +665,7 @@ impl Projection {
                 .fold(0u32, |over, ((((xa, xb), (ya, yb)), (za, zb)), (r, w))| {
                     let d = [xb - xa, yb - ya, zb - za];
                     let len2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                    let max = (1.0 + self.limit) * r;
-                    // Not `project`'s `len2 <= max²`: over it, or NaN (counted over there
-                    // too). No branch, so it vectorises.
-                    let past = (len2 > max * max) | len2.is_nan();
-                    over | ((*w != 0.0) as u32 & past as u32)
+                    over | ((*w != 0.0) as u32 & self.past_limit(len2, *r) as u32)
                 });
         over != 0
     }
