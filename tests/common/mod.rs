@@ -6,7 +6,7 @@ use bevy::mesh::{Mesh, VertexAttributeValues};
 use bevy::prelude::*;
 use bevy_cloth::params::{Environment, Integrator, Model, SpringFamily, SpringParams, Substeps};
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::{ClothSolver, ProxyBinding, SpringKind};
+use bevy_cloth::solver::{ClothSolver, Layout, ProxyBinding, SpringKind};
 
 /// A cloth of 6 × 6 particles 4 cm apart, without air drag, and where it lies flat (in
 /// xz) with its middle at `centre`: on a platform's top at y = 0.1, `centre.y` = 0.106 puts
@@ -281,4 +281,40 @@ pub fn proxy_offsets(
         .map(|(p, r)| Vec3::from(*p).distance(*r))
         .fold(0.0, f32::max);
     (farthest, moved)
+}
+
+/// A `width × height` mesh `spacing` m apart whose inner vertices are moved up to a third of
+/// the spacing, each cell split along a diagonal chosen by a hash: irregular triangles,
+/// springs of unequal lengths and directions, no two cells alike.
+pub fn irregular_mesh(width: u32, height: u32, spacing: f32) -> Layout {
+    let hash = |i: u32, salt: u32| {
+        let h = (i.wrapping_mul(0x9e37_79b9) ^ salt.wrapping_mul(0x85eb_ca6b))
+            .wrapping_mul(0xc2b2_ae35);
+        (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    };
+    let positions: Vec<Vec3> = (0..width * height)
+        .map(|v| {
+            let (i, j) = (v % width, v / width);
+            let inner = i > 0 && j > 0 && i + 1 < width && j + 1 < height;
+            let jitter = if inner {
+                Vec3::new(hash(v, 1), hash(v, 2), 0.0) * (spacing * 0.67)
+            } else {
+                Vec3::ZERO
+            };
+            Vec3::new(i as f32, -(j as f32), 0.0) * spacing + jitter
+        })
+        .collect();
+    let mut triangles = Vec::new();
+    for j in 0..height - 1 {
+        for i in 0..width - 1 {
+            let (a, b) = (j * width + i, j * width + i + 1);
+            let (c, d) = (a + width, b + width);
+            if hash(a, 3) < 0.0 {
+                triangles.extend([[a, c, b], [b, c, d]]);
+            } else {
+                triangles.extend([[a, c, d], [a, d, b]]);
+            }
+        }
+    }
+    Layout::from_mesh(&positions, &triangles).unwrap()
 }

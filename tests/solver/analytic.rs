@@ -289,43 +289,6 @@ fn crumpled_within_margin(mut cloth: ClothSolver, crumple: f32) -> (ClothSolver,
     (cloth, converged)
 }
 
-/// A `width × height` mesh 2 cm apart whose inner vertices are moved up to a third of
-/// the spacing, each cell split along a diagonal chosen by a hash: irregular triangles,
-/// springs of unequal lengths and directions, no two cells alike.
-fn irregular_mesh(width: u32, height: u32) -> Layout {
-    let spacing = 0.02;
-    let hash = |i: u32, salt: u32| {
-        let h = (i.wrapping_mul(0x9e37_79b9) ^ salt.wrapping_mul(0x85eb_ca6b))
-            .wrapping_mul(0xc2b2_ae35);
-        (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
-    };
-    let positions: Vec<Vec3> = (0..width * height)
-        .map(|v| {
-            let (i, j) = (v % width, v / width);
-            let inner = i > 0 && j > 0 && i + 1 < width && j + 1 < height;
-            let jitter = if inner {
-                Vec3::new(hash(v, 1), hash(v, 2), 0.0) * (spacing * 0.67)
-            } else {
-                Vec3::ZERO
-            };
-            Vec3::new(i as f32, -(j as f32), 0.0) * spacing + jitter
-        })
-        .collect();
-    let mut triangles = Vec::new();
-    for j in 0..height - 1 {
-        for i in 0..width - 1 {
-            let (a, b) = (j * width + i, j * width + i + 1);
-            let (c, d) = (a + width, b + width);
-            if hash(a, 3) < 0.0 {
-                triangles.extend([[a, c, b], [b, c, d]]);
-            } else {
-                triangles.extend([[a, c, d], [a, d, b]]);
-            }
-        }
-    }
-    Layout::from_mesh(&positions, &triangles).unwrap()
-}
-
 #[test]
 fn the_power_iteration_finds_a_meshs_eigenvalue() {
     // A mesh without seams takes its substeps from the same estimate as a grid: on an
@@ -333,7 +296,7 @@ fn the_power_iteration_finds_a_meshs_eigenvalue() {
     // and within the margin of 1.25.
     for crumple in [0.0f32, 0.25] {
         let params = ClothParams::default();
-        let layout = irregular_mesh(40, 28);
+        let layout = irregular_mesh(40, 28, 0.02);
         let pins = ClothPins::TopCorners.resolve_for(&layout).unwrap();
         let cloth = ClothSolver::new(layout, &pins, &params, Affine3A::IDENTITY).unwrap();
         crumpled_within_margin(cloth, crumple);

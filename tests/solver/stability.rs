@@ -9,33 +9,40 @@ use bevy_cloth::params::{
     XpbdParams,
 };
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::ClothSolver;
+use bevy_cloth::solver::{ClothSolver, Layout};
 
 /// Maslova's stiffest, lightest material: k = 25,000 N/m, m = 0.001 g.
-fn maslova_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
-    let params = ClothParams {
+fn maslova_extreme_params(substeps: Substeps) -> ClothParams {
+    ClothParams {
         node_mass: 1e-6,
         springs: SpringParams::from_structural(25_000.0),
         substeps,
         ..conservative(Integrator::Verlet)
-    };
-    tilted_in_gusts(4, &params, 1e-6)
+    }
 }
 
-/// A `size × size` grid (5 cm spacing) pinned by its top corners, tilted 1.2 rad from
-/// hanging so it swings, in Maslova's gusty wind of `wind` N a particle.
-fn tilted_in_gusts(size: u32, params: &ClothParams, wind: f32) -> (ClothSolver, Environment) {
-    let cloth = ClothShape::Grid {
+/// Maslova's stiffest, lightest material on a 4 × 4 grid, tilted in gusts.
+fn maslova_extreme(substeps: Substeps) -> (ClothSolver, Environment) {
+    tilted_in_gusts(grid(4), &maslova_extreme_params(substeps), 1e-6)
+}
+
+/// A `size × size` grid, 5 cm spacing.
+fn grid(size: u32) -> Layout {
+    ClothShape::Grid {
         width: size,
         height: size,
         spacing: 0.05,
     }
-    .build_solver(
-        &ClothPins::TopCorners,
-        params,
-        Affine3A::from_rotation_x(-1.2),
-    )
-    .unwrap();
+    .layout()
+    .unwrap()
+}
+
+/// `layout` pinned by its top corners, tilted 1.2 rad from hanging so it swings, in
+/// Maslova's gusty wind of `wind` N a particle.
+fn tilted_in_gusts(layout: Layout, params: &ClothParams, wind: f32) -> (ClothSolver, Environment) {
+    let pins = ClothPins::TopCorners.resolve_for(&layout).unwrap();
+    let frame = Affine3A::from_rotation_x(-1.2);
+    let cloth = ClothSolver::new(layout, &pins, params, frame).unwrap();
     let env = Environment {
         wind: Wind {
             direction: Vec3::Z,
@@ -285,7 +292,7 @@ fn the_lightest_seed_material_with_drag_is_stable_at_one_substep() {
             substeps: Substeps::Fixed(1),
             ..conservative(Integrator::Verlet)
         };
-        let (mut cloth, env) = tilted_in_gusts(8, &params, 1e-5);
+        let (mut cloth, env) = tilted_in_gusts(grid(8), &params, 1e-5);
         let mut most = 0.0f32;
         for step in 0..500 {
             cloth.step(DT, &env);
@@ -312,48 +319,9 @@ fn stable_substeps_tame_the_stiffest_lightest_material_on_an_irregular_mesh() {
     // lightest material on a mesh of irregular triangles, tilted and swinging in gusts
     // at its automatic substeps, stays stable; at one substep it does not.
     let run = |substeps| {
-        let params = ClothParams {
-            node_mass: 1e-6,
-            springs: SpringParams::from_structural(25_000.0),
-            substeps,
-            ..conservative(Integrator::Verlet)
-        };
-        let mut positions = Vec::new();
-        for v in 0..36u32 {
-            let (i, j) = ((v % 6) as f32, (v / 6) as f32);
-            // Inner vertices moved up to a third of the 5 cm spacing.
-            let inner = (1.0..5.0).contains(&i) && (1.0..5.0).contains(&j);
-            let shift = if inner {
-                Vec3::new((v as f32 * 2.1).sin(), (v as f32 * 3.7).cos(), 0.0) * 0.016
-            } else {
-                Vec3::ZERO
-            };
-            positions.push(Vec3::new(i, -j, 0.0) * 0.05 + shift);
-        }
-        let mut triangles = Vec::new();
-        for j in 0..5u32 {
-            for i in 0..5u32 {
-                let (a, b) = (j * 6 + i, j * 6 + i + 1);
-                let (c, d) = (a + 6, b + 6);
-                if (i + j) % 2 == 0 {
-                    triangles.extend([[a, c, b], [b, c, d]]);
-                } else {
-                    triangles.extend([[a, c, d], [a, d, b]]);
-                }
-            }
-        }
-        let layout = bevy_cloth::solver::Layout::from_mesh(&positions, &triangles).unwrap();
-        let pins = ClothPins::TopCorners.resolve_for(&layout).unwrap();
-        let frame = Affine3A::from_rotation_x(-1.2);
-        let mut cloth = ClothSolver::new(layout, &pins, &params, frame).unwrap();
-        let env = Environment {
-            wind: Wind {
-                direction: Vec3::Z,
-                strength: 1e-6,
-                field: WindField::Trigonometric,
-            },
-            ..no_wind()
-        };
+        // Inner vertices moved up to a third of the 5 cm spacing.
+        let mesh = irregular_mesh(6, 6, 0.05);
+        let (mut cloth, env) = tilted_in_gusts(mesh, &maslova_extreme_params(substeps), 1e-6);
         for step in 0..1000 {
             cloth.step(DT, &env);
             if !cloth.is_stable() {
