@@ -653,8 +653,12 @@ impl ClothSolver {
         if !self.contact.replace(colliders) {
             return;
         }
-        let cloth = Bounds::around(&self.particles.position);
-        self.disturbed |= self.contact.change_reaches(&cloth);
+        // Only a cloth not yet disturbed asks whether the change reaches it (a moving
+        // character's cloth already is, by its pins or targets, and skips the box).
+        if !self.disturbed {
+            let cloth = Bounds::around(&self.particles.position);
+            self.disturbed = self.contact.change_reaches(&cloth);
+        }
         // The thin colliders, for the edge pass: thicker than the cloth's longest edge,
         // the particles catch a collider themselves.
         let longest = self.structure.longest_edge;

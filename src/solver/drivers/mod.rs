@@ -117,6 +117,9 @@ impl MotionConstraints {
                 && stop.radius > 0.0
                 && stop.distance < r
                 && let (Some(&from), Some(&to)) = (self.normal_from.get(i), self.normal_to.get(i))
+                // In front of its target a particle is outside the sphere, whose surface
+                // lies `distance` ≥ 0 behind it: no normal to make unit.
+                && (p.position[i] - target).dot(from.lerp(to, t)) <= 0.0
             {
                 let n = from.lerp(to, t).normalize_or_zero();
                 let centre = target - n * (stop.distance + stop.radius);
