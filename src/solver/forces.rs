@@ -223,29 +223,46 @@ impl ClothSolver {
         }
     }
 
-    /// Adds every acting spring's force (on a grid, by its stencil, `lattice.rs`).
+    /// Adds every acting spring's force: on a grid by its stencil, on a mesh in rows by
+    /// theirs and the springs kept apart from it by the general path (`lattice.rs`), on
+    /// any other cloth by the general path.
     pub(super) fn spring_forces(&mut self) {
         let damping = self.params.springs.damping;
-        if self.structure.stencil.is_some() {
-            let k = SpringKind::ALL.map(|kind| self.stiffness(kind));
-            if let Some(stencil) = &mut self.structure.stencil {
-                stencil.spring_forces(&mut self.particles, |kind| k[kind as usize], damping);
-            }
+        let k = SpringKind::ALL.map(|kind| self.stiffness(kind));
+        let (structure, p) = (&mut self.structure, &mut self.particles);
+        if let Some(stencil) = &mut structure.stencil {
+            stencil.spring_forces(p, |kind| k[kind as usize], damping);
             return;
         }
+        let apart = match &mut structure.rows {
+            Some(rows) => {
+                rows.stencil
+                    .spring_forces(p, |kind| k[kind as usize], damping);
+                Some(rows.apart.as_slice())
+            }
+            None => None,
+        };
+        let s = &structure.springs;
         for kind in SpringKind::ALL {
-            let k = self.stiffness(kind);
+            let k = k[kind as usize];
             if k == 0.0 {
                 continue;
             }
-            let range = self.structure.springs.ranges[kind as usize].clone();
+            let range = s.ranges[kind as usize].clone();
             // A particle cloth's springs all take their family's constant; only the patch
             // model's part lattice scales them one by one. Two instances of one loop, so
             // the common case reads no per-spring factor.
-            let (s, p) = (&self.structure.springs, &mut self.particles);
-            match s.stiffness_scale.as_deref() {
-                None => spring_forces(s, p, range, k, damping, |_| 1.0),
-                Some(scale) => spring_forces(s, p, range, k, damping, |i| scale[i]),
+            let scale = s.stiffness_scale.as_deref();
+            match (apart, scale) {
+                (None, None) => spring_forces(s, p, range, k, damping, |_| 1.0),
+                (None, Some(scale)) => spring_forces(s, p, range, k, damping, |i| scale[i]),
+                (Some(apart), _) => {
+                    // The family's springs kept apart (they are in index order).
+                    let at = |i: usize| apart.partition_point(|&s| (s as usize) < i);
+                    let springs = apart[at(range.start)..at(range.end)].iter();
+                    let springs = springs.map(|&s| s as usize);
+                    spring_forces(s, p, springs, k, damping, |i| s.scale(i));
+                }
             }
         }
     }
@@ -303,19 +320,19 @@ fn corner_load(air: &Air, cross: Vec3, w: Vec3) -> Option<(Vec3, f32, [f32; 6])>
 }
 
 /// Hooke springs `F = k (|l| − l0) l/|l|` (Maslova eq. 1.4) plus damping along the
-/// spring, over the springs `range` of `s`, each scaled by `scale(spring)`. Each spring
+/// spring, over the `springs` of `s` (indices), each scaled by `scale(spring)`. Each spring
 /// pushes its ends with equal and opposite forces; dividing by each end's mass in
 /// `integrate` shares the motion by inverse mass, as Sladović 2014 eq. 2 asks.
 #[inline(always)]
 pub(super) fn spring_forces(
     s: &Springs,
     p: &mut Particles,
-    range: std::ops::Range<usize>,
+    springs: impl IntoIterator<Item = usize>,
     k: f32,
     damping: f32,
     scale: impl Fn(usize) -> f32,
 ) {
-    for idx in range {
+    for idx in springs {
         if !s.alive[idx] {
             continue;
         }

@@ -7,7 +7,7 @@ use std::ops::Range;
 use bevy::math::Vec3;
 
 use super::bending::{Hinges, particle_areas};
-use super::lattice::Stencil;
+use super::lattice::{Rows, Stencil};
 use super::layout::Layout;
 use super::topology::{self, SpringKind, Springs, VertexFaces};
 
@@ -34,6 +34,9 @@ pub(super) struct Structure {
     /// A grid cloth's springs as stencil offsets (`lattice.rs`); `None` for meshes and
     /// garments.
     pub stencil: Option<Stencil>,
+    /// A mesh in rows (a skirt: a grid wrapped round), its springs' forces on a stencil
+    /// (`lattice.rs`); `None` for grids, garments and other meshes.
+    pub rows: Option<Rows>,
     /// The cloth's characteristic length L (mean structural rest length), for the
     /// shape-matching force law.
     pub length_scale: f32,
@@ -95,6 +98,10 @@ impl Structure {
         let n = local.len();
         let springs = Springs::from_pairs(pairs, &local);
         let stencil = grid.and_then(|(w, _)| Stencil::new(&springs, w as usize, n));
+        let sewn = !springs.ranges[SpringKind::Seam as usize].is_empty();
+        let rows = (grid.is_none() && !sewn)
+            .then(|| Rows::find(&springs, n))
+            .flatten();
         let (triangle_springs, spring_triangles) =
             topology::triangle_edge_springs(&triangles, &springs);
         let seams = springs.ranges[SpringKind::Seam as usize].clone();
@@ -130,6 +137,7 @@ impl Structure {
             runs,
             seam_start,
             stencil,
+            rows,
             length_scale,
             longest_edge,
             torn_count: 0,
@@ -157,7 +165,7 @@ impl Structure {
     /// Tears spring `k` (in the stencil too) and hides the faces it borders.
     pub fn tear(&mut self, k: usize) {
         self.springs.alive[k] = false;
-        if let Some(stencil) = &mut self.stencil {
+        for stencil in stencils(&mut self.stencil, &mut self.rows) {
             stencil.tear(k);
         }
         for &t in &self.spring_triangles[k] {
@@ -185,10 +193,18 @@ impl Structure {
 
     /// Mirrors the springs' rest lengths, factors and alive flags into the stencil.
     pub fn sync_stencil(&mut self) {
-        if let Some(stencil) = &mut self.stencil {
+        for stencil in stencils(&mut self.stencil, &mut self.rows) {
             stencil.sync(&self.springs);
         }
     }
+}
+
+/// A grid's stencil or a mesh's rows' (at most one is there).
+fn stencils<'a>(
+    grid: &'a mut Option<Stencil>,
+    rows: &'a mut Option<Rows>,
+) -> impl Iterator<Item = &'a mut Stencil> {
+    grid.iter_mut().chain(rows.as_mut().map(|r| &mut r.stencil))
 }
 
 #[cfg(test)]

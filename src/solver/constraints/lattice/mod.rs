@@ -199,6 +199,58 @@ impl SpringPass<'_> {
     }
 }
 
+/// The slot of a spring that is not in the stencil ([`Rows`]).
+const APART: u8 = u8::MAX;
+
+/// A mesh whose particles lie in rows (a skirt, a sleeve: a grid wrapped round into a
+/// cone or a tube): its springs' forces on a stencil over the rows, and the few that are
+/// no grid offset (those across the seam where the rows close) kept apart, for the
+/// general path. Only its forces take the stencil: its strain limiter and XPBD stay on
+/// the general path, whose sweep needs no colours of offsets.
+#[derive(Clone, Debug)]
+pub(in crate::solver) struct Rows {
+    pub stencil: Stencil,
+    /// The springs kept apart, by index in increasing order (so each family's are
+    /// together).
+    pub apart: Vec<u32>,
+}
+
+impl Rows {
+    /// Rows in a mesh's `springs` over `n` particles, when at most one spring in
+    /// [`APART_SHARE`] is no offset of them. The row's length is among the commonest
+    /// distances in index between a structural spring's ends (beyond the two a stencil
+    /// reaches along a row); the likeliest few are tried, and the one that keeps
+    /// fewest springs apart is taken.
+    pub fn find(springs: &Springs, n: usize) -> Option<Self> {
+        let structural = springs.ranges[SpringKind::Structural as usize].clone();
+        let mut count = std::collections::HashMap::<usize, usize>::new();
+        for s in structural.clone() {
+            let d = springs.a[s].abs_diff(springs.b[s]) as usize;
+            if d > 2 && d <= n / 2 {
+                *count.entry(d).or_default() += 1;
+            }
+        }
+        let mut widths: Vec<(usize, usize)> = count
+            .into_iter()
+            .filter(|&(_, c)| c * 8 >= structural.len())
+            .collect();
+        widths.sort_by_key(|&(w, c)| (std::cmp::Reverse(c), w));
+        widths
+            .into_iter()
+            .take(3)
+            .filter_map(|(width, _)| {
+                let mut apart = Vec::new();
+                let stencil = Stencil::build(springs, width, n, Some(&mut apart))?;
+                Some(Rows { stencil, apart })
+            })
+            .min_by_key(|rows| rows.apart.len())
+            .filter(|rows| rows.apart.len() * APART_SHARE <= springs.len())
+    }
+}
+
+/// A mesh is taken as [`Rows`] when at most one spring in this many is kept apart.
+const APART_SHARE: usize = 8;
+
 /// A grid cloth's springs as stencil offsets.
 #[derive(Clone, Debug)]
 pub(in crate::solver) struct Stencil {
@@ -228,21 +280,32 @@ impl Stencil {
     /// The stencil of `springs` on a `width`-wide grid of `n` particles, or `None` when a
     /// spring is not a grid offset (a seam, a welded mesh) or two share a slot.
     pub fn new(springs: &Springs, width: usize, n: usize) -> Option<Self> {
+        Self::build(springs, width, n, None)
+    }
+
+    /// [`Stencil::new`], or with `apart` the stencil of the springs that are grid
+    /// offsets, the others (by index, in increasing order) put in `apart`.
+    fn build(
+        springs: &Springs,
+        width: usize,
+        n: usize,
+        mut apart: Option<&mut Vec<u32>>,
+    ) -> Option<Self> {
         let mut offsets: Vec<Offset> = Vec::new();
         let mut slot = Vec::with_capacity(springs.len());
         for s in 0..springs.len() {
             let kind = springs.kind(s);
-            if kind == SpringKind::Seam {
-                return None;
-            }
             let (mut a, mut b) = (springs.a[s] as usize, springs.b[s] as usize);
             if b < a {
                 std::mem::swap(&mut a, &mut b);
             }
             let dy = b / width - a / width;
             let dx = (b % width) as isize - (a % width) as isize;
-            if dy > 2 || dx.abs() > 2 {
-                return None;
+            let taken = |o: &Offset| o.kind == kind && o.dx == dx && o.dy == dy && o.rest[a] != 0.0;
+            if kind == SpringKind::Seam || dy > 2 || dx.abs() > 2 || offsets.iter().any(taken) {
+                apart.as_mut()?.push(s as u32);
+                slot.push((APART, 0));
+                continue;
             }
             let index = match offsets
                 .iter()
@@ -263,9 +326,6 @@ impl Stencil {
                 }
             };
             let offset = &mut offsets[index];
-            if offset.rest[a] != 0.0 {
-                return None;
-            }
             offset.rest[a] = springs.rest_length[s];
             slot.push((index as u8, a as u32));
         }
@@ -290,6 +350,9 @@ impl Stencil {
     /// Takes the springs' rest lengths, stiffness factors and alive flags.
     pub fn sync(&mut self, springs: &Springs) {
         for (s, &(o, a)) in self.slot.iter().enumerate() {
+            if o == APART {
+                continue;
+            }
             let offset = &mut self.offsets[o as usize];
             offset.rest[a as usize] = springs.rest_length[s];
             offset.weight[a as usize] = if springs.alive[s] {
@@ -303,7 +366,9 @@ impl Stencil {
     /// Spring `s` tore.
     pub fn tear(&mut self, s: usize) {
         let (o, a) = self.slot[s];
-        self.offsets[o as usize].weight[a as usize] = 0.0;
+        if o != APART {
+            self.offsets[o as usize].weight[a as usize] = 0.0;
+        }
     }
 
     /// Adds every spring's Hooke force `k (|l| − l0) l/|l|` plus damping along it
@@ -869,5 +934,96 @@ mod tests {
         for row in 1..=4 {
             assert!(rise(row) > 1e-3, "row {row} rose {} m", rise(row));
         }
+    }
+
+    /// A cone of `around × down` particles (a skirt: a grid wrapped round, its rows
+    /// closed where the last column meets the first) as a mesh, its vertices numbered
+    /// `order(i)` for particle `i` of the rows.
+    fn cone(around: u32, down: u32, order: impl Fn(u32) -> u32) -> crate::solver::Layout {
+        let n = around * down;
+        let mut points = vec![Vec3::ZERO; n as usize];
+        for v in 0..n {
+            let (i, j) = (v % around, v / around);
+            let a = std::f32::consts::TAU * i as f32 / around as f32;
+            let r = 0.2 + 0.03 * j as f32;
+            points[order(v) as usize] = Vec3::new(r * a.sin(), -0.05 * j as f32, r * a.cos());
+        }
+        let mut triangles = Vec::new();
+        for j in 0..down - 1 {
+            for i in 0..around {
+                let (a, b) = (j * around + i, j * around + (i + 1) % around);
+                triangles.push([a, a + around, b].map(&order));
+                triangles.push([b, a + around, b + around].map(&order));
+            }
+        }
+        crate::solver::Layout::from_mesh(&points, &triangles).unwrap()
+    }
+
+    /// A cone's springs take a stencil over its rows, all but those across its seam
+    /// (whose ends are more than two columns apart), which are kept apart; the stencil's
+    /// forces and the general path's over those kept apart are the general path's over
+    /// every spring, a torn one too. The same cone with its vertices shuffled has no
+    /// rows: it stays on the general path.
+    #[test]
+    fn a_mesh_in_rows_takes_a_stencil_and_keeps_its_seam_apart() {
+        let (around, down) = (12u32, 5u32);
+        let layout = cone(around, down, |v| v);
+        let springs = Springs::from_pairs(layout.springs.clone(), &layout.positions);
+        let n = layout.positions.len();
+        // A cloth built of it takes the rows.
+        assert!(
+            crate::solver::structure::Structure::new(layout.clone())
+                .rows
+                .is_some()
+        );
+        let mut rows = Rows::find(&springs, n).expect("rows");
+        assert_eq!(rows.stencil.width, around as usize);
+        let across = |s: usize| {
+            let column = |v: u32| v % around;
+            column(springs.a[s]).abs_diff(column(springs.b[s])) > 2
+        };
+        let apart: Vec<usize> = (0..springs.len()).filter(|&s| across(s)).collect();
+        assert_eq!(
+            rows.apart.iter().map(|&s| s as usize).collect::<Vec<_>>(),
+            apart
+        );
+        assert!(!apart.is_empty() && apart.len() * APART_SHARE <= springs.len());
+
+        let mut springs = springs;
+        let torn = 7;
+        springs.alive[torn] = false;
+        rows.stencil.tear(torn);
+        let mut p = Particles::with_len(n);
+        for i in 0..n {
+            let jitter = |axis| unit_hash(i, axis) * 0.02;
+            p.position[i] = layout.positions[i] + Vec3::new(jitter(0), jitter(1), jitter(2));
+            p.velocity[i] = Vec3::new(unit_hash(i, 3), unit_hash(i, 4), unit_hash(i, 5));
+        }
+        let mut general = p.clone();
+        let k = [200.0, 50.0, 5.0, 2.0, 0.0];
+        rows.stencil
+            .spring_forces(&mut p, |kind| k[kind as usize], 0.3);
+        for kind in SpringKind::ALL {
+            let k = k[kind as usize];
+            let range = springs.ranges[kind as usize].clone();
+            let kept = rows.apart.iter().map(|&s| s as usize);
+            let kept = kept.filter(|s| range.contains(s));
+            spring_forces(&springs, &mut p, kept, k, 0.3, |_| 1.0);
+            spring_forces(&springs, &mut general, range, k, 0.3, |_| 1.0);
+        }
+        for i in 0..n {
+            let (f, g) = (p.force[i], general.force[i]);
+            assert!(
+                f.distance(g) < 1e-4 * (1.0 + g.length()),
+                "particle {i}: {f} against {g}"
+            );
+        }
+        assert!(general.force.iter().any(|f| f.length() > 1.0));
+
+        let mut order: Vec<u32> = (0..around * down).collect();
+        order.sort_by(|&u, &v| unit_hash(u as usize, 9).total_cmp(&unit_hash(v as usize, 9)));
+        let shuffled = cone(around, down, |v| order[v as usize]);
+        let springs = Springs::from_pairs(shuffled.springs, &shuffled.positions);
+        assert!(Rows::find(&springs, n).is_none());
     }
 }
