@@ -404,13 +404,9 @@ impl Crowd {
         let start = Instant::now();
         let turn = (t / self.size.teleport_every) as usize;
         let due = (self.time / self.size.teleport_every) as usize != turn;
-        let n = self.characters.len();
-        let zones = if self.size.wind { &self.zones[..] } else { &[] };
-        for (k, c) in self.characters.iter_mut().enumerate() {
-            let jumps = due && turn % n == k;
-            self.teleports += jumps as usize;
-            c.move_to(t, dt, jumps, zones);
-        }
+        let jumper = due.then(|| turn % self.characters.len());
+        self.teleports += jumper.is_some() as usize;
+        self.drive(pool, (t, dt), jumper);
         let drive = start.elapsed();
         let start = Instant::now();
         self.step_cloths(pool);
@@ -452,19 +448,19 @@ impl Crowd {
         }
     }
 
-    /// Draws every cloth: on the pool, the characters in as many lots as threads (each
-    /// cloth's drawing is its own), or one after another here.
-    fn draw(&mut self, pool: bool) {
-        if !pool {
-            self.characters.iter_mut().for_each(Character::draw);
-            return;
-        }
-        let lot = self.characters.len().div_ceil(solver::threads()).max(1);
-        solver::task_pool().scope(|scope| {
-            for chunk in self.characters.chunks_mut(lot) {
-                scope.spawn(async move { chunk.iter_mut().for_each(Character::draw) });
-            }
+    /// Moves every body to its pose at time `t` (a step of `dt`), character `jumper`
+    /// teleporting: on the pool as [`Self::draw`] shares the characters, as the plugin's
+    /// driving systems share the cloths, or one after another here.
+    fn drive(&mut self, pool: bool, (t, dt): (f32, f32), jumper: Option<usize>) {
+        let zones = if self.size.wind { &self.zones[..] } else { &[] };
+        each_character(&mut self.characters, pool, |k, c| {
+            c.move_to(t, dt, jumper == Some(k), zones);
         });
+    }
+
+    /// Draws every cloth: on the pool, or one after another here.
+    fn draw(&mut self, pool: bool) {
+        each_character(&mut self.characters, pool, |_, c| c.draw());
     }
 
     /// The largest structural strain over every cloth now, and whether every one is
@@ -474,6 +470,33 @@ impl Crowd {
             (s.max(c.strain().max), ok && c.is_stable())
         })
     }
+}
+
+/// `work` on each of `characters` with its index: on the pool, the characters in as
+/// many lots as threads (each one's cloths are its own), or one after another here.
+fn each_character(
+    characters: &mut [Character],
+    pool: bool,
+    work: impl Fn(usize, &mut Character) + Sync,
+) {
+    if !pool {
+        characters
+            .iter_mut()
+            .enumerate()
+            .for_each(|(k, c)| work(k, c));
+        return;
+    }
+    let lot = characters.len().div_ceil(solver::threads()).max(1);
+    let work = &work;
+    solver::task_pool().scope(|scope| {
+        for (l, chunk) in characters.chunks_mut(lot).enumerate() {
+            scope.spawn(async move {
+                for (k, c) in chunk.iter_mut().enumerate() {
+                    work(l * lot + k, c);
+                }
+            });
+        }
+    });
 }
 
 /// The crowd's cloths, as the example's: the default mass-spring, its strain limiter

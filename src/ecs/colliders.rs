@@ -523,23 +523,34 @@ pub(crate) fn give_colliders(
     mut cloths: Query<&mut ClothSimulation>,
 ) {
     placed.poses.end_step();
-    for mut sim in &mut cloths {
-        let sim = &mut *sim;
-        if placed.colliders.is_empty() && sim.solver.colliders().is_empty() {
-            continue;
+    let placed = &*placed;
+    // Side by side, as the cloths step: each one's colliders are its own.
+    let cloths = cloths
+        .iter_mut()
+        .map(|sim| (sim.solver.particle_count() as u64, sim));
+    solver::in_lots(cloths.collect(), |lot| {
+        for mut sim in lot {
+            give(placed, &mut sim);
         }
-        sim.colliders_from.clear();
-        let layers = sim.layers;
-        if placed.layers.iter().all(|&l| l.meet(layers)) {
-            sim.colliders_from.extend(0..placed.colliders.len() as u32);
-            sim.solver.set_colliders(placed.colliders.iter().cloned());
-        } else {
-            let met = (0..placed.colliders.len()).filter(|&i| placed.layers[i].meet(layers));
-            sim.colliders_from.extend(met.map(|i| i as u32));
-            let from = &sim.colliders_from;
-            let colliders = from.iter().map(|&i| placed.colliders[i as usize].clone());
-            sim.solver.set_colliders(colliders);
-        }
+    });
+}
+
+/// Gives `sim` the colliders of `placed` its layers meet.
+fn give(placed: &PlacedColliders, sim: &mut ClothSimulation) {
+    if placed.colliders.is_empty() && sim.solver.colliders().is_empty() {
+        return;
+    }
+    sim.colliders_from.clear();
+    let layers = sim.layers;
+    if placed.layers.iter().all(|&l| l.meet(layers)) {
+        sim.colliders_from.extend(0..placed.colliders.len() as u32);
+        sim.solver.set_colliders(placed.colliders.iter().cloned());
+    } else {
+        let met = (0..placed.colliders.len()).filter(|&i| placed.layers[i].meet(layers));
+        sim.colliders_from.extend(met.map(|i| i as u32));
+        let from = &sim.colliders_from;
+        let colliders = from.iter().map(|&i| placed.colliders[i as usize].clone());
+        sim.solver.set_colliders(colliders);
     }
 }
 

@@ -331,43 +331,59 @@ fn move_bodies(
     bindposes: Option<Res<Assets<SkinnedMeshInverseBindposes>>>,
     mut cloths: Query<(Entity, &mut ClothSimulation, &mut ClothBody)>,
 ) {
-    for (entity, mut sim, mut body) in &mut cloths {
-        let body = &mut *body;
-        if let Some(skin) = &mut body.skin {
-            let inverse = bindposes.as_ref();
-            let Some(inverse) = inverse.and_then(|b| b.get(&skin.mesh.inverse_bindposes)) else {
-                continue; // not loaded yet (or no renderer's skinning in this app)
-            };
-            skin.matrices.clear();
-            for (&joint, inverse) in skin.mesh.joints.iter().zip(inverse.iter()) {
-                match transforms.compute_global_transform(joint) {
-                    Ok(global) => skin
-                        .matrices
-                        .push(global.affine() * Affine3A::from_mat4(*inverse)),
-                    Err(_) => break,
-                }
-            }
-            if skin.matrices.len() != skin.mesh.joints.len() {
-                warn_once!("cloth {entity}: a joint of its skin has no transform; not moved");
-                continue;
+    let (transforms, inverse) = (&transforms, bindposes.as_deref());
+    // Side by side, as the cloths step: each one's skin and targets are its own.
+    let bodies = cloths
+        .iter_mut()
+        .map(|c| (c.1.solver.particle_count() as u64, c));
+    crate::solver::in_lots(bodies.collect(), |lot| {
+        for (entity, mut sim, mut body) in lot {
+            move_body(entity, &mut sim, &mut body, transforms, inverse);
+        }
+    });
+}
+
+/// [`move_bodies`] for one cloth.
+fn move_body(
+    entity: Entity,
+    sim: &mut ClothSimulation,
+    body: &mut ClothBody,
+    transforms: &TransformHelper,
+    bindposes: Option<&Assets<SkinnedMeshInverseBindposes>>,
+) {
+    if let Some(skin) = &mut body.skin {
+        let Some(inverse) = bindposes.and_then(|b| b.get(&skin.mesh.inverse_bindposes)) else {
+            return; // not loaded yet (or no renderer's skinning in this app)
+        };
+        skin.matrices.clear();
+        for (&joint, inverse) in skin.mesh.joints.iter().zip(inverse.iter()) {
+            match transforms.compute_global_transform(joint) {
+                Ok(global) => skin
+                    .matrices
+                    .push(global.affine() * Affine3A::from_mat4(*inverse)),
+                Err(_) => break,
             }
         }
-        body.aim(sim.solver.frame());
-        if !body.placed {
-            let p = sim.solver.particles_mut();
-            for (i, &x) in body.targets.iter().enumerate() {
-                p.position[i] = x;
-                p.previous[i] = x;
-                p.velocity[i] = Vec3::ZERO;
-            }
-            body.placed = true;
+        if skin.matrices.len() != skin.mesh.joints.len() {
+            warn_once!("cloth {entity}: a joint of its skin has no transform; not moved");
+            return;
         }
-        if let Err(e) = sim
-            .solver
-            .set_motion_constraints(&body.targets, &body.max_distance)
-        {
-            warn_once!("cloth {entity}: {e}");
+    }
+    body.aim(sim.solver.frame());
+    if !body.placed {
+        let p = sim.solver.particles_mut();
+        for (i, &x) in body.targets.iter().enumerate() {
+            p.position[i] = x;
+            p.previous[i] = x;
+            p.velocity[i] = Vec3::ZERO;
         }
+        body.placed = true;
+    }
+    if let Err(e) = sim
+        .solver
+        .set_motion_constraints(&body.targets, &body.max_distance)
+    {
+        warn_once!("cloth {entity}: {e}");
     }
 }
 

@@ -148,13 +148,17 @@ fn blow(
         }
     }
     let now = time.elapsed_secs();
-    for mut sim in &mut cloths {
-        let blowing = !sim.solver.wind_zones().is_empty();
-        if placed.is_empty() && !blowing {
-            continue;
+    let placed = &*placed;
+    // Side by side, as the cloths step: each one's zones are its own.
+    let blown = cloths
+        .iter_mut()
+        .filter(|sim| !placed.is_empty() || !sim.solver.wind_zones().is_empty())
+        .map(|sim| (sim.solver.particle_count() as u64, sim));
+    crate::solver::in_lots(blown.collect(), |lot| {
+        for mut sim in lot {
+            sim.solver
+                .set_wind_zones(placed, now)
+                .expect("every zone checked");
         }
-        sim.solver
-            .set_wind_zones(&placed, now)
-            .expect("every zone checked");
-    }
+    });
 }

@@ -49,3 +49,45 @@ fn a_wind_zone_entity_blows_on_the_cloths_it_reaches() {
     assert!(far.wind_zones().is_empty());
     assert_eq!(far.positions(), calm_far.positions());
 }
+
+/// The plugin drives the cloths side by side on two cores (the zones, the colliders, the
+/// skins each cloth's own): six banners, two of them in a zone, one against a ball, end
+/// on the bits they end on when every system takes one cloth after another.
+#[test]
+fn driving_side_by_side_is_driving_one_after_another() {
+    let run = |parallel: bool| {
+        bevy_cloth::solver::set_parallel(parallel);
+        let mut app = app();
+        let banners: Vec<Entity> = (0..6).map(|k| banner(&mut app, k as f32 * 0.8)).collect();
+        app.world_mut().spawn((
+            ClothWindZone::sphere(1.0, Vec3::Z * 6.0),
+            Transform::from_xyz(0.6, 1.8, 0.0),
+        ));
+        app.world_mut().spawn((
+            ClothCollider::sphere(0.1).with_thickness(0.01),
+            Transform::from_xyz(3.4, 1.8, 0.05),
+        ));
+        for _ in 0..40 {
+            app.update();
+        }
+        let world = app.world();
+        let sim = |e| &world.get::<ClothSimulation>(e).unwrap().solver;
+        let zones: Vec<usize> = banners.iter().map(|&e| sim(e).wind_zones().len()).collect();
+        let x: Vec<Vec<Vec3>> = banners
+            .iter()
+            .map(|&e| sim(e).positions().to_vec())
+            .collect();
+        (zones, x)
+    };
+    let (one, two) = (run(false), run(true));
+    bevy_cloth::solver::set_parallel(true);
+    assert_eq!(one, two);
+    // The zone blew on the first and not the last; the ball pushed the fifth off its
+    // plane, where the last, calm, hangs in it.
+    let (zones, x) = one;
+    assert_eq!((zones[0], zones[5]), (1, 0));
+    let off_plane = |k: usize| x[k].iter().map(|p| p.z.abs()).fold(0.0, f32::max);
+    assert!(off_plane(0) > 0.05, "{}", off_plane(0));
+    assert!(off_plane(4) > 1e-3, "{}", off_plane(4));
+    assert_eq!(off_plane(5), 0.0);
+}
