@@ -217,7 +217,7 @@ pub(in crate::solver) struct Rows {
 
 impl Rows {
     /// Rows in a mesh's `springs` over `n` particles, when at most one spring in
-    /// [`APART_SHARE`] is no offset of them. The row's length is among the commonest
+    /// [`APART_SHARE`] is no offset of them and the offsets are at least half full. The row's length is among the commonest
     /// distances in index between a structural spring's ends (beyond the two a stencil
     /// reaches along a row); the likeliest few are tried, and the one that keeps
     /// fewest springs apart is taken.
@@ -245,6 +245,9 @@ impl Rows {
             })
             .min_by_key(|rows| rows.apart.len())
             .filter(|rows| rows.apart.len() * APART_SHARE <= springs.len())
+            // Each offset is a pass over every particle: at least half of them must
+            // start one of its springs, or the general path does less.
+            .filter(|rows| rows.stencil.offsets.len() * n <= 2 * springs.len())
     }
 }
 
