@@ -199,6 +199,31 @@ impl SpringPass<'_> {
     }
 }
 
+/// The index in `offsets` of the offset of `kind` by `(dx, dy)` (`step` in particle
+/// indices), added (empty, for `n` particles) if it is not there yet.
+fn offset_of(
+    offsets: &mut Vec<Offset>,
+    (kind, dx, dy): (SpringKind, isize, usize),
+    step: usize,
+    n: usize,
+) -> usize {
+    if let Some(index) = offsets
+        .iter()
+        .position(|o| o.kind == kind && o.dx == dx && o.dy == dy)
+    {
+        return index;
+    }
+    offsets.push(Offset {
+        kind,
+        dx,
+        dy,
+        step,
+        rest: vec![0.0; n],
+        weight: vec![0.0; n],
+    });
+    offsets.len() - 1
+}
+
 /// The slot of a spring that is not in the stencil ([`Rows`]).
 const APART: u8 = u8::MAX;
 
@@ -304,32 +329,16 @@ impl Stencil {
             }
             let dy = b / width - a / width;
             let dx = (b % width) as isize - (a % width) as isize;
-            let taken = |o: &Offset| o.kind == kind && o.dx == dx && o.dy == dy && o.rest[a] != 0.0;
-            if kind == SpringKind::Seam || dy > 2 || dx.abs() > 2 || offsets.iter().any(taken) {
+            // Its offset, unless it is none (a seam, too far) or its slot is taken.
+            let index = (kind != SpringKind::Seam && dy <= 2 && dx.abs() <= 2)
+                .then(|| offset_of(&mut offsets, (kind, dx, dy), b - a, n))
+                .filter(|&o| offsets[o].rest[a] == 0.0);
+            let Some(index) = index else {
                 apart.as_mut()?.push(s as u32);
                 slot.push((APART, 0));
                 continue;
-            }
-            let index = match offsets
-                .iter()
-                .position(|o| o.kind == kind && o.dx == dx && o.dy == dy)
-            {
-                Some(index) => index,
-                None => {
-                    let step = b - a;
-                    offsets.push(Offset {
-                        kind,
-                        dx,
-                        dy,
-                        step,
-                        rest: vec![0.0; n],
-                        weight: vec![0.0; n],
-                    });
-                    offsets.len() - 1
-                }
             };
-            let offset = &mut offsets[index];
-            offset.rest[a] = springs.rest_length[s];
+            offsets[index].rest[a] = springs.rest_length[s];
             slot.push((index as u8, a as u32));
         }
         let max_step = offsets.iter().map(|o| o.step).max().unwrap_or(0);
@@ -866,6 +875,30 @@ mod tests {
     use crate::solver::forces::spring_forces;
     use crate::solver::unit_hash;
 
+    /// Particles at `rest`, each moved up to 2 cm along each axis and given a velocity
+    /// (both of a hash of its index).
+    fn jittered(rest: &[Vec3]) -> Particles {
+        let mut p = Particles::with_len(rest.len());
+        for (i, &x) in rest.iter().enumerate() {
+            let jitter = |axis| unit_hash(i, axis) * 0.02;
+            p.position[i] = x + Vec3::new(jitter(0), jitter(1), jitter(2));
+            p.velocity[i] = Vec3::new(unit_hash(i, 3), unit_hash(i, 4), unit_hash(i, 5));
+        }
+        p
+    }
+
+    /// `p`'s forces are `general`'s, particle by particle, to rounding (summed in another
+    /// order), and some are more than 1 N.
+    fn assert_same_forces(p: &Particles, general: &Particles) {
+        for (i, (f, g)) in p.force.iter().zip(&general.force).enumerate() {
+            assert!(
+                f.distance(*g) < 1e-4 * (1.0 + g.length()),
+                "particle {i}: {f} against {g}"
+            );
+        }
+        assert!(general.force.iter().any(|f| f.length() > 1.0));
+    }
+
     /// The stencil's spring forces on a crumpled, moving 7×5 grid against the general
     /// path's, spring by spring (`forces.rs`): the same law, summed in another order.
     #[test]
@@ -881,12 +914,7 @@ mod tests {
         let n = layout.positions.len();
         let mut stencil = Stencil::new(&springs, 7, n).unwrap();
         stencil.sync(&springs);
-        let mut p = Particles::with_len(n);
-        for i in 0..n {
-            let jitter = |axis| unit_hash(i, axis) * 0.02;
-            p.position[i] = layout.positions[i] + Vec3::new(jitter(0), jitter(1), jitter(2));
-            p.velocity[i] = Vec3::new(unit_hash(i, 3), unit_hash(i, 4), unit_hash(i, 5));
-        }
+        let mut p = jittered(&layout.positions);
         let mut general = p.clone();
         let k = [200.0, 50.0, 5.0, 2.0, 0.0];
         stencil.spring_forces(&mut p, |kind| k[kind as usize], 0.3);
@@ -896,14 +924,7 @@ mod tests {
                 1.0
             });
         }
-        for i in 0..n {
-            let (f, g) = (p.force[i], general.force[i]);
-            assert!(
-                f.distance(g) < 1e-4 * (1.0 + g.length()),
-                "particle {i}: {f} against {g}"
-            );
-        }
-        assert!(general.force.iter().any(|f| f.length() > 1.0));
+        assert_same_forces(&p, &general);
     }
 
     /// A strip hanging from its top row, every row below pulled 0.2 m down at once (only
@@ -996,12 +1017,7 @@ mod tests {
         let torn = 7;
         springs.alive[torn] = false;
         rows.stencil.tear(torn);
-        let mut p = Particles::with_len(n);
-        for i in 0..n {
-            let jitter = |axis| unit_hash(i, axis) * 0.02;
-            p.position[i] = layout.positions[i] + Vec3::new(jitter(0), jitter(1), jitter(2));
-            p.velocity[i] = Vec3::new(unit_hash(i, 3), unit_hash(i, 4), unit_hash(i, 5));
-        }
+        let mut p = jittered(&layout.positions);
         let mut general = p.clone();
         let k = [200.0, 50.0, 5.0, 2.0, 0.0];
         rows.stencil
@@ -1014,14 +1030,7 @@ mod tests {
             spring_forces(&springs, &mut p, kept, k, 0.3, |_| 1.0);
             spring_forces(&springs, &mut general, range, k, 0.3, |_| 1.0);
         }
-        for i in 0..n {
-            let (f, g) = (p.force[i], general.force[i]);
-            assert!(
-                f.distance(g) < 1e-4 * (1.0 + g.length()),
-                "particle {i}: {f} against {g}"
-            );
-        }
-        assert!(general.force.iter().any(|f| f.length() > 1.0));
+        assert_same_forces(&p, &general);
 
         let mut order: Vec<u32> = (0..around * down).collect();
         order.sort_by(|&u, &v| unit_hash(u as usize, 9).total_cmp(&unit_hash(v as usize, 9)));
