@@ -336,10 +336,8 @@ fn move_bodies(
     let bodies = cloths
         .iter_mut()
         .map(|c| (c.1.solver.particle_count() as u64, c));
-    crate::solver::in_lots(bodies.collect(), |lot| {
-        for (entity, mut sim, mut body) in lot {
-            move_body(entity, &mut sim, &mut body, transforms, inverse);
-        }
+    crate::solver::each_in_lots(bodies, |(entity, mut sim, mut body)| {
+        move_body(entity, &mut sim, &mut body, transforms, inverse);
     });
 }
 

@@ -154,11 +154,9 @@ fn blow(
         .iter_mut()
         .filter(|sim| !placed.is_empty() || !sim.solver.wind_zones().is_empty())
         .map(|sim| (sim.solver.particle_count() as u64, sim));
-    crate::solver::in_lots(blown.collect(), |lot| {
-        for mut sim in lot {
-            sim.solver
-                .set_wind_zones(placed, now)
-                .expect("every zone checked");
-        }
+    crate::solver::each_in_lots(blown, |mut sim| {
+        sim.solver
+            .set_wind_zones(placed, now)
+            .expect("every zone checked");
     });
 }

@@ -161,3 +161,9 @@ pub(crate) fn in_lots<T: Send>(mut items: Vec<(u64, T)>, run: impl Fn(Vec<T>) + 
         }
     });
 }
+
+/// [`in_lots`] with `run` on each item of each lot: each item (with its work) handled on
+/// its own, as a cloth's driving is.
+pub(crate) fn each_in_lots<T: Send>(items: impl Iterator<Item = (u64, T)>, run: impl Fn(T) + Sync) {
+    in_lots(items.collect(), |lot| lot.into_iter().for_each(&run));
+}

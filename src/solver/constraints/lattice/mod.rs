@@ -242,10 +242,10 @@ pub(in crate::solver) struct Rows {
 
 impl Rows {
     /// Rows in a mesh's `springs` over `n` particles, when at most one spring in
-    /// [`APART_SHARE`] is no offset of them and the offsets are at least half full. The row's length is among the commonest
-    /// distances in index between a structural spring's ends (beyond the two a stencil
-    /// reaches along a row); the likeliest few are tried, and the one that keeps
-    /// fewest springs apart is taken.
+    /// [`APART_SHARE`] is no offset of them and the offsets are at least half full. The
+    /// row's length is among the commonest distances in index between a structural
+    /// spring's ends (beyond the two a stencil reaches along a row); the likeliest few
+    /// are tried, and the one that keeps fewest springs apart is taken.
     pub fn find(springs: &Springs, n: usize) -> Option<Self> {
         let structural = springs.ranges[SpringKind::Structural as usize].clone();
         let mut count = std::collections::HashMap::<usize, usize>::new();
