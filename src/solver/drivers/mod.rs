@@ -77,6 +77,30 @@ pub struct BackStop {
     pub radius: f32,
 }
 
+impl BackStop {
+    /// Moves `x` out of this stop's sphere behind `target` along `normal` (the targets'
+    /// normal, any length): out to its surface the nearest way, along the line from its
+    /// centre. Whether it moved.
+    #[inline(always)]
+    fn keep_out(&self, x: &mut Vec3, target: Vec3, normal: Vec3) -> bool {
+        // In front of its target a particle is outside the sphere, whose surface lies
+        // `distance` ≥ 0 behind it: no normal to make unit.
+        if (*x - target).dot(normal) > 0.0 {
+            return false;
+        }
+        let n = normal.normalize_or_zero();
+        let centre = target - n * (self.distance + self.radius);
+        let off = *x - centre;
+        let l2 = off.length_squared();
+        let inside = l2 < self.radius * self.radius;
+        if inside {
+            let out = if l2 > 0.0 { off / l2.sqrt() } else { n };
+            *x = centre + out * self.radius;
+        }
+        inside
+    }
+}
+
 impl MotionConstraints {
     /// Starts a step: the targets (and their normals) go from where the last step's ended
     /// to those given.
@@ -99,44 +123,52 @@ impl MotionConstraints {
     /// (Jolt applies it first; the order matters only where the two spheres' surfaces
     /// cross, and there this one keeps the particle out of the body).
     pub fn hold(&self, p: &mut Particles, t: f32, h: f32) {
-        for (i, &r) in self.radius.iter().enumerate() {
-            if p.inv_mass[i] == 0.0 {
+        let n = self.radius.len();
+        if n == 0 {
+            return;
+        }
+        // Every array sliced to the constraints' length once, so that the loop indexes
+        // without a bounds check a particle (this runs every substep on every particle
+        // of a skinned cloth).
+        let (from, to, radius) = (&self.from[..n], &self.to[..n], &self.radius[..n]);
+        let (x, velocity) = (&mut p.position[..n], &mut p.velocity[..n]);
+        let (previous, w) = (&p.previous[..n], &p.inv_mass[..n]);
+        let stops = self.stops(n);
+        for i in 0..n {
+            if w[i] == 0.0 {
                 continue;
             }
-            let target = self.from[i].lerp(self.to[i], t);
+            let (target, r) = (from[i].lerp(to[i], t), radius[i]);
             let mut moved = false;
             if r.is_finite() {
-                let off = p.position[i] - target;
+                let off = x[i] - target;
                 let l2 = off.length_squared();
                 if l2 > r * r {
-                    p.position[i] = target + off * (r / l2.sqrt());
+                    x[i] = target + off * (r / l2.sqrt());
                     moved = true;
                 }
             }
-            if let Some(stop) = self.back_stop.get(i)
-                && stop.radius > 0.0
-                && stop.distance < r
-                && let (Some(&from), Some(&to)) = (self.normal_from.get(i), self.normal_to.get(i))
-                // In front of its target a particle is outside the sphere, whose surface
-                // lies `distance` ≥ 0 behind it: no normal to make unit.
-                && (p.position[i] - target).dot(from.lerp(to, t)) <= 0.0
+            if let Some((stop, normal_from, normal_to)) = stops
+                && stop[i].radius > 0.0
+                && stop[i].distance < r
             {
-                let n = from.lerp(to, t).normalize_or_zero();
-                let centre = target - n * (stop.distance + stop.radius);
-                let off = p.position[i] - centre;
-                let l2 = off.length_squared();
-                if l2 < stop.radius * stop.radius {
-                    // Out to the sphere's surface the nearest way (along the normal from its
-                    // centre).
-                    let out = if l2 > 0.0 { off / l2.sqrt() } else { n };
-                    p.position[i] = centre + out * stop.radius;
-                    moved = true;
-                }
+                let normal = normal_from[i].lerp(normal_to[i], t);
+                moved |= stop[i].keep_out(&mut x[i], target, normal);
             }
             if moved {
-                p.velocity[i] = (p.position[i] - p.previous[i]) / h;
+                velocity[i] = (x[i] - previous[i]) / h;
             }
         }
+    }
+
+    /// The back stops and their targets' normals at the step's start and end, each of
+    /// `n`; `None` when there are none (or no normals yet).
+    fn stops(&self, n: usize) -> Option<(&[BackStop], &[Vec3], &[Vec3])> {
+        Some((
+            self.back_stop.get(..n)?,
+            self.normal_from.get(..n)?,
+            self.normal_to.get(..n)?,
+        ))
     }
 
     /// The targets' normals for the next step, from the cloth's triangles at the targets
