@@ -264,12 +264,7 @@ impl ZoneAt {
         if self.stir > 0.0 {
             let t = &self.zone.turbulence;
             let q = (x - self.drift) / t.scale;
-            let seed = t.seed.wrapping_mul(3);
-            let whirl = Vec3::new(
-                noise3(seed.wrapping_add(1), q),
-                noise3(seed.wrapping_add(2), q),
-                noise3(seed.wrapping_add(3), q),
-            );
+            let whirl = noise3x3(t.seed.wrapping_mul(3), q);
             v += self.stir * whirl;
         }
         weight * v
@@ -279,10 +274,26 @@ impl ZoneAt {
 /// A hash of a lattice point and a seed to a value in [−1, 1].
 #[inline]
 fn lattice(seed: u32, x: i32, y: i32, z: i32) -> f32 {
-    let mut h = seed.wrapping_mul(0x9e37_79b9)
-        ^ (x as u32).wrapping_mul(0x8da6_b343)
+    mix(seeded(seed) ^ place(x, y, z))
+}
+
+/// A seed's part of a lattice point's hash.
+#[inline]
+fn seeded(seed: u32) -> u32 {
+    seed.wrapping_mul(0x9e37_79b9)
+}
+
+/// A lattice point's part of its hash.
+#[inline]
+fn place(x: i32, y: i32, z: i32) -> u32 {
+    (x as u32).wrapping_mul(0x8da6_b343)
         ^ (y as u32).wrapping_mul(0xd816_3841)
-        ^ (z as u32).wrapping_mul(0xcb1a_b31f);
+        ^ (z as u32).wrapping_mul(0xcb1a_b31f)
+}
+
+/// The seed's and the point's parts of a hash, mixed to a value in [−1, 1].
+#[inline]
+fn mix(mut h: u32) -> f32 {
     h ^= h >> 15;
     h = h.wrapping_mul(0x2c1b_3c6d);
     h ^= h >> 12;
@@ -306,8 +317,9 @@ fn noise1(seed: u32, t: f32) -> f32 {
 }
 
 /// Value noise in space, in [−1, 1], smooth, 0 mean: the lattice's values trilinearly
-/// blended with [`fade`].
-#[inline]
+/// blended with [`fade`]. (The zones draw three at once, [`noise3x3`]; this one is
+/// what they are checked against.)
+#[cfg(test)]
 fn noise3(seed: u32, p: Vec3) -> f32 {
     let cell = p.floor();
     let (i, j, k) = (cell.x as i32, cell.y as i32, cell.z as i32);
@@ -326,9 +338,63 @@ fn noise3(seed: u32, p: Vec3) -> f32 {
     along_y[0] + (along_y[1] - along_y[0]) * w
 }
 
+/// [`noise3`] at `p` for the seeds `seed + 1`, `seed + 2` and `seed + 3`, to the bit,
+/// side by side: the cell, its fades and each lattice point's part of the hash worked
+/// out once for the three (the turbulence's three components, every particle a zone
+/// reaches, every step).
+#[inline]
+fn noise3x3(seed: u32, p: Vec3) -> Vec3 {
+    let cell = p.floor();
+    let (i, j, k) = (cell.x as i32, cell.y as i32, cell.z as i32);
+    let f = p - cell;
+    let (u, v, w) = (fade(f.x), fade(f.y), fade(f.z));
+    let seeds = [1, 2, 3].map(|s| seeded(seed.wrapping_add(s)));
+    let at = |x, y, z| {
+        let point = place(x, y, z);
+        Vec3::from_array(seeds.map(|s| mix(s ^ point)))
+    };
+    let mut along_y = [Vec3::ZERO; 2];
+    for (dz, out) in along_y.iter_mut().enumerate() {
+        let k = k + dz as i32;
+        let row = |j| {
+            let a = at(i, j, k);
+            a + (at(i + 1, j, k) - a) * u
+        };
+        let (a, b) = (row(j), row(j + 1));
+        *out = a + (b - a) * v;
+    }
+    along_y[0] + (along_y[1] - along_y[0]) * w
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The three noises of a zone's turbulence drawn at once are the three drawn one by
+    /// one, to the bit, and the hash split into a seed's and a point's parts is the hash
+    /// in one expression: at points across cell boundaries, negative and far from 0.
+    #[test]
+    fn three_noises_at_once_are_three_one_by_one() {
+        let whole = |seed: u32, x: i32, y: i32, z: i32| {
+            mix(seed.wrapping_mul(0x9e37_79b9)
+                ^ (x as u32).wrapping_mul(0x8da6_b343)
+                ^ (y as u32).wrapping_mul(0xd816_3841)
+                ^ (z as u32).wrapping_mul(0xcb1a_b31f))
+        };
+        for k in -600..600 {
+            let f = k as f32;
+            let p = Vec3::new(f * 0.173, (0.37 * f).sin() * 9.0 - 2.0, f * -0.061 + 0.5);
+            let p = if k % 7 == 0 { p.floor() } else { p };
+            let seed = (k as u32).wrapping_mul(2_654_435_761);
+            let three = noise3x3(seed, p);
+            for (s, got) in three.to_array().into_iter().enumerate() {
+                let one = noise3(seed.wrapping_add(s as u32 + 1), p);
+                assert_eq!(got.to_bits(), one.to_bits(), "{p} seed {seed} lane {s}");
+            }
+            let (x, y, z) = (k, k * 31 - 7, -k * 17);
+            assert_eq!(lattice(seed, x, y, z), whole(seed, x, y, z));
+        }
+    }
 
     /// The noise stays in [−1, 1], is continuous across lattice cells, averages about
     /// 0, and depends on its seed.
