@@ -472,8 +472,10 @@ impl Crowd {
     }
 }
 
-/// `work` on each of `characters` with its index: on the pool, the characters in as
-/// many lots as threads (each one's cloths are its own), or one after another here.
+/// `work` on each of `characters` with its index: on the pool, shared out among the
+/// threads as the plugin shares its cloths (`solver::share_items`: each thread takes the
+/// next character when done with its last; each one's cloths are its own), or one after
+/// another here.
 fn each_character(
     characters: &mut [Character],
     pool: bool,
@@ -486,17 +488,8 @@ fn each_character(
             .for_each(|(k, c)| work(k, c));
         return;
     }
-    let lot = characters.len().div_ceil(solver::threads()).max(1);
-    let work = &work;
-    solver::task_pool().scope(|scope| {
-        for (l, chunk) in characters.chunks_mut(lot).enumerate() {
-            scope.spawn(async move {
-                for (k, c) in chunk.iter_mut().enumerate() {
-                    work(l * lot + k, c);
-                }
-            });
-        }
-    });
+    let each = characters.iter_mut().enumerate().map(|c| (1, c));
+    solver::share_items(each, |(k, c)| work(k, c));
 }
 
 /// The crowd's cloths, as the example's: the default mass-spring, its strain limiter

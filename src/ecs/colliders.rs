@@ -528,7 +528,7 @@ pub(crate) fn give_colliders(
     let cloths = cloths
         .iter_mut()
         .map(|sim| (sim.solver.particle_count() as u64, sim));
-    solver::each_in_lots(cloths, |mut sim| give(placed, &mut sim));
+    solver::share_items(cloths, |mut sim| give(placed, &mut sim));
 }
 
 /// Gives `sim` the colliders of `placed` its layers meet.

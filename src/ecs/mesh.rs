@@ -198,18 +198,15 @@ fn write_meshes(world: &mut World, mut state: Local<Option<SystemState<Drawing>>
     let side_by_side =
         solver::threads() > 1 && cloths.iter().filter(|(sim, _, v, _)| due(sim, *v)).count() > 1;
     if side_by_side {
-        let work: Vec<_> = cloths
+        let work = cloths
             .iter_mut()
             .filter(|(sim, _, visibility, _)| due(sim, *visibility))
             .map(|(sim, _, _, proxy)| {
                 let n = proxy.as_ref().map_or(0, |p| p.len()) + sim.solver.particle_count();
                 (n as u64, (sim, proxy))
-            })
-            .collect();
-        solver::in_lots(work, |lot| {
-            for (mut sim, mut proxy) in lot {
-                prepare(&mut sim, proxy.as_deref_mut(), blend, t);
-            }
+            });
+        solver::share_items(work, |(mut sim, mut proxy)| {
+            prepare(&mut sim, proxy.as_deref_mut(), blend, t);
         });
     }
     // Then into the meshes, one after another (the assets are one resource).

@@ -336,7 +336,7 @@ fn move_bodies(
     let bodies = cloths
         .iter_mut()
         .map(|c| (c.1.solver.particle_count() as u64, c));
-    crate::solver::each_in_lots(bodies, |(entity, mut sim, mut body)| {
+    crate::solver::share_items(bodies, |(entity, mut sim, mut body)| {
         move_body(entity, &mut sim, &mut body, transforms, inverse);
     });
 }

@@ -154,7 +154,7 @@ fn blow(
         .iter_mut()
         .filter(|sim| !placed.is_empty() || !sim.solver.wind_zones().is_empty())
         .map(|sim| (sim.solver.particle_count() as u64, sim));
-    crate::solver::each_in_lots(blown, |mut sim| {
+    crate::solver::share_items(blown, |mut sim| {
         sim.solver
             .set_wind_zones(placed, now)
             .expect("every zone checked");

@@ -8,7 +8,7 @@
 //! pool.
 
 use super::ClothSolver;
-use super::parallel::in_lots;
+use super::parallel::share_items;
 use super::self_contact::refresh;
 use crate::params::Environment;
 
@@ -22,15 +22,12 @@ pub fn begin_cloths(cloths: &mut [(&mut ClothSolver, bool)], dt: f32) {
     // state and substeps) is its own: side by side, as the substeps are. Planned one
     // after another, they were an eighth of a crowd's step on two cores.
     if super::threads() > 1 && cloths.iter().filter(|c| alone(c)).count() > 1 {
-        let lots = cloths
+        let plans = cloths
             .iter_mut()
             .filter(|c| alone(c))
-            .map(|(cloth, _)| (cloth.particle_count() as u64, &mut **cloth))
-            .collect();
-        in_lots(lots, |lot| {
-            for cloth in lot {
-                cloth.begin_step(dt);
-            }
+            .map(|(cloth, _)| (cloth.particle_count() as u64, &mut **cloth));
+        share_items(plans, |cloth| {
+            cloth.begin_step(dt);
         });
     } else {
         for (cloth, _) in cloths.iter_mut().filter(|c| alone(c)) {
@@ -49,11 +46,11 @@ pub fn begin_cloths(cloths: &mut [(&mut ClothSolver, bool)], dt: f32) {
 
 /// Takes the substeps each cloth has left in its step (begun by [`begin_cloths`]): those
 /// in contact with others together ([`substep_together`]), every other cloth alone, the
-/// work shared among the threads in balanced lots (the largest first, each to the
-/// least loaded, by particles × substeps): one lot a task on the compute pool (the
-/// calling thread working beside its threads), each lot's cloths one after another.
-/// With 20 small cloths one task per cloth left the two cores at 1.15× one; one lot per
-/// thread, 1.8×.
+/// work shared among the threads (`share_items`: the largest first by particles ×
+/// substeps, each thread taking the next cloth when done with its last): one task a
+/// thread on the compute pool (the calling thread working beside its threads). With 20
+/// small cloths one task per cloth left the two cores at 1.15× one; one task a thread,
+/// 1.8×.
 /// One thread ([`set_parallel`](super::set_parallel)`(false)`) runs them all here, those
 /// in contact last.
 pub fn run_cloths(cloths: &mut [&mut ClothSolver], env: &Environment) {
@@ -84,7 +81,7 @@ pub fn run_cloths(cloths: &mut [&mut ClothSolver], env: &Environment) {
         let w = touching.iter().map(|c| work(c, left(c))).sum();
         units.push((w, Unit::Together(touching)));
     }
-    in_lots(units, |lot| run_lot(lot, env));
+    share_items(units.into_iter(), |unit| run_unit(unit, env));
 }
 
 /// What one cloth (or the cloths in contact, together) has left of its step, as work.
@@ -98,17 +95,15 @@ fn work(cloth: &ClothSolver, n: u32) -> u64 {
     cloth.particle_count() as u64 * n as u64
 }
 
-/// Runs each unit's substeps in turn.
-fn run_lot(lot: Vec<Unit>, env: &Environment) {
-    for unit in lot {
-        match unit {
-            Unit::Alone(cloth, n) => {
-                for _ in 0..n {
-                    cloth.substep(env);
-                }
+/// Runs a unit's substeps.
+fn run_unit(unit: Unit, env: &Environment) {
+    match unit {
+        Unit::Alone(cloth, n) => {
+            for _ in 0..n {
+                cloth.substep(env);
             }
-            Unit::Together(mut cloths) => substep_together(&mut cloths, env),
         }
+        Unit::Together(mut cloths) => substep_together(&mut cloths, env),
     }
 }
 

@@ -45,12 +45,11 @@ pub use many::{begin_cloths, run_cloths};
 pub use many::{begin_together, substep_together};
 pub use models::{patches, shape_matching};
 pub(crate) use parallel::for_each_indexed;
-pub(crate) use parallel::{each_in_lots, in_lots};
 pub use parallel::{set_parallel, threads};
 pub use proxy::ProxyBinding;
 // Used by the lab through `crate::lab`: hidden from the docs.
 #[doc(hidden)]
-pub use parallel::pool as task_pool;
+pub use parallel::{pool as task_pool, share_items};
 pub use self_contact::{collide_cloths, exchange_cloths};
 pub use state::Particles;
 pub use steps::{StageTimes, StepReport};
