@@ -443,9 +443,11 @@ impl Crowd {
         solver::begin_cloths(&mut flagged, dt);
         drop(flagged);
         solver::run_cloths(&mut cloths, &self.env);
-        for cloth in cloths.iter_mut() {
+        // Each cloth's end of step side by side too, as the plugin's `finish_steps`.
+        let each = cloths.iter_mut().map(|c| (c.particle_count() as u64, c));
+        solver::share_items(each, |cloth| {
             cloth.end_step();
-        }
+        });
     }
 
     /// Moves every body to its pose at time `t` (a step of `dt`), character `jumper`

@@ -297,12 +297,20 @@ pub(crate) fn finish_steps(
         Without<ClothInvalid>,
     >,
 ) {
-    for (entity, mut sim, progress, stats) in &mut cloths {
-        if progress.substeps == 0 {
-            continue;
-        }
+    // Each cloth's end of step (its finiteness check, checkpoint and tears) is its own:
+    // side by side over the pool, as its substeps were; then what it tells the app, one
+    // cloth after another (commands and messages are one resource).
+    let mut ended: Vec<_> = cloths
+        .iter_mut()
+        .filter(|(_, _, progress, _)| progress.substeps > 0)
+        .map(|(entity, sim, _, stats)| (entity, sim, stats, solver::StepReport::default()))
+        .collect();
+    let each = ended
+        .iter_mut()
+        .map(|e| (e.1.solver.particle_count() as u64, e));
+    solver::share_items(each, |(_, sim, _, report)| *report = sim.solver.end_step());
+    for (entity, mut sim, stats, report) in ended {
         let sim = &mut *sim;
-        let report = sim.solver.end_step();
         let start = Instant::now();
         if !report.finite {
             let error = ClothError::NonFinite {
