@@ -163,8 +163,8 @@ pub fn share_items<T: Send>(items: impl Iterator<Item = (u64, T)>, run: impl Fn(
     });
 }
 
-/// The next item of `queue`, the lock held only while it is taken (a panic in another
-/// thread's item does not stop this one's).
+/// The next item of `queue`, the lock held only while it is taken (never while an
+/// item runs, so no item's panic can poison it; taken over anyway if one did).
 fn take_next<T>(queue: &Mutex<impl Iterator<Item = T>>) -> Option<T> {
     queue.lock().unwrap_or_else(PoisonError::into_inner).next()
 }
