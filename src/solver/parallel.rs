@@ -150,10 +150,11 @@ pub fn share_items<T: Send>(items: impl Iterator<Item = (u64, T)>, run: impl Fn(
         return;
     }
     items.sort_by_key(|(w, _)| std::cmp::Reverse(*w));
+    let tasks = threads.min(items.len());
     let queue = Mutex::new(items.into_iter().map(|(_, item)| item));
     let (run, queue) = (&run, &queue);
     pool().scope(|scope| {
-        for _ in 0..threads.min(queue_len(queue)) {
+        for _ in 0..tasks {
             scope.spawn(async move {
                 while let Some(item) = take_next(queue) {
                     run(item);
@@ -167,9 +168,4 @@ pub fn share_items<T: Send>(items: impl Iterator<Item = (u64, T)>, run: impl Fn(
 /// item runs, so no item's panic can poison it; taken over anyway if one did).
 fn take_next<T>(queue: &Mutex<impl Iterator<Item = T>>) -> Option<T> {
     queue.lock().unwrap_or_else(PoisonError::into_inner).next()
-}
-
-/// How many items `queue` holds.
-fn queue_len<T>(queue: &Mutex<impl ExactSizeIterator<Item = T>>) -> usize {
-    queue.lock().unwrap_or_else(PoisonError::into_inner).len()
 }
