@@ -21,19 +21,13 @@ pub fn begin_cloths(cloths: &mut [(&mut ClothSolver, bool)], dt: f32) {
     // Each cloth's plan (its drivers, teleports, the wind at its particles, its model's
     // state and substeps) is its own: side by side, as the substeps are. Planned one
     // after another, they were an eighth of a crowd's step on two cores.
-    if super::threads() > 1 && cloths.iter().filter(|c| alone(c)).count() > 1 {
-        let plans = cloths
-            .iter_mut()
-            .filter(|c| alone(c))
-            .map(|(cloth, _)| (cloth.particle_count() as u64, &mut **cloth));
-        share_items(plans, |cloth| {
-            cloth.begin_step(dt);
-        });
-    } else {
-        for (cloth, _) in cloths.iter_mut().filter(|c| alone(c)) {
-            cloth.begin_step(dt);
-        }
-    }
+    let plans = cloths
+        .iter_mut()
+        .filter(|c| alone(c))
+        .map(|(cloth, _)| (cloth.particle_count() as u64, &mut **cloth));
+    share_items(plans, |cloth| {
+        cloth.begin_step(dt);
+    });
     let mut touching: Vec<&mut ClothSolver> = cloths
         .iter_mut()
         .filter(|(cloth, steps)| *steps && cloth.touches_other_cloths())

@@ -124,9 +124,6 @@ impl MotionConstraints {
     /// cross, and there this one keeps the particle out of the body).
     pub fn hold(&self, p: &mut Particles, t: f32, h: f32) {
         let n = self.radius.len();
-        if n == 0 {
-            return;
-        }
         // Every array sliced to the constraints' length once, so that the loop indexes
         // without a bounds check a particle (this runs every substep on every particle
         // of a skinned cloth).
