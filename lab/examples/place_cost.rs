@@ -1,8 +1,9 @@
-//! What placing a proxy's render vertices costs, alone: 100 cloths of 16 × 24 particles
+//! What drawing a proxy costs, in its two parts, alone: 100 cloths of 16 × 24 particles
 //! (the crowd's capes), each drawn through a grid 3 × 3 times finer (3,196 vertices, 8.3
-//! times the particles), crumpled differently every round. Each round places every
-//! cloth's vertices once (`ProxyBinding::place`, no tangents, as the crowd draws); the
-//! median and least of 200 rounds after 20, ms a round, and ns a vertex.
+//! times the particles), crumpled differently every round. Each round works out every
+//! cloth's smooth normals (`ClothSolver::normals_into`), then places its vertices on
+//! them (`ProxyBinding::place`, no tangents, as the crowd draws); the median and least
+//! of 200 rounds after 20 of each part, ms a round, and ns a particle or a vertex.
 //!
 //! `cargo run -p bevy_cloth_lab --example place_cost`
 
@@ -51,7 +52,8 @@ fn main() {
         .normalize();
     let m = fine.len();
     let (mut positions, mut normals) = (vec![[0.0f32; 3]; m], vec![[0.0f32; 3]; m]);
-    let mut times = Vec::new();
+    let (mut times, mut normal_times) = (Vec::new(), Vec::new());
+    let mut smooth = vec![Vec3::ZERO; rest.len()];
     for round in 0..220 {
         let phase = round as f32 * 0.1;
         let bend = |v: usize| {
@@ -65,6 +67,14 @@ fn main() {
             .map(|v| (out + 0.3 * bend(v) * (rest[1] - rest[0]).normalize()).normalize())
             .collect();
         let start = Instant::now();
+        for _ in 0..cloths.len() {
+            cape.normals_into(&mut smooth);
+            std::hint::black_box(&mut smooth);
+        }
+        if round >= 20 {
+            normal_times.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        let start = Instant::now();
         for binding in &mut cloths {
             binding.place(&x, &n, &mut positions, &mut normals, None);
         }
@@ -73,6 +83,13 @@ fn main() {
         }
         std::hint::black_box(&positions);
     }
+    normal_times.sort_by(f64::total_cmp);
+    let (median, least) = (normal_times[normal_times.len() / 2], normal_times[0]);
+    let particles = (rest.len() * cloths.len()) as f64;
+    println!(
+        "normals of {particles} particles: median {median:.3} ms (least {least:.3}), {:.2} ns a particle",
+        median * 1e6 / particles
+    );
     times.sort_by(f64::total_cmp);
     let (median, least) = (times[times.len() / 2], times[0]);
     let vertices = (m * cloths.len()) as f64;

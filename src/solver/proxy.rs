@@ -7,6 +7,8 @@
 
 use bevy::math::{Vec3, Vec3A, Vec4};
 
+use super::unit::{BATCH, all_scale, length_recips, scaled_or};
+
 /// One render vertex's place on the simulation mesh: 16 bytes, all that placing reads
 /// of it (the vertices are the most numerous thing drawn, so their bytes are most of
 /// what placing reads from memory).
@@ -330,9 +332,9 @@ impl ProxyBinding {
     /// along the triangle's normal (what [`place`](Self::place) writes, to the bit).
     pub fn point(&self, x: &[Vec3], v: usize) -> Vec3 {
         let b = &self.bound[v];
-        Face::of(x, self.triangles[b.triangle as usize], &[], Vec3A::ZERO)
-            .point(b.weights, b.height)
-            .into()
+        let mut face = Face::of(x, self.triangles[b.triangle as usize], &[]);
+        face.normal = face.normal.normalize_or(Vec3A::ZERO);
+        face.point(b.weights, b.height).into()
     }
 
     /// Places every render vertex over the simulation's positions `x` (and its smooth
@@ -340,10 +342,11 @@ impl ProxyBinding {
     /// normal, its normal the blend of its corners' by its weights, its tangent turned
     /// with its triangle and made square to that normal. `tangents` is written only when
     /// given. Each triangle is worked out once (its first corner, edges, normal and
-    /// corners' normals, in four-lane vectors), then the vertices a batch at a time: a batch's normalisations (a square root and a
-    /// division each) side by side, which the compiler issues as vector instructions,
-    /// where one vertex after another waited on each one's in turn (they were two fifths
-    /// of placing).
+    /// corners' normals, in four-lane vectors), then the vertices a batch at a time.
+    /// Triangles' and vertices' normals are made unit a batch at a time, their square
+    /// roots and divisions side by side (one vertex after another waited on each one's
+    /// in turn: they were two fifths of placing), and a batch whose blends all have a
+    /// length is scaled without a test a vertex.
     pub fn place(
         &mut self,
         x: &[Vec3],
@@ -354,17 +357,30 @@ impl ProxyBinding {
     ) {
         FACES.with_borrow_mut(|faces| {
             faces.clear();
-            faces.extend(
-                self.triangles
-                    .iter()
-                    .zip(&mut self.last_normals)
-                    .map(|(&t, last)| {
-                        // A triangle of no area this frame keeps its last normal (and frame).
-                        let face = Face::of(x, t, normals, *last);
+            faces.extend(self.triangles.iter().map(|&t| Face::of(x, t, normals)));
+            // Each face's normal made unit a batch at a time; a triangle of no area this
+            // frame keeps its last normal (and frame).
+            for (faces, last) in faces
+                .chunks_mut(BATCH)
+                .zip(self.last_normals.chunks_mut(BATCH))
+            {
+                let mut squared = [0.0; BATCH];
+                for (s, face) in squared.iter_mut().zip(faces.iter()) {
+                    *s = face.normal.dot(face.normal);
+                }
+                let rcp = length_recips(squared);
+                if all_scale(&rcp) {
+                    for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
+                        face.normal *= r;
                         *last = face.normal;
-                        face
-                    }),
-            );
+                    }
+                } else {
+                    for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
+                        face.normal = scaled_or(face.normal, r, *last);
+                        *last = face.normal;
+                    }
+                }
+            }
             self.place_on(faces, x, positions, out_normals, tangents);
         });
     }
@@ -393,18 +409,26 @@ impl ProxyBinding {
                 *out = Vec3::from(face.point(b.weights, b.height)).to_array();
                 *blend = face.blend(b.weights);
             }
-            let rcp = length_recips(&blend);
-            let mut smooth = [Vec3A::ZERO; BATCH];
-            for (k, (b, out)) in batch.iter().zip(out_normals).enumerate() {
-                // Looked up again: kept from the loop above in an array of the batch's
-                // normals, drawing measured 5% slower (`cloth crowd`).
-                let normal = faces[b.triangle as usize].normal;
-                smooth[k] = scaled_or(blend[k], rcp[k], normal);
-                *out = Vec3::from(smooth[k]).to_array();
+            // The blends made unit in place: the drawn normals.
+            let rcp = length_recips(squared_lengths(&blend));
+            if all_scale(&rcp) {
+                for ((smooth, out), r) in blend.iter_mut().zip(out_normals).zip(rcp) {
+                    *smooth *= r;
+                    *out = Vec3::from(*smooth).to_array();
+                }
+            } else {
+                // A blend of no length (corners' normals that cancel) takes its
+                // triangle's normal; so does the batch's tail past the last vertex.
+                for (((b, smooth), out), r) in
+                    batch.iter().zip(&mut blend).zip(out_normals).zip(rcp)
+                {
+                    *smooth = scaled_or(*smooth, r, faces[b.triangle as usize].normal);
+                    *out = Vec3::from(*smooth).to_array();
+                }
             }
             if let Some(tangents) = tangents.as_deref_mut() {
                 let tangents = &mut tangents[first..first + batch.len()];
-                self.turn_tangents(faces, (first, batch), &smooth, tangents);
+                self.turn_tangents(faces, (first, batch), &blend, tangents);
             }
         }
     }
@@ -429,7 +453,7 @@ impl ProxyBinding {
             let turned = t.x * along + t.y * across + t.z * normal;
             square[k] = turned - turned.dot(smooth[k]) * smooth[k];
         }
-        let rcp = length_recips(&square);
+        let rcp = length_recips(squared_lengths(&square));
         for (k, (b, out)) in batch.iter().zip(out).enumerate() {
             let along = self.frames[b.triangle as usize].0.into();
             *out = Vec3::from(scaled_or(square[k], rcp[k], along))
@@ -440,10 +464,11 @@ impl ProxyBinding {
 }
 
 impl Face {
-    /// Triangle `[a, b, c]` over `x` with its corners' `normals` (none: zero), and
-    /// `fallback` for its normal if it has no area (the same bits as [`frame`]'s).
+    /// Triangle `[a, b, c]` over `x` with its corners' `normals` (none: zero), its
+    /// `normal` not yet unit: the cross product of its edges, twice its area (made unit
+    /// with the same bits as [`frame`]'s).
     #[inline(always)]
-    fn of(x: &[Vec3], [a, b, c]: [u32; 3], normals: &[Vec3], fallback: Vec3A) -> Face {
+    fn of(x: &[Vec3], [a, b, c]: [u32; 3], normals: &[Vec3]) -> Face {
         let [a, b, c] = [a, b, c].map(|i| i as usize);
         let origin = Vec3A::from(x[a]);
         let edges = [Vec3A::from(x[b]) - origin, Vec3A::from(x[c]) - origin];
@@ -452,7 +477,7 @@ impl Face {
         Face {
             origin,
             edges,
-            normal: edges[0].cross(edges[1]).try_normalize().unwrap_or(fallback),
+            normal: edges[0].cross(edges[1]),
             normals: [n0, corner(b) - n0, corner(c) - n0],
         }
     }
@@ -466,32 +491,14 @@ thread_local! {
     static FACES: std::cell::RefCell<Vec<Face>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// Render vertices placed together by [`ProxyBinding::place`].
-const BATCH: usize = 8;
-
-/// `1 / |v|` of each of `v`, as glam's `length_recip` (the same bits), side by side.
+/// The squared length of each of `v`.
 #[inline(always)]
-fn length_recips(v: &[Vec3A; BATCH]) -> [f32; BATCH] {
+fn squared_lengths(v: &[Vec3A; BATCH]) -> [f32; BATCH] {
     let mut squared = [0.0; BATCH];
     for (s, v) in squared.iter_mut().zip(v) {
         *s = v.dot(*v);
     }
-    let mut rcp = [0.0; BATCH];
-    for (r, s) in rcp.iter_mut().zip(squared) {
-        *r = 1.0 / s.sqrt();
-    }
-    rcp
-}
-
-/// `v` scaled by its `rcp` (`1 / |v|`), or `fallback` when it has no length: glam's
-/// `normalize_or`, with the reciprocal worked out beforehand.
-#[inline(always)]
-fn scaled_or(v: Vec3A, rcp: f32, fallback: Vec3A) -> Vec3A {
-    if rcp.is_finite() && rcp > 0.0 {
-        v * rcp
-    } else {
-        fallback
-    }
+    squared
 }
 
 #[cfg(test)]
@@ -615,6 +622,50 @@ mod tests {
         let (along, _, normal) = frame(&x, corners).unwrap();
         assert_eq!(out_n[1], normal.to_array());
         assert_eq!(Vec3::from_slice(&out_t[1][..3]), along);
+    }
+
+    /// A triangle pressed flat keeps the normal it had when last placed, and its vertices
+    /// stand off it along that normal; the triangles made unit in its batch, and in the
+    /// whole batches beside it, get their own normals (the bits of [`frame`]'s).
+    #[test]
+    fn a_flattened_triangle_keeps_its_last_normal() {
+        let (w, h) = (5u32, 4u32);
+        let (rest, triangles) = sheet(w, h, 0.02);
+        // A vertex above each triangle's centre: 24 triangles in use, three batches.
+        let render: Vec<Vec3> = triangles
+            .iter()
+            .map(|t| t.iter().map(|&i| rest[i as usize]).sum::<Vec3>() / 3.0 + 0.01 * Vec3::Z)
+            .collect();
+        let mut binding = ProxyBinding::bind(&rest, &triangles, &render, None).unwrap();
+        assert_eq!(binding.triangles.len(), 24);
+        let n = render.len();
+        let (mut out, mut out_n) = (vec![[0.0; 3]; n], vec![[0.0; 3]; n]);
+        let normals = vec![Vec3::Z; rest.len()];
+        binding.place(&rest, &normals, &mut out, &mut out_n, None);
+        // Corners 7, 8 and 13 pressed to one point: the triangles with two or three of
+        // them have no area.
+        let mut x = sheet(w, h, 0.05).0;
+        let p = Vec3::new(0.25, 0.15, 0.03);
+        for i in [7, 8, 13] {
+            x[i] = p;
+        }
+        binding.place(&x, &normals, &mut out, &mut out_n, None);
+        let mut flat = 0;
+        for (v, b) in binding.bound.iter().enumerate() {
+            let corners = binding.triangles[b.triangle as usize];
+            let normal = match frame(&x, corners) {
+                Some((_, _, normal)) => normal,
+                None => {
+                    flat += 1;
+                    frame(&rest, corners).unwrap().2
+                }
+            };
+            let [i, j, k] = corners.map(|i| x[i as usize]);
+            let [s, t] = b.weights;
+            let on = i + s * (j - i) + t * (k - i);
+            assert_eq!(out[v], (on + b.height * normal).to_array(), "{v}");
+        }
+        assert!(flat >= 2, "{flat} flattened");
     }
 
     /// The search ring by ring through the cells finds the triangle a search over every

@@ -150,9 +150,7 @@ impl ClothSolver {
         // increasing triangle order: the same sums, to the bit.
         if parallel::on_this_thread(parallel::PARALLEL_FROM, out.len()) {
             self.structure.normal_sums_into(x, out);
-            for n in out.iter_mut() {
-                *n = n.normalize_or(Vec3::Z);
-            }
+            super::unit::normalize_each_or(out, Vec3::Z);
             return;
         }
         parallel::for_each_indexed(out, |i, n| {

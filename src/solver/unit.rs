@@ -1,0 +1,108 @@
+//! Vectors made unit a batch at a time, to the bit as glam's `normalize_or` makes them
+//! one by one. One by one, each vector's square root and division wait on the one
+//! before's in the processor's single divider; a batch's squared lengths side by side
+//! become vector square roots and divisions, and a batch whose vectors all have a length
+//! (all but never, for drawn normals) is scaled without a test a vector.
+
+use std::ops::Mul;
+
+use bevy::math::{Vec3, Vec4};
+
+/// Vectors made unit together.
+pub(crate) const BATCH: usize = 8;
+const _: () = assert!(BATCH == 8, "all_scale tests two vectors of four");
+
+/// `1 / √s` of each squared length `s`, as glam's `length_recip` works it out from
+/// `length_squared` (the same bits), side by side.
+#[inline(always)]
+pub(crate) fn length_recips(squared: [f32; BATCH]) -> [f32; BATCH] {
+    let mut rcp = [0.0; BATCH];
+    for (r, s) in rcp.iter_mut().zip(squared) {
+        *r = 1.0 / s.sqrt();
+    }
+    rcp
+}
+
+/// Whether every one of `rcp` scales its vector to a unit one, finite and above zero,
+/// where glam's `normalize_or` would not take its fallback (a zero vector's is infinite,
+/// an infinite or not-a-number one's zero or not a number). Tested all at once, without
+/// a branch a vector.
+#[inline(always)]
+pub(crate) fn all_scale(rcp: &[f32; BATCH]) -> bool {
+    // Four at a time in glam's vectors: written lane by lane, the compiler tested each
+    // float's bits in integer registers and branched on each.
+    let scales = |r: Vec4| (r.cmpgt(Vec4::ZERO) & r.cmplt(Vec4::INFINITY)).all();
+    let (low, high) = rcp.split_at(4);
+    scales(Vec4::from_slice(low)) & scales(Vec4::from_slice(high))
+}
+
+/// `v` scaled by its `rcp` (`1 / |v|`), or `fallback` when it has no length: glam's
+/// `normalize_or`, with the reciprocal worked out beforehand.
+#[inline(always)]
+pub(crate) fn scaled_or<V: Mul<f32, Output = V>>(v: V, rcp: f32, fallback: V) -> V {
+    if rcp.is_finite() && rcp > 0.0 {
+        v * rcp
+    } else {
+        fallback
+    }
+}
+
+/// Each of `v` made unit, or `fallback` where it has no length: `normalize_or` on each,
+/// to the bit, a batch at a time.
+pub(crate) fn normalize_each_or(v: &mut [Vec3], fallback: Vec3) {
+    let mut batches = v.chunks_exact_mut(BATCH);
+    for batch in &mut batches {
+        let mut squared = [0.0; BATCH];
+        for (s, v) in squared.iter_mut().zip(batch.iter()) {
+            *s = v.length_squared();
+        }
+        let rcp = length_recips(squared);
+        if all_scale(&rcp) {
+            for (v, r) in batch.iter_mut().zip(rcp) {
+                *v *= r;
+            }
+        } else {
+            for (v, r) in batch.iter_mut().zip(rcp) {
+                *v = scaled_or(*v, r, fallback);
+            }
+        }
+    }
+    for v in batches.into_remainder() {
+        *v = v.normalize_or(fallback);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A batch at a time is glam's `normalize_or` one by one, to the bit: for vectors of
+    /// every size, of no length, infinite and not a number, in whole batches and a
+    /// remainder, in batches all of length and batches with one of none.
+    #[test]
+    fn normalized_in_batches_as_one_by_one() {
+        let fallback = Vec3::new(0.0, 0.0, 1.0);
+        let mut v: Vec<Vec3> = (0..53)
+            .map(|k| {
+                let f = k as f32;
+                let scale = 10f32.powi(k % 13 - 6);
+                scale * Vec3::new((0.7 * f).sin(), (1.3 * f).cos(), 0.1 * f - 2.0)
+            })
+            .collect();
+        v[9] = Vec3::ZERO;
+        v[20] = Vec3::new(f32::INFINITY, 1.0, 0.0);
+        v[31] = Vec3::new(f32::NAN, 0.0, 0.0);
+        v[50] = Vec3::ZERO;
+        let want: Vec<Vec3> = v.iter().map(|v| v.normalize_or(fallback)).collect();
+        normalize_each_or(&mut v, fallback);
+        for (k, (got, want)) in v.iter().zip(&want).enumerate() {
+            assert_eq!(
+                got.to_array().map(f32::to_bits),
+                want.to_array().map(f32::to_bits),
+                "{k}"
+            );
+        }
+        assert_eq!(v[9], fallback);
+        assert_eq!(v[31], fallback);
+    }
+}
