@@ -278,8 +278,9 @@ pub(crate) fn place_proxy(
         *out = to_local.transform_point3(p);
     }
     for (out, n) in local_normals.iter_mut().zip(normals) {
-        *out = to_local.transform_vector3(*n).normalize_or(Vec3::Z);
+        *out = to_local.transform_vector3(*n);
     }
+    crate::solver::unit::normalize_each_or(local_normals, Vec3::Z);
     binding.place(
         local,
         local_normals,

@@ -28,7 +28,7 @@ mod steps;
 mod structure;
 mod substeps;
 pub mod topology;
-mod unit;
+pub(crate) mod unit;
 
 // The rooms' modules the other stages name.
 use constraints::{bending, chains, lattice, tethers, xpbd};

@@ -177,9 +177,7 @@ impl MotionConstraints {
         }
         self.normal_next.resize(self.next.len(), Vec3::ZERO);
         structure.normal_sums_into(&self.next, &mut self.normal_next);
-        for n in &mut self.normal_next {
-            *n = n.normalize_or_zero();
-        }
+        super::unit::normalize_each_or(&mut self.normal_next, Vec3::ZERO);
     }
 }
 
