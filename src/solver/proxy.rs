@@ -332,7 +332,8 @@ impl ProxyBinding {
     /// along the triangle's normal (what [`place`](Self::place) writes, to the bit).
     pub fn point(&self, x: &[Vec3], v: usize) -> Vec3 {
         let b = &self.bound[v];
-        let mut face = Face::of(x, self.triangles[b.triangle as usize], &[]);
+        let corner = |i: u32| [x[i as usize].into(), Vec3A::ZERO];
+        let mut face = Face::of(self.triangles[b.triangle as usize].map(corner));
         face.normal = face.normal.normalize_or(Vec3A::ZERO);
         face.point(b.weights, b.height).into()
     }
@@ -356,32 +357,46 @@ impl ProxyBinding {
         tangents: Option<&mut [[f32; 4]]>,
     ) {
         FACES.with_borrow_mut(|faces| {
-            faces.clear();
-            faces.extend(self.triangles.iter().map(|&t| Face::of(x, t, normals)));
-            // Each face's normal made unit a batch at a time; a triangle of no area this
-            // frame keeps its last normal (and frame).
-            for (faces, last) in faces
-                .chunks_mut(BATCH)
-                .zip(self.last_normals.chunks_mut(BATCH))
-            {
-                let mut squared = [0.0; BATCH];
-                for (s, face) in squared.iter_mut().zip(faces.iter()) {
-                    *s = face.normal.dot(face.normal);
-                }
-                let rcp = length_recips(squared);
-                if all_scale(&rcp) {
-                    for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
-                        face.normal *= r;
-                        *last = face.normal;
+            CORNERS.with_borrow_mut(|corners| {
+                // Each particle's position and normal in four-lane vectors once, where each
+                // of its six or so triangles converted them again.
+                corners.clear();
+                let normals = normals
+                    .iter()
+                    .map(|&n| n.into())
+                    .chain(std::iter::repeat(Vec3A::ZERO));
+                corners.extend(x.iter().zip(normals).map(|(&p, n)| [p.into(), n]));
+                faces.clear();
+                faces.extend(
+                    self.triangles
+                        .iter()
+                        .map(|t| Face::of(t.map(|i| corners[i as usize]))),
+                );
+                // Each face's normal made unit a batch at a time; a triangle of no area this
+                // frame keeps its last normal (and frame).
+                for (faces, last) in faces
+                    .chunks_mut(BATCH)
+                    .zip(self.last_normals.chunks_mut(BATCH))
+                {
+                    let mut squared = [0.0; BATCH];
+                    for (s, face) in squared.iter_mut().zip(faces.iter()) {
+                        *s = face.normal.dot(face.normal);
                     }
-                } else {
-                    for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
-                        face.normal = scaled_or(face.normal, r, *last);
-                        *last = face.normal;
+                    let rcp = length_recips(squared);
+                    if all_scale(&rcp) {
+                        for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
+                            face.normal *= r;
+                            *last = face.normal;
+                        }
+                    } else {
+                        for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
+                            face.normal = scaled_or(face.normal, r, *last);
+                            *last = face.normal;
+                        }
                     }
                 }
-            }
-            self.place_on(faces, x, positions, out_normals, tangents);
+                self.place_on(faces, x, positions, out_normals, tangents);
+            })
         });
     }
 
@@ -464,21 +479,17 @@ impl ProxyBinding {
 }
 
 impl Face {
-    /// Triangle `[a, b, c]` over `x` with its corners' `normals` (none: zero), its
-    /// `normal` not yet unit: the cross product of its edges, twice its area (made unit
-    /// with the same bits as [`frame`]'s).
+    /// The triangle of three corners (each its position and normal), its `normal` not
+    /// yet unit: the cross product of its edges, twice its area (made unit with the same
+    /// bits as [`frame`]'s).
     #[inline(always)]
-    fn of(x: &[Vec3], [a, b, c]: [u32; 3], normals: &[Vec3]) -> Face {
-        let [a, b, c] = [a, b, c].map(|i| i as usize);
-        let origin = Vec3A::from(x[a]);
-        let edges = [Vec3A::from(x[b]) - origin, Vec3A::from(x[c]) - origin];
-        let corner = |i: usize| normals.get(i).map_or(Vec3A::ZERO, |&n| n.into());
-        let n0 = corner(a);
+    fn of([[a, na], [b, nb], [c, nc]]: [[Vec3A; 2]; 3]) -> Face {
+        let edges = [b - a, c - a];
         Face {
-            origin,
+            origin: a,
             edges,
             normal: edges[0].cross(edges[1]),
-            normals: [n0, corner(b) - n0, corner(c) - n0],
+            normals: [na, nb - na, nc - na],
         }
     }
 }
@@ -489,6 +500,8 @@ thread_local! {
     /// (112 bytes a triangle, 8 MB for the crowd's hundred cloths) was read back from
     /// memory every frame only to be overwritten.
     static FACES: std::cell::RefCell<Vec<Face>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// And its particles' positions and normals, in four-lane vectors.
+    static CORNERS: std::cell::RefCell<Vec<[Vec3A; 2]>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// The squared length of each of `v`.
