@@ -6,7 +6,8 @@
 //! on the cloth (driving the bodies' pins, targets, colliders and wind; the cloths'
 //! step; drawing: normals and the proxies' vertices), on one thread and on the pool.
 
-use std::time::Instant;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 use bevy::math::{Affine3A, Quat, Vec3};
 use serde::Serialize;
@@ -111,9 +112,10 @@ impl Drawn {
     }
 
     /// What a game's write-back does: the normals, and each drawn vertex placed (the
-    /// example's meshes have no tangents).
-    fn draw(&mut self) {
+    /// example's meshes have no tangents). How long placing took.
+    fn draw(&mut self) -> Duration {
         self.cloth.normals_into(&mut self.normals);
+        let start = Instant::now();
         self.local.copy_from_slice(self.cloth.positions());
         self.binding.place(
             &self.local,
@@ -122,6 +124,7 @@ impl Drawn {
             &mut self.drawn_normals,
             None,
         );
+        start.elapsed()
     }
 }
 
@@ -177,6 +180,9 @@ pub struct FrameCost {
     pub step: f64,
     /// Drawing: normals and every proxy vertex placed.
     pub draw: f64,
+    /// Of the drawing, placing the proxies' vertices: each cloth's placing timed and
+    /// summed (on the pool, over both threads).
+    pub place: f64,
 }
 
 /// The crowd.
@@ -334,9 +340,8 @@ impl Character {
         }
     }
 
-    fn draw(&mut self) {
-        self.cape.draw();
-        self.skirt.draw();
+    fn draw(&mut self) -> Duration {
+        self.cape.draw() + self.skirt.draw()
     }
 }
 
@@ -412,7 +417,7 @@ impl Crowd {
         self.step_cloths(pool);
         let step = start.elapsed();
         let start = Instant::now();
-        self.draw(pool);
+        let place = self.draw(pool);
         let draw = start.elapsed();
         self.time = t;
         let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
@@ -420,6 +425,7 @@ impl Crowd {
             drive: ms(drive),
             step: ms(step),
             draw: ms(draw),
+            place: ms(place),
         }
     }
 
@@ -460,9 +466,15 @@ impl Crowd {
         });
     }
 
-    /// Draws every cloth: on the pool, or one after another here.
-    fn draw(&mut self, pool: bool) {
-        each_character(&mut self.characters, pool, |_, c| c.draw());
+    /// Draws every cloth: on the pool, or one after another here. How long placing the
+    /// proxies' vertices took, summed over the cloths.
+    fn draw(&mut self, pool: bool) -> Duration {
+        let placing = AtomicU64::new(0);
+        each_character(&mut self.characters, pool, |_, c| {
+            let ns = c.draw().as_nanos() as u64;
+            placing.fetch_add(ns, Ordering::Relaxed);
+        });
+        Duration::from_nanos(placing.into_inner())
     }
 
     /// The largest structural strain over every cloth now, and whether every one is
@@ -547,6 +559,8 @@ pub struct PartCosts {
     pub drive: [f64; 3],
     /// Drawing.
     pub draw: [f64; 3],
+    /// Of the drawing, placing the proxies' vertices.
+    pub place: [f64; 3],
 }
 
 fn spread(mut v: Vec<f64>) -> [f64; 3] {
@@ -580,6 +594,7 @@ pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize
         step: spread(c.iter().map(|c| c.step).collect()),
         drive: spread(c.iter().map(|c| c.drive).collect()),
         draw: spread(c.iter().map(|c| c.draw).collect()),
+        place: spread(c.iter().map(|c| c.place).collect()),
     });
     let health = crowds.each_ref().map(|c| c.health());
     let (particles, drawn) = crowds[0].counts();
