@@ -96,10 +96,11 @@ struct Drawn {
 }
 
 impl Drawn {
-    fn new(cloth: ClothSolver, in_body: Vec<Vec3>, fine: &[Vec3]) -> Self {
-        let binding = ProxyBinding::bind(in_body.as_slice(), cloth.triangles(), fine, None)
-            .expect("a cloth with triangles");
-        let (n, m) = (cloth.particle_count(), fine.len());
+    /// `cloth` drawn through a clone of `binding` (what binding worked out is shared by
+    /// every cloth of the shape, as a game's instances of one cape share their asset's).
+    fn new(cloth: ClothSolver, in_body: Vec<Vec3>, binding: &ProxyBinding) -> Self {
+        let binding = binding.clone();
+        let (n, m) = (cloth.particle_count(), binding.len());
         Drawn {
             cloth,
             in_body,
@@ -198,11 +199,11 @@ pub struct Crowd {
 }
 
 /// The rest shapes every character's cloths share: the cape's and the skirt's layouts
-/// (their rest positions in the body's frame), their finer drawn points, and the skirt's
-/// painted distances.
+/// (their rest positions in the body's frame), their finer drawn meshes bound to them,
+/// and the skirt's painted distances.
 struct Shapes {
-    cape: (Layout, Vec<Vec3>),
-    skirt: (Layout, Vec<Vec3>),
+    cape: (Layout, ProxyBinding),
+    skirt: (Layout, ProxyBinding),
     skirt_radius: Vec<f32>,
     cape_top: u32,
 }
@@ -234,12 +235,20 @@ impl Shapes {
         };
         let mut cape_grid = shape.layout().expect("a grid");
         cape_grid.positions = on_back(1);
+        let skirt = Layout::from_mesh(&skirt_rest, &skirt_triangles).expect("a mesh");
+        let bound = |layout: &Layout, fine: &[Vec3]| {
+            ProxyBinding::bind(&layout.positions, &layout.triangles, fine, None)
+                .expect("a cloth with triangles")
+        };
         Shapes {
-            cape: (cape_grid, on_back(size.refine)),
-            skirt: (
-                Layout::from_mesh(&skirt_rest, &skirt_triangles).expect("a mesh"),
-                cone(around, down, size.refine).0,
-            ),
+            cape: {
+                let binding = bound(&cape_grid, &on_back(size.refine));
+                (cape_grid, binding)
+            },
+            skirt: {
+                let binding = bound(&skirt, &cone(around, down, size.refine).0);
+                (skirt, binding)
+            },
             skirt_radius: (0..around * down)
                 .map(|k| 0.2 * ((k / around) as f32 / (down - 1) as f32).powi(2))
                 .collect(),
@@ -262,8 +271,8 @@ impl Character {
         };
         let pose = walk.pose(0.0);
         let frame = Affine3A::from_rotation_translation(pose.0, pose.1);
-        let (cape_layout, cape_fine) = &shapes.cape;
-        let (skirt_layout, skirt_fine) = &shapes.skirt;
+        let (cape_layout, cape_binding) = &shapes.cape;
+        let (skirt_layout, skirt_binding) = &shapes.skirt;
         let (cape_rest, skirt_rest) = (&cape_layout.positions, &skirt_layout.positions);
         let mut cape = solver_of(cape_layout.clone(), params, frame);
         let mut skirt = solver_of(skirt_layout.clone(), params, frame);
@@ -286,8 +295,8 @@ impl Character {
         }
         Character {
             walk,
-            cape: Drawn::new(cape, cape_rest.clone(), cape_fine),
-            skirt: Drawn::new(skirt, skirt_rest.clone(), skirt_fine),
+            cape: Drawn::new(cape, cape_rest.clone(), cape_binding),
+            skirt: Drawn::new(skirt, skirt_rest.clone(), skirt_binding),
             cape_top: shapes.cape_top,
             skirt_radius: shapes.skirt_radius.clone(),
             last_pose: pose,

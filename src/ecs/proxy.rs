@@ -1,5 +1,7 @@
 //! Proxy meshes: a cloth simulated on a coarse mesh drawn with a finer one.
 
+use std::collections::HashMap;
+
 use bevy::mesh::{Mesh, VertexAttributeValues};
 use bevy::prelude::*;
 
@@ -18,8 +20,11 @@ use crate::solver::ProxyBinding;
 /// at rest (its barycentric place and its height along the normal), then moved with it
 /// every frame: positions, normals and tangents written in place (NvCloth's and Chaos
 /// Cloth's skinning of a render mesh to a simulation mesh). The mesh's positions are in
-/// the cloth entity's own frame, as the simulation's rest shape is; the entity's
-/// `Mesh3d` becomes this mesh once it is bound. A mesh that cannot be bound (no
+/// the cloth entity's own frame, as the simulation's rest shape is. Once it is bound the
+/// entity draws its own copy of it (its `Mesh3d` becomes the copy): the mesh itself stays
+/// as it was, so that many cloths may be drawn through one mesh, as a crowd's capes are,
+/// and cloths of one rest shape drawn through one mesh share their binding. A mesh that
+/// cannot be bound (no
 /// positions, a simulation without triangles) is refused: the cloth is paused with
 /// [`ClothError::BadMesh`].
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
@@ -169,7 +174,8 @@ fn carried(mesh: &Mesh, by: Affine3A) -> Mesh {
 #[allow(clippy::type_complexity)]
 fn bind_proxies(
     mut commands: Commands,
-    meshes: Res<Assets<Mesh>>,
+    mut meshes: ResMut<Assets<Mesh>>,
+    mut bound_before: Local<Bindings>,
     mut cloths: Query<
         (
             Entity,
@@ -187,10 +193,15 @@ fn bind_proxies(
         let Some(mesh) = meshes.get(&proxy.mesh) else {
             continue;
         };
-        match bind(mesh, &sim.solver) {
+        match bound_before.bind(proxy.mesh.id(), mesh, &sim.solver) {
             Ok(binding) => {
                 let (n, m) = (sim.solver.particle_count(), binding.len());
                 let tangents = mesh.attribute(Mesh::ATTRIBUTE_TANGENT).is_some();
+                // The cloth's own copy to draw into: the proxy's mesh stays as it was,
+                // for the other cloths drawn through it (a crowd's capes) and to bind
+                // again.
+                let copy = mesh.clone();
+                let drawn = meshes.add(copy);
                 // Drawn on it from the next write, moving or not.
                 sim.mesh_dirty = true;
                 commands.entity(entity).insert((
@@ -204,7 +215,7 @@ fn bind_proxies(
                             tangents: tangents.then(|| vec![[0.0; 4]; m]),
                         },
                     },
-                    Mesh3d(proxy.mesh.clone()),
+                    Mesh3d(drawn),
                 ));
             }
             Err(e) => pause_invalid(&mut commands, entity, e),
@@ -212,23 +223,87 @@ fn bind_proxies(
     }
 }
 
-/// Binds `mesh`'s vertices to `cloth`'s rest triangles.
-fn bind(mesh: &Mesh, cloth: &crate::solver::ClothSolver) -> Result<ProxyBinding, ClothError> {
-    let bad = |reason: &str| ClothError::BadMesh {
+/// The bindings made so far, by their proxy mesh and a fingerprint of what was bound (the
+/// mesh's positions and tangents, the simulation's rest positions and triangles): a cloth
+/// bound as another was shares its binding (what binding worked out is read from memory
+/// once a frame for all of them). Entries no cloth holds any longer are dropped when the
+/// next is made.
+#[derive(Default)]
+struct Bindings(HashMap<(AssetId<Mesh>, u64), ProxyBinding>);
+
+impl Bindings {
+    /// `mesh` (the asset `id`) bound to `cloth`'s rest triangles: a clone of a binding
+    /// made before from the same mesh and rest shape, or bound afresh.
+    fn bind(
+        &mut self,
+        id: AssetId<Mesh>,
+        mesh: &Mesh,
+        cloth: &crate::solver::ClothSolver,
+    ) -> Result<ProxyBinding, ClothError> {
+        let (positions, tangents) = render_vertices(mesh)?;
+        let (rest, triangles) = (cloth.rest_positions(), cloth.triangles());
+        let key = (
+            id,
+            fingerprint(&positions, tangents.as_deref(), rest, triangles),
+        );
+        if let Some(before) = self.0.get(&key)
+            // The fingerprint is a hash: the binding is taken only if it puts every
+            // vertex back where it is.
+            && before.len() == positions.len()
+            && (0..positions.len()).all(|v| before.point(rest, v).distance(positions[v]) < 1e-5)
+        {
+            return Ok(before.clone());
+        }
+        let binding = ProxyBinding::bind(rest, triangles, &positions, tangents.as_deref())
+            .ok_or_else(|| bad_proxy("the simulation has no triangles to bind it to"))?;
+        self.0.retain(|_, kept| kept.sharers() > 1);
+        self.0.insert(key, binding.clone());
+        Ok(binding)
+    }
+}
+
+/// A hash of what a binding is made from.
+fn fingerprint(
+    positions: &[Vec3],
+    tangents: Option<&[Vec4]>,
+    rest: &[Vec3],
+    triangles: &[[u32; 3]],
+) -> u64 {
+    use std::hash::{Hash, Hasher};
+    let mut hasher = std::hash::DefaultHasher::new();
+    let bits = |v: Vec3| v.to_array().map(f32::to_bits);
+    positions.iter().for_each(|&p| bits(p).hash(&mut hasher));
+    tangents.map(<[Vec4]>::len).hash(&mut hasher);
+    for t in tangents.unwrap_or_default() {
+        t.to_array().map(f32::to_bits).hash(&mut hasher);
+    }
+    rest.iter().for_each(|&p| bits(p).hash(&mut hasher));
+    triangles.hash(&mut hasher);
+    hasher.finish()
+}
+
+/// A proxy mesh refused, for `reason`.
+fn bad_proxy(reason: &str) -> ClothError {
+    ClothError::BadMesh {
         reason: format!("proxy mesh: {reason}"),
-    };
+    }
+}
+
+/// `mesh`'s positions and tangents (if it has them), checked: finite positions, and
+/// normals to write.
+fn render_vertices(mesh: &Mesh) -> Result<(Vec<Vec3>, Option<Vec<Vec4>>), ClothError> {
     let positions: Vec<Vec3> = match mesh.attribute(Mesh::ATTRIBUTE_POSITION) {
         Some(VertexAttributeValues::Float32x3(p)) => p.iter().map(|&p| Vec3::from(p)).collect(),
-        _ => return Err(bad("it has no Float32x3 positions")),
+        _ => return Err(bad_proxy("it has no Float32x3 positions")),
     };
     if positions.iter().any(|p| !p.is_finite()) {
-        return Err(bad("a vertex position is not finite"));
+        return Err(bad_proxy("a vertex position is not finite"));
     }
     if !matches!(
         mesh.attribute(Mesh::ATTRIBUTE_NORMAL),
         Some(VertexAttributeValues::Float32x3(n)) if n.len() == positions.len()
     ) {
-        return Err(bad("it has no Float32x3 normals to write"));
+        return Err(bad_proxy("it has no Float32x3 normals to write"));
     }
     let tangents: Option<Vec<Vec4>> = match mesh.attribute(Mesh::ATTRIBUTE_TANGENT) {
         Some(VertexAttributeValues::Float32x4(t)) => {
@@ -236,13 +311,7 @@ fn bind(mesh: &Mesh, cloth: &crate::solver::ClothSolver) -> Result<ProxyBinding,
         }
         _ => None,
     };
-    ProxyBinding::bind(
-        cloth.rest_positions(),
-        cloth.triangles(),
-        &positions,
-        tangents.as_deref(),
-    )
-    .ok_or_else(|| bad("the simulation has no triangles to bind it to"))
+    Ok((positions, tangents))
 }
 
 impl ProxyBound {
@@ -323,6 +392,54 @@ mod tests {
     use super::*;
     use bevy::asset::RenderAssetUsages;
     use bevy::mesh::PrimitiveTopology;
+
+    /// A cloth bound as another was (the same proxy mesh, the same rest shape) shares its
+    /// binding; another mesh, or another rest shape, binds afresh; a binding no cloth holds
+    /// any longer is dropped when the next is made.
+    #[test]
+    fn cloths_bound_alike_share_their_binding() {
+        use crate::layout::shape::{ClothPins, ClothShape};
+        let solver = |spacing: f32| {
+            ClothShape::Grid {
+                width: 4,
+                height: 3,
+                spacing,
+            }
+            .build_solver(
+                &ClothPins::None,
+                &crate::params::ClothParams::default(),
+                Affine3A::IDENTITY,
+            )
+            .unwrap()
+        };
+        let (cloth, wider) = (solver(0.1), solver(0.2));
+        // The simulation's own vertices, a little off its plane, drawn as the proxy.
+        let render: Vec<[f32; 3]> = cloth
+            .rest_positions()
+            .iter()
+            .map(|p| (*p + Vec3::Z * 0.01).to_array())
+            .collect();
+        let mut mesh = Mesh::new(PrimitiveTopology::TriangleList, RenderAssetUsages::all());
+        mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, vec![[0.0, 0.0, 1.0]; render.len()]);
+        mesh.insert_attribute(Mesh::ATTRIBUTE_POSITION, render);
+        let (id, other) = (AssetId::<Mesh>::default(), AssetId::<Mesh>::invalid());
+        let mut bindings = Bindings::default();
+        let first = bindings.bind(id, &mesh, &cloth).unwrap();
+        let second = bindings.bind(id, &mesh, &cloth).unwrap();
+        assert!(first.shares_with(&second));
+        assert_eq!(first, second);
+        let third = bindings.bind(other, &mesh, &cloth).unwrap();
+        assert!(!third.shares_with(&first), "another mesh binds afresh");
+        let fourth = bindings.bind(id, &mesh, &wider).unwrap();
+        assert!(
+            !fourth.shares_with(&first),
+            "another rest shape binds afresh"
+        );
+        assert_eq!(bindings.0.len(), 3);
+        drop((first, second, third));
+        bindings.bind(other, &mesh, &wider).unwrap();
+        assert_eq!(bindings.0.len(), 2, "the two no cloth held are dropped");
+    }
 
     /// A mesh carried by a stretching, mirroring move keeps its normals perpendicular to
     /// its moved surface and flips its tangents' handedness.

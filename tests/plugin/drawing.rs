@@ -199,12 +199,19 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
     for _ in 0..300 {
         app.update();
     }
-    assert_eq!(app.world().get::<Mesh3d>(cloth).unwrap().0, handle);
+    // The cloth draws its own copy of the proxy's mesh, which stays as it was.
+    let own = app.world().get::<Mesh3d>(cloth).unwrap().0.clone();
+    assert_ne!(own, handle);
+    let template: Vec<Vec3> = mesh_positions(&app, &handle)
+        .into_iter()
+        .map(Vec3::from)
+        .collect();
+    assert_eq!(template, render_x);
     let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
     let binding =
         bevy_cloth::solver::ProxyBinding::bind(&rest, sim.solver.triangles(), &render_x, None)
             .unwrap();
-    let drawn = mesh_positions(&app, &handle);
+    let drawn = mesh_positions(&app, &own);
     let (farthest, moved) = proxy_offsets(&sim.solver, &binding, &drawn, &render_x);
     eprintln!(
         "{} render vertices: farthest from its bound point {farthest:e} m; moved up to {moved:.3} m",
@@ -214,7 +221,7 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
     assert!(farthest < 1e-5, "{farthest} m");
     assert!(moved > 0.01, "the cloth sagged: {moved} m");
     let meshes = app.world().resource::<Assets<Mesh>>();
-    let mesh = meshes.get(&handle).unwrap();
+    let mesh = meshes.get(&own).unwrap();
     let (
         Some(bevy::mesh::VertexAttributeValues::Float32x3(normals)),
         Some(bevy::mesh::VertexAttributeValues::Float32x4(tangents)),
@@ -230,6 +237,75 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
         assert!((n.length() - 1.0).abs() < 1e-4);
         assert!(n.dot(t).abs() < 1e-4, "tangent {t} against normal {n}");
     }
+}
+
+/// Two cloths drawn through one proxy mesh (as a crowd's capes are) each draw their own
+/// copy of it on their own triangles: one hangs from its corners and the other falls, and
+/// after 60 frames each drawn mesh is within 1e-5 m of its own cloth's bound points, the
+/// two far apart, and the proxy's mesh as it was.
+#[test]
+fn cloths_drawn_through_one_proxy_mesh_each_draw_their_own() {
+    let mut app = app();
+    app.insert_resource(ClothInterpolation(false));
+    let (w, h) = (8u32, 6u32);
+    let hanging = app
+        .world_mut()
+        .spawn((Cloth::grid(w, h, 0.1), Transform::from_xyz(0.0, 2.0, 0.0)))
+        .id();
+    let falling = app
+        .world_mut()
+        .spawn((
+            Cloth::grid(w, h, 0.1).with_pins(ClothPins::None),
+            Transform::from_xyz(3.0, 2.0, 0.0),
+        ))
+        .id();
+    while app.world().get::<ClothSimulation>(falling).is_none() {
+        app.update();
+    }
+    let rest = {
+        let sim = app.world().get::<ClothSimulation>(hanging).unwrap();
+        sim.solver.rest_positions().to_vec()
+    };
+    let render = finer_grid(&rest, (w, h), 3);
+    let render_x: Vec<Vec3> = match render.attribute(Mesh::ATTRIBUTE_POSITION) {
+        Some(bevy::mesh::VertexAttributeValues::Float32x3(p)) => {
+            p.iter().map(|&p| Vec3::from(p)).collect()
+        }
+        _ => unreachable!(),
+    };
+    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(render);
+    for cloth in [hanging, falling] {
+        app.world_mut().entity_mut(cloth).insert(ClothProxy {
+            mesh: handle.clone(),
+        });
+    }
+    for _ in 0..60 {
+        app.update();
+    }
+    let world = app.world();
+    let drawn = [hanging, falling].map(|cloth| world.get::<Mesh3d>(cloth).unwrap().0.clone());
+    assert_ne!(drawn[0], drawn[1]);
+    assert!(!drawn.contains(&handle));
+    let template: Vec<Vec3> = mesh_positions(&app, &handle)
+        .into_iter()
+        .map(Vec3::from)
+        .collect();
+    assert_eq!(template, render_x, "the proxy's mesh is as it was");
+    let positions = drawn.each_ref().map(|mesh| mesh_positions(&app, mesh));
+    for (cloth, positions) in [hanging, falling].iter().zip(&positions) {
+        let sim = world.get::<ClothSimulation>(*cloth).unwrap();
+        let binding =
+            bevy_cloth::solver::ProxyBinding::bind(&rest, sim.solver.triangles(), &render_x, None)
+                .unwrap();
+        let (farthest, _) = proxy_offsets(&sim.solver, &binding, positions, &render_x);
+        assert!(farthest < 1e-5, "{cloth}: {farthest} m");
+    }
+    let apart = positions[0]
+        .iter()
+        .zip(&positions[1])
+        .map(|(a, b)| Vec3::from(*a).distance(Vec3::from(*b)))
+        .fold(0.0, f32::max);
+    assert!(apart > 0.1, "the two drawn meshes differ: {apart} m");
 }
 
 /// A proxy mesh without positions is refused: the cloth is paused and says why.
