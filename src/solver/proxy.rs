@@ -454,7 +454,13 @@ impl ProxyBinding {
             }
             // The blends made unit in place: the drawn normals.
             let rcp = length_recips(squared_lengths(&blend));
-            if all_scale(&rcp) {
+            let scale = all_scale(&rcp);
+            if scale && tangents.is_none() {
+                // No tangents to make square to them: the unit normals are written only.
+                for ((blend, out), r) in blend.iter().zip(out_normals).zip(rcp) {
+                    *out = Vec3::from(*blend * r).to_array();
+                }
+            } else if scale {
                 for ((smooth, out), r) in blend.iter_mut().zip(out_normals).zip(rcp) {
                     *smooth *= r;
                     *out = Vec3::from(*smooth).to_array();
