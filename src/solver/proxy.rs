@@ -669,6 +669,10 @@ mod tests {
             assert_eq!(out_n[v], smooth.to_array(), "{v}");
             assert_eq!(out_t[v], tangent.extend(t.w).to_array(), "{v}");
         }
+        // Without tangents (the unit normals written, not kept): the same bits.
+        let (mut bare, mut bare_n) = (vec![[0.0; 3]; 19], vec![[0.0; 3]; 19]);
+        binding.place(&x, &normals, &mut bare, &mut bare_n, None);
+        assert_eq!((bare, bare_n), (out.clone(), out_n.clone()));
         // Both stand-ins were taken for the second vertex: its corners' normals and its
         // tangent have no length.
         let corners = binding.shared.triangles[binding.shared.bound[1].triangle as usize];
