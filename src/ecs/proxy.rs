@@ -24,9 +24,8 @@ use crate::solver::ProxyBinding;
 /// entity draws its own copy of it (its `Mesh3d` becomes the copy): the mesh itself stays
 /// as it was, so that many cloths may be drawn through one mesh, as a crowd's capes are,
 /// and cloths of one rest shape drawn through one mesh share their binding. A mesh that
-/// cannot be bound (no
-/// positions, a simulation without triangles) is refused: the cloth is paused with
-/// [`ClothError::BadMesh`].
+/// cannot be bound (no positions, a simulation without triangles) is refused: the cloth
+/// is paused with [`ClothError::BadMesh`].
 #[derive(Component, Clone, Debug, PartialEq, Reflect)]
 #[reflect(Component)]
 pub struct ClothProxy {

@@ -4,7 +4,7 @@
 
 use std::ops::Range;
 
-use bevy::math::{Vec3, Vec3A};
+use bevy::math::Vec3;
 
 use super::bending::{Hinges, particle_areas};
 use super::lattice::{Rows, Stencil};
@@ -53,11 +53,6 @@ pub(super) struct Structure {
     pub area: Vec<f32>,
 }
 
-thread_local! {
-    /// This thread's sums of [`Structure::normal_sums_into`], kept for their storage.
-    static SUMS: std::cell::RefCell<Vec<Vec3A>> = const { std::cell::RefCell::new(Vec::new()) };
-}
-
 impl Structure {
     /// Particle `i`'s normal, unnormalised: the sum of its visible triangles' area
     /// vectors (twice their areas) at positions `x`, in increasing triangle order; zero
@@ -78,25 +73,16 @@ impl Structure {
     /// in increasing triangle order: the same bits as gathering them particle by
     /// particle, at a third of the cross products.
     pub fn normal_sums_into(&self, x: &[Vec3], out: &mut [Vec3]) {
-        // Summed in four-lane vectors (one load, add and store a corner, where three
-        // floats took three each): the same operations lane by lane, the same bits.
-        SUMS.with_borrow_mut(|sums| {
-            sums.clear();
-            sums.resize(out.len(), Vec3A::ZERO);
-            for (t, &[a, b, c]) in self.triangles.iter().enumerate() {
-                if self.triangle_visible[t] {
-                    let [a, b, c] = [a, b, c].map(|v| v as usize);
-                    let origin = Vec3A::from(x[a]);
-                    let area = (Vec3A::from(x[b]) - origin).cross(Vec3A::from(x[c]) - origin);
-                    sums[a] += area;
-                    sums[b] += area;
-                    sums[c] += area;
-                }
+        out.fill(Vec3::ZERO);
+        for (t, &[a, b, c]) in self.triangles.iter().enumerate() {
+            if self.triangle_visible[t] {
+                let [a, b, c] = [a, b, c].map(|v| v as usize);
+                let area = (x[b] - x[a]).cross(x[c] - x[a]);
+                out[a] += area;
+                out[b] += area;
+                out[c] += area;
             }
-            for (out, &sum) in out.iter_mut().zip(sums.iter()) {
-                *out = sum.into();
-            }
-        });
+        }
     }
 
     /// The make-up of a validated layout.

@@ -1,8 +1,9 @@
 //! Vectors made unit a batch at a time, to the bit as glam's `normalize_or` makes them
-//! one by one. One by one, each vector's square root and division wait on the one
-//! before's in the processor's single divider; a batch's squared lengths side by side
-//! become vector square roots and divisions, and a batch whose vectors all have a length
-//! (all but never, for drawn normals) is scaled without a test a vector.
+//! one by one. One by one, each vector's square root and division are scalar
+//! instructions, and placing a proxy's vertices that way spent two fifths of its time on
+//! them; a batch's squared lengths side by side become vector square roots and
+//! divisions, and a batch whose vectors all have a length (nearly every batch of drawn
+//! normals) is scaled without a test a vector.
 
 use std::ops::Mul;
 
