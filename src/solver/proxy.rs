@@ -612,16 +612,11 @@ mod tests {
         }
     }
 
-    /// Placing a batch at a time gives each vertex the same bits as placing it alone with
-    /// glam's `normalize_or`: on a crumpled sheet, for a count of vertices that is not a
-    /// whole number of batches, with some corners' normals of no length (the triangle's
-    /// normal stands in) and a tangent of no length (the first edge stands in).
-    #[test]
-    fn placing_in_batches_is_placing_one_by_one() {
-        let (w, h) = (5u32, 4u32);
-        let (rest, triangles) = sheet(w, h, 0.0);
-        // The first two over the corner whose normals have no length.
-        let render: Vec<Vec3> = (0..19)
+    /// 19 render vertices over the first cells of a 5 × 4 [`sheet`] (the first two over
+    /// its first corner) and their tangents (every third of no length: the first edge
+    /// stands in).
+    fn scattered_vertices() -> (Vec<Vec3>, Vec<Vec4>) {
+        let render = (0..19)
             .map(|k| match k {
                 0 => Vec3::new(0.02, 0.03, 0.0),
                 1 => Vec3::new(0.03, 0.02, 0.01),
@@ -635,14 +630,25 @@ mod tests {
                 }
             })
             .collect();
-        let tangents: Vec<Vec4> = (0..19)
+        let tangents = (0..19)
             .map(|k| match k % 3 {
                 0 => Vec4::new(1.0, 0.0, 0.0, 1.0),
-                // No tangent to turn: the first edge stands in.
                 1 => Vec4::new(0.0, 0.0, 0.0, -1.0),
                 _ => Vec4::new(0.6, 0.8, 0.1, 1.0),
             })
             .collect();
+        (render, tangents)
+    }
+
+    /// Placing a batch at a time gives each vertex the same bits as placing it alone with
+    /// glam's `normalize_or`: on a crumpled sheet, for a count of vertices that is not a
+    /// whole number of batches, with some corners' normals of no length (the triangle's
+    /// normal stands in) and a tangent of no length (the first edge stands in).
+    #[test]
+    fn placing_in_batches_is_placing_one_by_one() {
+        let (w, h) = (5u32, 4u32);
+        let (rest, triangles) = sheet(w, h, 0.0);
+        let (render, tangents) = scattered_vertices();
         let mut binding = ProxyBinding::bind(&rest, &triangles, &render, Some(&tangents)).unwrap();
         let x = sheet(w, h, 0.04).0;
         let normals: Vec<Vec3> = (0..w * h)

@@ -162,6 +162,28 @@ fn finer_grid(rest: &[Vec3], (w, h): (u32, u32), k: u32) -> Mesh {
     .with_inserted_indices(bevy::mesh::Indices::U32(indices))
 }
 
+/// A proxy 3 × 3 times finer than `cloth`, a built `w × h` grid ([`finer_grid`]): the
+/// cloth's rest positions, the proxy's vertices, and the proxy's mesh added to the app.
+fn finer_proxy(
+    app: &mut App,
+    cloth: Entity,
+    (w, h): (u32, u32),
+) -> (Vec<Vec3>, Vec<Vec3>, Handle<Mesh>) {
+    let rest = {
+        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
+        sim.solver.rest_positions().to_vec()
+    };
+    let render = finer_grid(&rest, (w, h), 3);
+    let render_x: Vec<Vec3> = match render.attribute(Mesh::ATTRIBUTE_POSITION) {
+        Some(bevy::mesh::VertexAttributeValues::Float32x3(p)) => {
+            p.iter().map(|&p| Vec3::from(p)).collect()
+        }
+        _ => unreachable!(),
+    };
+    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(render);
+    (rest, render_x, handle)
+}
+
 /// A cloth drawn with a proxy 3 × 3 times finer (9 times the vertices): once bound, the
 /// entity draws the proxy's mesh, and after 300 frames of sagging every render vertex is
 /// within 1e-5 m of its bound point on its simulation triangle (bound anew here from the
@@ -181,18 +203,7 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
     while app.world().get::<ClothSimulation>(cloth).is_none() {
         app.update();
     }
-    let rest = {
-        let sim = app.world().get::<ClothSimulation>(cloth).unwrap();
-        sim.solver.rest_positions().to_vec()
-    };
-    let render = finer_grid(&rest, (w, h), 3);
-    let render_x: Vec<Vec3> = match render.attribute(Mesh::ATTRIBUTE_POSITION) {
-        Some(bevy::mesh::VertexAttributeValues::Float32x3(p)) => {
-            p.iter().map(|&p| Vec3::from(p)).collect()
-        }
-        _ => unreachable!(),
-    };
-    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(render);
+    let (rest, render_x, handle) = finer_proxy(&mut app, cloth, (w, h));
     app.world_mut().entity_mut(cloth).insert(ClothProxy {
         mesh: handle.clone(),
     });
@@ -262,18 +273,7 @@ fn cloths_drawn_through_one_proxy_mesh_each_draw_their_own() {
     while app.world().get::<ClothSimulation>(falling).is_none() {
         app.update();
     }
-    let rest = {
-        let sim = app.world().get::<ClothSimulation>(hanging).unwrap();
-        sim.solver.rest_positions().to_vec()
-    };
-    let render = finer_grid(&rest, (w, h), 3);
-    let render_x: Vec<Vec3> = match render.attribute(Mesh::ATTRIBUTE_POSITION) {
-        Some(bevy::mesh::VertexAttributeValues::Float32x3(p)) => {
-            p.iter().map(|&p| Vec3::from(p)).collect()
-        }
-        _ => unreachable!(),
-    };
-    let handle = app.world_mut().resource_mut::<Assets<Mesh>>().add(render);
+    let (rest, render_x, handle) = finer_proxy(&mut app, hanging, (w, h));
     for cloth in [hanging, falling] {
         app.world_mut().entity_mut(cloth).insert(ClothProxy {
             mesh: handle.clone(),

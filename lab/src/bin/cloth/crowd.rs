@@ -58,6 +58,14 @@ pub(crate) fn crowd(args: CrowdArgs) -> Result<(), String> {
         );
         return Ok(());
     }
+    print_table(&cost, &args);
+    Ok(())
+}
+
+/// The crowd's cost as a table: its make-up, each part of a frame on one thread and on
+/// the pool, the rest of the frame's share and placing's.
+fn print_table(cost: &crowd::CrowdCost, args: &CrowdArgs) {
+    let size = cost.size;
     println!(
         "{} characters, {} cloths: {} particles simulated, {} vertices drawn; {}; {} frames after \
          {} warm-up, {} teleports; {}–{} substeps; largest strain in a frame: median {:.1}%, \
@@ -115,5 +123,4 @@ pub(crate) fn crowd(args: CrowdArgs) -> Result<(), String> {
         one.place[2],
         100.0 * one.place[0] / one.step[0]
     );
-    Ok(())
 }
