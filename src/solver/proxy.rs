@@ -383,48 +383,46 @@ impl ProxyBinding {
         out_normals: &mut [[f32; 3]],
         tangents: Option<&mut [[f32; 4]]>,
     ) {
-        FACES.with_borrow_mut(|faces| {
-            CORNERS.with_borrow_mut(|corners| {
-                // Each particle's position and normal in four-lane vectors once, where each
-                // of its six or so triangles converted them again.
-                corners.clear();
-                let normals = normals
+        SCRATCH.with_borrow_mut(|(faces, corners)| {
+            // Each particle's position and normal in four-lane vectors once, where each
+            // of its six or so triangles converted them again.
+            corners.clear();
+            let normals = normals
+                .iter()
+                .map(|&n| n.into())
+                .chain(std::iter::repeat(Vec3A::ZERO));
+            corners.extend(x.iter().zip(normals).map(|(&p, n)| [p.into(), n]));
+            faces.clear();
+            faces.extend(
+                self.shared
+                    .triangles
                     .iter()
-                    .map(|&n| n.into())
-                    .chain(std::iter::repeat(Vec3A::ZERO));
-                corners.extend(x.iter().zip(normals).map(|(&p, n)| [p.into(), n]));
-                faces.clear();
-                faces.extend(
-                    self.shared
-                        .triangles
-                        .iter()
-                        .map(|t| Face::of(t.map(|i| corners[i as usize]))),
-                );
-                // Each face's normal made unit a batch at a time; a triangle of no area this
-                // frame keeps its last normal (and frame).
-                for (faces, last) in faces
-                    .chunks_mut(BATCH)
-                    .zip(self.last_normals.chunks_mut(BATCH))
-                {
-                    let mut squared = [0.0; BATCH];
-                    for (s, face) in squared.iter_mut().zip(faces.iter()) {
-                        *s = face.normal.dot(face.normal);
+                    .map(|t| Face::of(t.map(|i| corners[i as usize]))),
+            );
+            // Each face's normal made unit a batch at a time; a triangle of no area this
+            // frame keeps its last normal (and frame).
+            for (faces, last) in faces
+                .chunks_mut(BATCH)
+                .zip(self.last_normals.chunks_mut(BATCH))
+            {
+                let mut squared = [0.0; BATCH];
+                for (s, face) in squared.iter_mut().zip(faces.iter()) {
+                    *s = face.normal.dot(face.normal);
+                }
+                let rcp = length_recips(squared);
+                if all_scale(&rcp) {
+                    for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
+                        face.normal *= r;
+                        *last = face.normal;
                     }
-                    let rcp = length_recips(squared);
-                    if all_scale(&rcp) {
-                        for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
-                            face.normal *= r;
-                            *last = face.normal;
-                        }
-                    } else {
-                        for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
-                            face.normal = scaled_or(face.normal, r, *last);
-                            *last = face.normal;
-                        }
+                } else {
+                    for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
+                        face.normal = scaled_or(face.normal, r, *last);
+                        *last = face.normal;
                     }
                 }
-                self.place_on(faces, x, positions, out_normals, tangents);
-            })
+            }
+            self.place_on(faces, x, positions, out_normals, tangents);
         });
     }
 
@@ -535,13 +533,14 @@ impl Face {
 }
 
 thread_local! {
-    /// This thread's faces of the binding it is placing ([`ProxyBinding::place`]), worked
-    /// out afresh each call: one buffer a thread, warm in its cache, where one a binding
-    /// (112 bytes a triangle, 8 MB for the crowd's hundred cloths) was read back from
-    /// memory every frame only to be overwritten.
-    static FACES: std::cell::RefCell<Vec<Face>> = const { std::cell::RefCell::new(Vec::new()) };
-    /// And its particles' positions and normals, in four-lane vectors.
-    static CORNERS: std::cell::RefCell<Vec<[Vec3A; 2]>> = const { std::cell::RefCell::new(Vec::new()) };
+    /// This thread's faces of the binding it is placing ([`ProxyBinding::place`]) and its
+    /// particles' positions and normals in four-lane vectors, worked out afresh each
+    /// call: one buffer a thread, warm in its cache, where one a binding (112 bytes a
+    /// triangle, 8 MB for the crowd's hundred cloths) was read back from memory every
+    /// frame only to be overwritten.
+    #[allow(clippy::type_complexity)]
+    static SCRATCH: std::cell::RefCell<(Vec<Face>, Vec<[Vec3A; 2]>)> =
+        const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
 }
 
 /// The squared length of each of `v`.

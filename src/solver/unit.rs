@@ -51,6 +51,8 @@ pub(crate) fn scaled_or<V: Mul<f32, Output = V>>(v: V, rcp: f32, fallback: V) ->
 /// Each of `v` made unit, or `fallback` where it has no length: `normalize_or` on each,
 /// to the bit, a batch at a time.
 pub(crate) fn normalize_each_or(v: &mut [Vec3], fallback: Vec3) {
+    // Whole batches of eight (their loops unrolled; a last, shorter batch through the
+    // same path measured 3% slower in `place_cost`), then the rest one by one.
     let mut batches = v.chunks_exact_mut(BATCH);
     for batch in &mut batches {
         let mut squared = [0.0; BATCH];
