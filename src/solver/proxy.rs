@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use bevy::math::{Vec3, Vec3A, Vec4};
 
-use super::unit::{BATCH, all_scale, length_recips, scaled_or};
+use super::unit::{BATCH, all_scale, length_recips, scaled_or, squared_lengths};
 
 /// One render vertex's place on the simulation mesh: 16 bytes, all that placing reads
 /// of it (the vertices are the most numerous thing drawn, so their bytes are most of
@@ -405,11 +405,11 @@ impl ProxyBinding {
                 .chunks_mut(BATCH)
                 .zip(self.last_normals.chunks_mut(BATCH))
             {
-                let mut squared = [0.0; BATCH];
-                for (s, face) in squared.iter_mut().zip(faces.iter()) {
-                    *s = face.normal.dot(face.normal);
+                let mut normals = [Vec3A::ZERO; BATCH];
+                for (n, face) in normals.iter_mut().zip(faces.iter()) {
+                    *n = face.normal;
                 }
-                let rcp = length_recips(squared);
+                let rcp = length_recips(squared_lengths(&normals));
                 if all_scale(&rcp) {
                     for ((face, last), r) in faces.iter_mut().zip(last).zip(rcp) {
                         face.normal *= r;
@@ -541,16 +541,6 @@ thread_local! {
     #[allow(clippy::type_complexity)]
     static SCRATCH: std::cell::RefCell<(Vec<Face>, Vec<[Vec3A; 2]>)> =
         const { std::cell::RefCell::new((Vec::new(), Vec::new())) };
-}
-
-/// The squared length of each of `v`.
-#[inline(always)]
-fn squared_lengths(v: &[Vec3A; BATCH]) -> [f32; BATCH] {
-    let mut squared = [0.0; BATCH];
-    for (s, v) in squared.iter_mut().zip(v) {
-        *s = v.dot(*v);
-    }
-    squared
 }
 
 #[cfg(test)]
