@@ -109,13 +109,14 @@ fn print_table(cost: &crowd::CrowdCost, args: &CrowdArgs) {
     );
     row("drawing (normals, proxies)", one.draw, pool.draw);
     println!(
-        "the rest of the frame against the step (pool): driving {:.0}%, drawing {:.0}%",
+        "the rest of the frame against the step (pool): {:.1}% (driving {:.1}%, drawing {:.1}%)",
+        100.0 * (pool.drive[0] + pool.draw[0]) / pool.step[0],
         100.0 * pool.drive[0] / pool.step[0],
         100.0 * pool.draw[0] / pool.step[0]
     );
     println!(
         "of the drawing on one thread, placing the proxies' {:.1}× as many vertices: {:.2} ms \
-         [{:.2}–{:.2}], {:.0}% of the step (the rest is the simulation's normals, which a cloth \
+         [{:.2}–{:.2}], {:.1}% of the step (the rest is the simulation's normals, which a cloth \
          drawn without a proxy needs too)",
         cost.drawn as f64 / cost.particles as f64,
         one.place[0],
