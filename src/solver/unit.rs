@@ -132,4 +132,30 @@ mod tests {
         assert_eq!(v[9], fallback);
         assert_eq!(v[31], fallback);
     }
+
+    /// Four at a time, the squared lengths and their reciprocal roots are glam's one by
+    /// one, to the bit: for vectors of every size from 1e-20 to 1e20, of no length,
+    /// infinite and not a number.
+    #[test]
+    fn squared_lengths_and_recips_as_one_by_one() {
+        let mut v: [Vec3A; BATCH] = std::array::from_fn(|k| {
+            let f = k as f32;
+            let scale = 10f32.powi(5 * k as i32 - 20);
+            scale * Vec3A::new((0.7 * f).sin(), (1.3 * f).cos() + 0.1, 0.3 * f - 1.0)
+        });
+        let bits = |a: [f32; BATCH]| a.map(f32::to_bits);
+        for special in [
+            Vec3A::ZERO,
+            Vec3A::new(f32::INFINITY, 1.0, 0.0),
+            Vec3A::new(0.0, f32::NAN, 2.0),
+        ] {
+            let squared = squared_lengths(&v);
+            assert_eq!(bits(squared), bits(v.map(|v| v.length_squared())));
+            assert_eq!(
+                bits(length_recips(squared)),
+                bits(v.map(|v| v.length_recip()))
+            );
+            v[3] = special;
+        }
+    }
 }
