@@ -47,6 +47,7 @@ impl ClothSolver {
             drivers_motion: None,
             felt: Default::default(),
             wind: Default::default(),
+            touched: Vec::new(),
             air: Default::default(),
         };
         cloth.clock.substeps = 1;

@@ -20,6 +20,12 @@ pub(super) struct Clock {
     /// The automatic substeps hit their cap in the current step, or the strain limiter's
     /// sweeps ran out of its budget.
     pub under_resolved: bool,
+    /// The most automatic substeps a step of XPBD may take, set from outside
+    /// ([`ClothSolver::set_substep_budget`](super::ClothSolver::set_substep_budget)):
+    /// a frame budget's share. `None`: only the cloth's own cap.
+    pub budget: Option<u32>,
+    /// XPBD needed more substeps than its budget in the current step.
+    pub over_budget: bool,
     /// The strain limiter's sweeps until within that the current step has left
     /// (`limits::limiter_budget`).
     pub limiter_sweeps_left: u32,

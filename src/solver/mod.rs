@@ -9,6 +9,7 @@
 //! cloth's particles ([`Particles`]), what it is made of (`structure.rs`), its clock
 //! (`clock.rs`) and the shared stages (`forces.rs`, `integrate.rs`).
 
+mod budget;
 mod build;
 mod clock;
 mod constraints;
@@ -35,6 +36,7 @@ use constraints::{bending, chains, lattice, tethers, xpbd};
 use contact::self_contact;
 use models::switch;
 
+pub use budget::{BudgetClaim, share_budget};
 pub use contact::shapes::{self, ColliderShape, ConvexHull, Placement, Shape};
 pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};
@@ -106,6 +108,9 @@ pub struct ClothSolver {
     air: forces::AirLoad,
     /// The wind zones that reach it.
     wind: forces::Blowing,
+    /// The particles self-collision or contact moved in the step in progress: the
+    /// stretch at their springs is not the solver's error (`steps/mod.rs`).
+    touched: Vec<bool>,
 }
 
 /// The active model's own state: none for mass-spring (or before the first step

@@ -188,4 +188,37 @@ impl ClothSolver {
     pub fn under_resolved(&self) -> bool {
         self.clock.under_resolved
     }
+
+    /// Caps the automatic substeps of XPBD at `most` a step from the next step on (at
+    /// least 1; `None` lifts the cap): a frame budget's share, which the plugin sets
+    /// from [`ClothBudget`](crate::ClothBudget). Below what its accuracy target asks,
+    /// the cloth gives accuracy and reports it ([`StepReport::over_budget`], with
+    /// the strain its constraints left in [`StepReport::solver_strain`]). The explicit
+    /// models keep their stable count whatever the cap, and a fixed count is the cloth's
+    /// own choice: neither is capped.
+    pub fn set_substep_budget(&mut self, most: Option<u32>) {
+        self.clock.budget = most;
+    }
+
+    /// Whether [`set_substep_budget`](Self::set_substep_budget) caps this cloth: XPBD at
+    /// automatic substeps.
+    pub fn budget_caps(&self) -> bool {
+        matches!(
+            (self.params.model, self.params.substeps),
+            (
+                crate::params::Model::Xpbd(_),
+                crate::params::Substeps::Auto { .. }
+            )
+        )
+    }
+
+    /// The cap [`set_substep_budget`](Self::set_substep_budget) set.
+    pub fn substep_budget(&self) -> Option<u32> {
+        self.clock.budget
+    }
+
+    /// True when the last step of XPBD needed more substeps than its budget allowed.
+    pub fn over_budget(&self) -> bool {
+        self.clock.over_budget
+    }
 }

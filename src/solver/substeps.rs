@@ -284,6 +284,22 @@ impl ClothSolver {
         worst
     }
 
+    /// [`Self::structural_strain`] over the springs none of whose ends self-collision or
+    /// contact moved in the step in progress.
+    pub(super) fn untouched_structural_strain(&self) -> f32 {
+        let (x, w) = (&self.particles.position, &self.particles.inv_mass);
+        let s = &self.structure.springs;
+        let touched = |i: usize| self.touched.get(i).copied().unwrap_or(false);
+        let mut worst = 0.0f32;
+        for k in s.ranges[SpringKind::Structural as usize].clone() {
+            let (a, b) = (s.a[k] as usize, s.b[k] as usize);
+            if s.alive[k] && w[a] + w[b] > 0.0 && !touched(a) && !touched(b) {
+                worst = worst.max(x[a].distance(x[b]) / s.rest_length[k] - 1.0);
+            }
+        }
+        worst
+    }
+
     /// True when the explicit bound depends on the current deformation.
     pub(super) fn state_dependent_stiffness(&self) -> bool {
         match self.params.model {

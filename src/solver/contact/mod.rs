@@ -118,11 +118,13 @@ impl Contact {
     /// its whole depth and do not launch it. Deeper than that, it leaves along the
     /// cloth's own normal where that leads out (`normal(x, i)`: particle `i`'s normal,
     /// any length, at positions `x`), and keeps no motion back in.
+    /// Each particle it moves is marked in `touched`.
     pub fn resolve(
         &mut self,
         p: &mut Particles,
         (tau, h, depenetration): (f32, f32, f32),
         normal: impl Fn(&[Vec3], usize) -> Vec3,
+        touched: &mut [bool],
     ) {
         if self.colliders.is_empty() {
             return;
@@ -164,6 +166,7 @@ impl Contact {
             p.position[i] = x;
             p.previous[i] = previous;
             p.velocity[i] = (x - previous) / h;
+            mark(touched, i);
         }
     }
 }
@@ -175,8 +178,15 @@ impl Contact {
     /// closest points' line, the correction shared by its two particles by their
     /// barycentric weight and inverse mass (the position-based edge constraint), back to
     /// the side the edge came from, with Coulomb friction and no energy added. A rope or
-    /// a pole across the cloth holds it. Runs after [`Contact::resolve`].
-    pub fn resolve_edges(&mut self, p: &mut Particles, springs: &Springs, h: f32) {
+    /// a pole across the cloth holds it. Runs after [`Contact::resolve`]; the ends of
+    /// each edge it moves are marked in `touched`.
+    pub fn resolve_edges(
+        &mut self,
+        p: &mut Particles,
+        springs: &Springs,
+        h: f32,
+        touched: &mut [bool],
+    ) {
         if self.thin.is_empty() {
             return;
         }
@@ -205,12 +215,22 @@ impl Contact {
                     }
                     let ends = (springs.a[s] as usize, springs.b[s] as usize);
                     if let Some((impulse, at)) = rope.push_edge(p, ends, h) {
+                        mark(touched, ends.0);
+                        mark(touched, ends.1);
                         self.collider_impulses[k].linear -= impulse;
                         self.collider_impulses[k].angular -= at.cross(impulse);
                     }
                 }
             }
         }
+    }
+}
+
+/// Marks particle `i` as moved by contact (a slice shorter than the cloth, from stages
+/// called by hand before any step began, marks nothing).
+pub(in crate::solver) fn mark(touched: &mut [bool], i: usize) {
+    if let Some(t) = touched.get_mut(i) {
+        *t = true;
     }
 }
 
