@@ -65,12 +65,12 @@ pub mod prelude {
     pub use crate::ecs::avian::ClothAvianPlugin;
     pub use crate::ecs::{
         AttachParticles, Cloth, ClothAttachment, ClothAttachments, ClothAwoke, ClothBackStop,
-        ClothBecameInvalid, ClothBuilt, ClothCollider, ClothColliderBecameInvalid,
+        ClothBecameInvalid, ClothBudget, ClothBuilt, ClothCollider, ClothColliderBecameInvalid,
         ClothColliderInvalid, ClothColliderSpan, ClothCulling, ClothEnvironment, ClothFellAsleep,
-        ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothPause, ClothPlugin,
-        ClothProxy, ClothProxyEntity, ClothSimulation, ClothSleep, ClothStats, ClothSubstep,
-        ClothSubstepSystems, ClothSystems, ClothTeleport, ClothTeleported, ClothTorn, ClothWake,
-        ClothWindZone,
+        ClothInterpolation, ClothInvalid, ClothLod, ClothMaxDistance, ClothOverBudget, ClothPause,
+        ClothPlugin, ClothPriority, ClothProxy, ClothProxyEntity, ClothSimulation, ClothSleep,
+        ClothStageStats, ClothStats, ClothSubstep, ClothSubstepSystems, ClothSystems,
+        ClothTeleport, ClothTeleported, ClothTorn, ClothWake, ClothWindZone, ClothWithinBudget,
     };
     pub use crate::error::ClothError;
     pub use crate::fabric::Fabric;

@@ -5,6 +5,7 @@
 pub(crate) mod attach;
 #[cfg(feature = "avian")]
 pub mod avian;
+pub(crate) mod budget;
 pub(crate) mod build;
 pub(crate) mod cloth;
 pub(crate) mod colliders;
@@ -21,6 +22,10 @@ pub(crate) mod step;
 pub(crate) mod wind;
 
 pub use attach::{AttachParticles, ClothAttachPlugin, ClothAttachment, ClothAttachments};
+pub use budget::{
+    ClothBudget, ClothBudgetPlugin, ClothOverBudget, ClothPriority, ClothStageStats,
+    ClothWithinBudget,
+};
 pub use build::ClothGarmentPlugin;
 pub use cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,

@@ -34,6 +34,7 @@ use bevy::ecs::schedule::ScheduleLabel;
 use bevy::prelude::*;
 
 use crate::ecs::attach::ClothAttachPlugin;
+use crate::ecs::budget::ClothBudgetPlugin;
 use crate::ecs::build::{ClothGarmentPlugin, build_cloths};
 use crate::ecs::cloth::{
     Cloth, ClothEnvironment, ClothInterpolation, ClothInvalid, ClothPause, ClothSimulation,
@@ -174,6 +175,7 @@ impl PluginGroup for ClothPlugin {
             .add(ClothWindPlugin)
             .add(ClothMeshPlugin)
             .add(ClothProxyPlugin)
+            .add(ClothBudgetPlugin)
     }
 }
 

@@ -32,6 +32,12 @@ pub struct ClothStats {
     pub substeps: u32,
     /// True when automatic substeps hit their cap: the step may be unstable.
     pub under_resolved: bool,
+    /// The substeps the last step needed (its accuracy target, or an explicit model's
+    /// stable count), before any cap.
+    pub needed_substeps: u32,
+    /// True when the last step gave accuracy to keep to its frame budget
+    /// ([`ClothBudget`](crate::ClothBudget)): it took fewer substeps than it needed.
+    pub over_budget: bool,
     /// True when the cloth fell asleep at its last step (see [`ClothSleep`](crate::ClothSleep), which says
     /// whether it sleeps now): the other values are those of that step.
     pub asleep: bool,
@@ -60,6 +66,8 @@ impl ClothStats {
         self.torn = cloth.torn_count();
         self.substeps = cloth.substeps();
         self.under_resolved = cloth.under_resolved();
+        self.needed_substeps = cloth.last_report().needed;
+        self.over_budget = cloth.over_budget();
         self.max_strain = cloth.strain().max;
         self.energy = cloth.energy(env);
         let time = cloth.time();
