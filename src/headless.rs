@@ -12,11 +12,11 @@ use bevy::prelude::*;
 use bevy::time::TimeUpdateStrategy;
 use serde::Serialize;
 
-use crate::ClothPlugin;
 use crate::error::ClothError;
 use crate::params::{Environment, WindZone};
 use crate::scene::ClothScene;
 use crate::solver::{self, Collider};
+use crate::{ClothBudget, ClothPlugin};
 
 /// What a headless run of a scene did, per cloth.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -46,6 +46,45 @@ pub struct ClothSummary {
     pub torn_springs: usize,
     /// Finite everywhere and no spring past 100% strain.
     pub stable: bool,
+    /// The most substeps any step took.
+    pub most_substeps: u32,
+    /// Steps that ran capped (`under_resolved`).
+    pub steps_under_resolved: usize,
+    /// Steps that gave accuracy to keep to a frame budget (`over_budget`).
+    pub steps_over_budget: usize,
+    /// The largest structural strain at the end of any step.
+    pub largest_strain: f32,
+    /// Every step ended finite with no structural spring past [`WHOLE_STRAIN`]: the cloth
+    /// held together throughout, as a person looking at it would say.
+    pub whole: bool,
+}
+
+/// The strain past which a cloth no longer looks like itself, whatever a solver reports:
+/// 50%, five times the limit of believable cloth (Provot 1995 takes 10%).
+pub const WHOLE_STRAIN: f32 = 0.5;
+
+/// What a run saw of one cloth over all its steps.
+#[derive(Clone, Copy, Debug, Default)]
+struct Extremes {
+    most_substeps: u32,
+    steps_under_resolved: usize,
+    steps_over_budget: usize,
+    largest_strain: f32,
+    broken: bool,
+}
+
+impl Extremes {
+    fn record(&mut self, cloth: &solver::ClothSolver) {
+        let report = cloth.last_report();
+        self.most_substeps = self.most_substeps.max(report.substeps);
+        self.steps_under_resolved += usize::from(report.under_resolved);
+        self.steps_over_budget += usize::from(report.over_budget);
+        let strain = report.max_strain.unwrap_or_else(|| cloth.strain().max);
+        self.largest_strain = self.largest_strain.max(strain);
+        // A NaN strain is no number: not whole.
+        let within = strain.partial_cmp(&WHOLE_STRAIN).is_some_and(|o| o.is_le());
+        self.broken |= !report.finite || !within;
+    }
 }
 
 /// A headless run: the scene's cloths stepped together.
@@ -56,9 +95,15 @@ pub struct RunSummary {
     /// Simulated seconds.
     pub simulated_seconds: f32,
     /// Median wall-clock time of one step of all cloths, ms (of a uniform sample of
-    /// `StepTimes::KEPT` steps in longer runs; the only field that varies
-    /// between identical runs).
+    /// `StepTimes::KEPT` steps in longer runs; it varies between identical runs, as do
+    /// the two times below, and nothing else).
     pub median_ms_per_step: f64,
+    /// The slowest step, ms (it varies between identical runs too).
+    pub max_ms_per_step: f64,
+    /// The run's time over its particle-substeps (every cloth's particles times its
+    /// substeps, summed over the steps), ns: the cost a frame budget plans with
+    /// ([`ClothBudget::nanoseconds_per_particle_substep`]).
+    pub ns_per_particle_substep: f64,
     /// Per cloth.
     pub cloths: Vec<ClothSummary>,
 }
@@ -73,6 +118,10 @@ pub struct SceneRun {
     pub timestep: f32,
     /// The wind zones, on the run's clock.
     pub wind_zones: Vec<WindZone>,
+    /// A frame budget shared among the cloths each step as the plugin shares it
+    /// ([`ClothBudget::share`], every cloth at priority 1; `max_steps_per_frame` has no
+    /// frames here). `None` (the default): accuracy first.
+    pub budget: Option<ClothBudget>,
 }
 
 impl SceneRun {
@@ -97,6 +146,7 @@ impl SceneRun {
             environment: scene.environment,
             timestep: scene.timestep,
             wind_zones: scene.wind_zones.clone(),
+            budget: None,
         })
     }
 
@@ -115,6 +165,18 @@ impl SceneRun {
         if self.cloths.len() > 1 {
             let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
             solver::collide_cloths(&mut all);
+        }
+        if let Some(budget) = &self.budget {
+            let claims: Vec<_> = self
+                .cloths
+                .iter()
+                .map(|(_, c)| solver::BudgetClaim::of(c, 1.0))
+                .collect();
+            let mut caps = Vec::new();
+            budget.share(&claims, &mut caps);
+            for ((_, cloth), cap) in self.cloths.iter_mut().zip(caps) {
+                cloth.set_substep_budget(cap);
+            }
         }
         // As the plugin steps them: cloths in contact together, the rest side by side.
         let mut all: Vec<_> = self.cloths.iter_mut().map(|(_, c)| (c, true)).collect();
@@ -141,21 +203,37 @@ impl SceneRun {
             .collect();
         // Any number of steps in bounded memory (`--steps` is streamed).
         let mut times = crate::stats::StepTimes::default();
+        let (mut slowest, mut total_ms, mut work) = (0.0f64, 0.0f64, 0.0f64);
+        let mut extremes = vec![Extremes::default(); self.cloths.len()];
         for step in 1..=steps {
             let start = Instant::now();
             self.step();
-            times.push(start.elapsed().as_secs_f64() * 1e3);
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            times.push(ms);
+            slowest = slowest.max(ms);
+            total_ms += ms;
+            for ((_, cloth), seen) in self.cloths.iter().zip(&mut extremes) {
+                seen.record(cloth);
+                work += cloth.particle_count() as f64 * f64::from(cloth.last_report().taken);
+            }
             each(step, &self.cloths);
         }
         RunSummary {
             steps,
             simulated_seconds: steps as f32 * self.timestep,
             median_ms_per_step: times.median(),
+            max_ms_per_step: slowest,
+            ns_per_particle_substep: if work > 0.0 {
+                total_ms * 1e6 / work
+            } else {
+                0.0
+            },
             cloths: self
                 .cloths
                 .iter()
                 .zip(energy_start)
-                .map(|((name, c), energy_start)| {
+                .zip(extremes)
+                .map(|(((name, c), energy_start), seen)| {
                     let strain = c.strain();
                     let energy = c.energy(&env);
                     ClothSummary {
@@ -171,6 +249,11 @@ impl SceneRun {
                         energy_end: energy.total(),
                         torn_springs: c.torn_count(),
                         stable: c.is_stable(),
+                        most_substeps: seen.most_substeps,
+                        steps_under_resolved: seen.steps_under_resolved,
+                        steps_over_budget: seen.steps_over_budget,
+                        largest_strain: seen.largest_strain,
+                        whole: !seen.broken && steps > 0,
                     }
                 })
                 .collect(),

@@ -36,6 +36,34 @@ pub(crate) struct RunArgs {
     /// No progress bar and no summary line on stderr (the JSON on stdout stays).
     #[arg(long)]
     pub(crate) quiet: bool,
+    /// Runs inside the plugin's default frame budget (`ClothBudget::default()`: 4 ms a
+    /// step for all cloths, 1 ms for any one) instead of accuracy first.
+    #[arg(long)]
+    pub(crate) budget: bool,
+    /// The budget's milliseconds for all cloths a step (implies --budget).
+    #[arg(long, value_name = "MS")]
+    pub(crate) budget_ms: Option<f32>,
+    /// The budget's milliseconds for any one cloth a step (implies --budget).
+    #[arg(long, value_name = "MS")]
+    pub(crate) cloth_budget_ms: Option<f32>,
+}
+
+impl RunArgs {
+    /// The frame budget the flags ask for (`None`: accuracy first), checked.
+    fn frame_budget(&self) -> Result<Option<ClothBudget>, String> {
+        if !(self.budget || self.budget_ms.is_some() || self.cloth_budget_ms.is_some()) {
+            return Ok(None);
+        }
+        let mut budget = ClothBudget::default();
+        if let Some(ms) = self.budget_ms {
+            budget.milliseconds = Some(ms);
+        }
+        if let Some(ms) = self.cloth_budget_ms {
+            budget.per_cloth_milliseconds = Some(ms);
+        }
+        budget.validate().map_err(|e| e.to_string())?;
+        Ok(Some(budget))
+    }
 }
 
 pub(crate) fn run(args: RunArgs) -> Result<(), String> {
@@ -64,6 +92,7 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
             .map_or(step as f32 * timestep, |(_, cloth)| cloth.time())
     };
     let mut run = SceneRun::new(&scene).map_err(|e| format!("{scene_path}: {e}"))?;
+    run.budget = args.frame_budget()?;
     let mut dump = match &args.dump {
         Some(path) => Some(Dump::new(path)?),
         None => None,
@@ -116,17 +145,31 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
 /// its particles, substeps, largest strain and whether it stayed stable.
 fn say_summary(scene: &str, summary: &bevy_cloth::headless::RunSummary) {
     eprintln!(
-        "{scene}: {} steps ({:.2} s simulated), {:.3} ms a step (median)",
-        summary.steps, summary.simulated_seconds, summary.median_ms_per_step
+        "{scene}: {} steps ({:.2} s simulated), {:.3} ms a step (median), {:.3} ms the \
+         slowest, {:.0} ns a particle-substep",
+        summary.steps,
+        summary.simulated_seconds,
+        summary.median_ms_per_step,
+        summary.max_ms_per_step,
+        summary.ns_per_particle_substep
     );
     for c in &summary.cloths {
         eprintln!(
-            "  {}: {} particles, {} substeps a step, largest strain {:.2}%, {}",
+            "  {}: {} particles, {} substeps a step at the end ({} the most; steps capped {}, \
+             over budget {}), largest strain {:.2}% at the end ({:.2}% the most), {}",
             if c.name.is_empty() { "cloth" } else { &c.name },
             c.particles,
             c.substeps,
+            c.most_substeps,
+            c.steps_under_resolved,
+            c.steps_over_budget,
             c.max_strain * 100.0,
-            if c.stable { "stable" } else { "NOT stable" }
+            c.largest_strain * 100.0,
+            if c.whole {
+                "whole throughout"
+            } else {
+                "NOT whole (non-finite or past 50% strain)"
+            }
         );
     }
 }
