@@ -4,6 +4,7 @@
 mod common;
 
 mod attach;
+mod budget;
 mod building;
 mod colliders;
 mod culling;

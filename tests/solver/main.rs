@@ -4,6 +4,7 @@
 mod common;
 
 mod analytic;
+mod budget;
 mod kernels;
 mod stability;
 mod structure;
