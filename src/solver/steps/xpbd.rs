@@ -110,13 +110,6 @@ impl ModelSteps for XpbdParams {
         constraints.tethers.project(&mut cloth.particles, pins, h);
     }
 
-    /// Over budget: the constraints projected once more (the stretch solved along its
-    /// lines again), a second iteration in the last substep. Its move goes to the
-    /// velocities as every projection's does.
-    fn settle(&self, cloth: &mut ClothSolver) {
-        self.constrain(cloth);
-    }
-
     fn end(&self, cloth: &mut ClothSolver) {
         cloth.tear_overstretched();
     }
