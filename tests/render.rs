@@ -259,10 +259,10 @@ const GUSTS: &[&str] = &[
 fn flag_renders_and_moves() {
     // The textured flag on its pole, carried round a circle: its coloured bands are the
     // cloth's pixels, and it moves with the pole (the attachment and the texture).
-    // On the clock of a 60th of a second a frame: on the wall clock a loaded machine's
-    // slow frames hold more fixed steps than the cloths take in one (three by default,
-    // `ClothBudget::max_steps_per_frame`), so the flag lagged behind its pole (centred
-    // at x = 433, left of the 450 asked).
+    // On the clock of a 60th of a second a frame, so where the flag is at a frame does
+    // not hang on how slow the machine draws (with the cloths capped at three steps a
+    // frame, `ClothBudget::max_steps_per_frame`, it lagged behind its pole on a loaded
+    // machine: centred at x = 433, left of the 450 asked).
     renders_and_moves("flag", &["--frame-time", "0.016667"], (40, 120), 0.005..0.4);
 }
 

@@ -543,7 +543,7 @@ fn cloth_controls(ui: &mut egui::Ui, cloth: &mut Cloth) {
     if sc.enabled {
         optional(
             ui,
-            "distance, m (else the spacing)",
+            "distance, m (else ¾ of the spacing)",
             &mut sc.distance,
             0.01,
             0.001..=0.1,

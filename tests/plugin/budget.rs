@@ -161,11 +161,15 @@ fn a_refused_budget_caps_nothing() {
     assert!(report.substeps > 3 && !report.over_budget, "{report:?}");
 }
 
-/// A frame of 80 ms holds five fixed steps of 16 ms; the cloths take three of them (the
-/// default cap) and count those they skip.
+/// A frame of 80 ms holds five fixed steps of 16 ms; at a cap of three a frame the cloths
+/// take three of them and count those they skip.
 #[test]
 fn the_cloths_step_at_most_three_times_a_frame() {
     let mut app = app();
+    app.insert_resource(ClothBudget {
+        max_steps_per_frame: Some(3),
+        ..default()
+    });
     let e = app
         .world_mut()
         .spawn(Cloth::grid(4, 4, 0.1).with_params(quiet_params()))
