@@ -122,6 +122,8 @@ pub struct SceneRun {
     /// ([`ClothBudget::share`], every cloth at priority 1; `max_steps_per_frame` has no
     /// frames here). `None` (the default): accuracy first.
     pub budget: Option<ClothBudget>,
+    /// The budget's claims and caps, kept for their storage.
+    shares: (Vec<solver::BudgetClaim>, Vec<Option<u32>>),
 }
 
 impl SceneRun {
@@ -147,6 +149,7 @@ impl SceneRun {
             timestep: scene.timestep,
             wind_zones: scene.wind_zones.clone(),
             budget: None,
+            shares: Default::default(),
         })
     }
 
@@ -167,14 +170,15 @@ impl SceneRun {
             solver::collide_cloths(&mut all);
         }
         if let Some(budget) = &self.budget {
-            let claims: Vec<_> = self
-                .cloths
-                .iter()
-                .map(|(_, c)| solver::BudgetClaim::of(c, 1.0))
-                .collect();
-            let mut caps = Vec::new();
-            budget.share(&claims, &mut caps);
-            for ((_, cloth), cap) in self.cloths.iter_mut().zip(caps) {
+            let (claims, caps) = &mut self.shares;
+            claims.clear();
+            claims.extend(
+                self.cloths
+                    .iter()
+                    .map(|(_, c)| solver::BudgetClaim::of(c, 1.0)),
+            );
+            budget.share(claims, caps);
+            for ((_, cloth), &cap) in self.cloths.iter_mut().zip(caps.iter()) {
                 cloth.set_substep_budget(cap);
             }
         }
@@ -234,27 +238,7 @@ impl SceneRun {
                 .zip(energy_start)
                 .zip(extremes)
                 .map(|(((name, c), energy_start), seen)| {
-                    let strain = c.strain();
-                    let energy = c.energy(&env);
-                    ClothSummary {
-                        name: name.clone(),
-                        particles: c.particle_count(),
-                        springs: c.spring_count(),
-                        substeps: c.substeps(),
-                        under_resolved: c.under_resolved(),
-                        max_strain: strain.max,
-                        mean_strain: strain.mean,
-                        kinetic_energy: energy.kinetic,
-                        energy_start,
-                        energy_end: energy.total(),
-                        torn_springs: c.torn_count(),
-                        stable: c.is_stable(),
-                        most_substeps: seen.most_substeps,
-                        steps_under_resolved: seen.steps_under_resolved,
-                        steps_over_budget: seen.steps_over_budget,
-                        largest_strain: seen.largest_strain,
-                        whole: !seen.broken && steps > 0,
-                    }
+                    summarise(name, c, &env, energy_start, seen, steps)
                 })
                 .collect(),
         }
@@ -300,3 +284,35 @@ pub fn headless_base_in(assets: impl Into<String>) -> App {
 
 /// The headless apps' frame and fixed step.
 const HEADLESS_STEP: Duration = Duration::from_millis(16);
+
+/// A cloth's line of the summary: its state now and what the run `seen` of it.
+fn summarise(
+    name: &str,
+    c: &solver::ClothSolver,
+    env: &Environment,
+    energy_start: f32,
+    seen: Extremes,
+    steps: usize,
+) -> ClothSummary {
+    let strain = c.strain();
+    let energy = c.energy(env);
+    ClothSummary {
+        name: name.to_string(),
+        particles: c.particle_count(),
+        springs: c.spring_count(),
+        substeps: c.substeps(),
+        under_resolved: c.under_resolved(),
+        max_strain: strain.max,
+        mean_strain: strain.mean,
+        kinetic_energy: energy.kinetic,
+        energy_start,
+        energy_end: energy.total(),
+        torn_springs: c.torn_count(),
+        stable: c.is_stable(),
+        most_substeps: seen.most_substeps,
+        steps_under_resolved: seen.steps_under_resolved,
+        steps_over_budget: seen.steps_over_budget,
+        largest_strain: seen.largest_strain,
+        whole: !seen.broken && steps > 0,
+    }
+}

@@ -15,7 +15,7 @@ use crate::ecs::sleep::ClothSleep;
 use crate::ecs::step::{StepProgress, begin_steps};
 use crate::error::ClothError;
 use crate::params::check;
-use crate::solver::{BudgetClaim, share_budget};
+use crate::solver::{BudgetClaim, StepReport, share_budget};
 
 /// What the cloths may cost, a resource: the plugin shares `milliseconds` of each fixed
 /// step among the cloths that step (by [`ClothPriority`] when it is short), no cloth
@@ -372,6 +372,31 @@ fn share_out(
     }
 }
 
+/// A cloth's crossing of its budget, either way: the event on its entity and a log line
+/// (`was`: it was over before this step).
+fn announce(commands: &mut Commands, who: Named, report: &StepReport, was: bool) {
+    let entity = who.0;
+    if report.over_budget && !was {
+        let strain = report.solver_strain.or(report.max_strain).unwrap_or(0.0);
+        warn!(
+            "{who} is over its cloth budget: its accuracy asks for {} substeps, it takes {} \
+             (its stretch {:.1}%); raise ClothBudget or its ClothPriority to give it more",
+            report.needed,
+            report.substeps,
+            strain * 100.0
+        );
+        commands.trigger(ClothOverBudget {
+            entity,
+            needed: report.needed,
+            allowed: report.substeps,
+            strain,
+        });
+    } else if !report.over_budget && was {
+        info!("{who} is within its cloth budget again");
+        commands.trigger(ClothWithinBudget { entity });
+    }
+}
+
 /// The stage's cost and counts, the diagnostics, and the events of the cloths that went
 /// over their budget or came back.
 #[allow(clippy::type_complexity)]
@@ -398,26 +423,7 @@ fn end_stage(
         count += 1;
         over += usize::from(report.over_budget);
         let was = state.as_ref().is_some_and(|s| s.0);
-        if report.over_budget && !was {
-            let strain = report.solver_strain.or(report.max_strain).unwrap_or(0.0);
-            warn!(
-                "{} is over its cloth budget: its accuracy asks for {} substeps, it takes {} \
-                 (its stretch {:.1}%); raise ClothBudget or its ClothPriority to give it more",
-                Named(entity, name),
-                report.needed,
-                report.substeps,
-                strain * 100.0
-            );
-            commands.trigger(ClothOverBudget {
-                entity,
-                needed: report.needed,
-                allowed: report.substeps,
-                strain,
-            });
-        } else if !report.over_budget && was {
-            info!("{} is within its cloth budget again", Named(entity, name));
-            commands.trigger(ClothWithinBudget { entity });
-        }
+        announce(&mut commands, Named(entity, name), &report, was);
         match state {
             Some(mut s) => s.0 = report.over_budget,
             None => {

@@ -114,3 +114,11 @@ impl Particles {
         )
     }
 }
+
+/// Marks particle `i` as moved by contact or self-collision (a slice shorter than the cloth, from stages
+/// called by hand before any step began, marks nothing).
+pub(in crate::solver) fn mark(touched: &mut [bool], i: usize) {
+    if let Some(t) = touched.get_mut(i) {
+        *t = true;
+    }
+}

@@ -39,6 +39,15 @@ fn windy_app() -> App {
     app
 }
 
+/// The cloth's last step report.
+fn last_report(app: &App, e: Entity) -> bevy_cloth::solver::StepReport {
+    app.world()
+        .get::<ClothSimulation>(e)
+        .expect("the cloth is built")
+        .solver
+        .last_report()
+}
+
 #[derive(Resource, Default)]
 struct Seen {
     over: Vec<ClothOverBudget>,
@@ -62,8 +71,7 @@ fn a_cloth_over_its_share_says_so_and_says_when_it_is_back() {
     // The default budget: 4 ms at 200 ns a particle-substep is 20,000
     // particle-substeps, 30 substeps of 651 particles.
     let stats = app.world().get::<ClothStats>(e).cloned();
-    let sim = app.world().get::<ClothSimulation>(e).unwrap();
-    let report = sim.solver.last_report();
+    let report = last_report(&app, e);
     assert_eq!(report.substeps, 30);
     assert!(report.over_budget && report.needed > 30, "{report:?}");
     if let Some(stats) = stats {
@@ -94,12 +102,7 @@ fn a_cloth_over_its_share_says_so_and_says_when_it_is_back() {
     for _ in 0..3 {
         app.update();
     }
-    let report = app
-        .world()
-        .get::<ClothSimulation>(e)
-        .unwrap()
-        .solver
-        .last_report();
+    let report = last_report(&app, e);
     assert!(!report.over_budget && report.substeps > 30, "{report:?}");
     assert_eq!(app.world().resource::<Seen>().within, within + 1);
 }
@@ -152,12 +155,7 @@ fn a_refused_budget_caps_nothing() {
     for _ in 0..20 {
         app.update();
     }
-    let report = app
-        .world()
-        .get::<ClothSimulation>(e)
-        .unwrap()
-        .solver
-        .last_report();
+    let report = last_report(&app, e);
     assert!(report.substeps > 3 && !report.over_budget, "{report:?}");
 }
 

@@ -3,6 +3,7 @@
 //! Coulomb friction against the surface's own motion and sums the reaction each collider
 //! takes.
 
+use crate::solver::state::mark;
 use bevy::math::{Quat, Vec3};
 
 mod collider;
@@ -223,14 +224,6 @@ impl Contact {
                 }
             }
         }
-    }
-}
-
-/// Marks particle `i` as moved by contact (a slice shorter than the cloth, from stages
-/// called by hand before any step began, marks nothing).
-pub(in crate::solver) fn mark(touched: &mut [bool], i: usize) {
-    if let Some(t) = touched.get_mut(i) {
-        *t = true;
     }
 }
 

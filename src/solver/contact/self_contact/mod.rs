@@ -57,8 +57,8 @@ use grid::Grid;
 use bevy::math::{Vec3, Vec3A};
 
 use crate::params::SelfCollision;
-use crate::solver::contact::mark;
 use crate::solver::parallel::{self, CHUNK};
+use crate::solver::state::mark;
 use crate::solver::{Particles, SpringKind, Springs};
 
 /// The self-collision stage's state (see the module doc).
