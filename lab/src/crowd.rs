@@ -12,11 +12,13 @@ use std::time::{Duration, Instant};
 use bevy::math::{Affine3A, Quat, Vec3};
 use serde::Serialize;
 
+use bevy_cloth::headless::WHOLE_STRAIN;
 use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{ClothParams, Environment, Turbulence, WindZone, ZoneShape};
+use bevy_cloth::prelude::ClothBudget;
 use bevy_cloth::solver::shapes::Capsule;
 use bevy_cloth::solver::{
-    self, BackStop, ClothSolver, Collider, ColliderShape, Layout, Motion, ProxyBinding,
+    self, BackStop, BudgetClaim, ClothSolver, Collider, ColliderShape, Layout, Motion, ProxyBinding,
 };
 
 /// How big the crowd is.
@@ -196,6 +198,49 @@ pub struct Crowd {
     size: CrowdSize,
     /// Teleports so far.
     pub teleports: usize,
+    /// A world budget shared among the cloths each step, as the plugin shares it.
+    budget: Option<ClothBudget>,
+    /// The budget's claims and caps, kept for their storage.
+    shares: (Vec<BudgetClaim>, Vec<Option<u32>>),
+    /// What the cloths gave to keep to the budget, since [`Self::count_from_now`].
+    pub gave: Gave,
+}
+
+/// What a crowd's cloths gave to keep to a shared budget: cloth steps that needed more
+/// substeps than their share, and the solver's own strain (the structural stretch its
+/// constraints left, [`StepReport::solver_strain`](bevy_cloth::solver::StepReport))
+/// in those steps and in the others.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Gave {
+    /// Steps over budget, per cloth (capes and skirts in turn, character by character).
+    pub steps: Vec<u32>,
+    /// Cloth steps counted.
+    pub cloth_steps: u64,
+    /// The largest solver strain in a step over budget, and in a step within.
+    pub strain: (f32, f32),
+    /// Cloths the budget can cap (XPBD at automatic substeps); the others take what
+    /// their stability asks for, whatever the budget.
+    pub cappable: usize,
+}
+
+impl Gave {
+    /// Cloths that gave accuracy at least once: capes, skirts.
+    pub fn cloths(&self) -> (usize, usize) {
+        let gave = |k: usize| {
+            self.steps
+                .iter()
+                .skip(k)
+                .step_by(2)
+                .filter(|&&n| n > 0)
+                .count()
+        };
+        (gave(0), gave(1))
+    }
+
+    /// Cloth steps over budget, all told.
+    pub fn total(&self) -> u64 {
+        self.steps.iter().map(|&n| u64::from(n)).sum()
+    }
 }
 
 /// The rest shapes every character's cloths share: the cape's and the skirt's layouts
@@ -390,7 +435,26 @@ impl Crowd {
             time: 0.0,
             size,
             teleports: 0,
+            budget: None,
+            shares: Default::default(),
+            gave: Gave::default(),
         }
+    }
+
+    /// The crowd with a world budget shared among its cloths each step (`None`: each
+    /// takes what its accuracy asks for).
+    pub fn with_budget(mut self, budget: Option<ClothBudget>) -> Self {
+        self.budget = budget;
+        self
+    }
+
+    /// Counts what the cloths give to the budget from the next step on.
+    pub fn count_from_now(&mut self) {
+        self.gave = Gave {
+            steps: vec![0; 2 * self.characters.len()],
+            cappable: self.cloths().filter(|c| c.budget_caps()).count(),
+            ..Gave::default()
+        };
     }
 
     /// Every cloth.
@@ -425,6 +489,7 @@ impl Crowd {
         let start = Instant::now();
         self.step_cloths(pool);
         let step = start.elapsed();
+        self.tally();
         let start = Instant::now();
         let place = self.draw(pool);
         let draw = start.elapsed();
@@ -438,9 +503,55 @@ impl Crowd {
         }
     }
 
+    /// Shares the budget among the cloths from their last steps' needs, as the plugin
+    /// does at the start of a fixed step (every cloth at the same priority).
+    fn share(&mut self) {
+        let Some(budget) = &self.budget else {
+            return;
+        };
+        let (claims, caps) = &mut self.shares;
+        claims.clear();
+        claims.extend(self.characters.iter().flat_map(|c| {
+            [&c.cape.cloth, &c.skirt.cloth].map(|cloth| BudgetClaim::of(cloth, 1.0))
+        }));
+        budget.share(claims, caps);
+        let cloths = self
+            .characters
+            .iter_mut()
+            .flat_map(|c| [&mut c.cape.cloth, &mut c.skirt.cloth]);
+        for (cloth, &cap) in cloths.zip(caps.iter()) {
+            cloth.set_substep_budget(cap);
+        }
+    }
+
+    /// Adds the last step's cloths to [`Self::gave`], once counting has begun.
+    fn tally(&mut self) {
+        if self.gave.steps.is_empty() {
+            return;
+        }
+        let gave = &mut self.gave;
+        for (k, cloth) in self
+            .characters
+            .iter()
+            .flat_map(|c| [&c.cape.cloth, &c.skirt.cloth])
+            .enumerate()
+        {
+            let report = cloth.last_report();
+            let strain = report.solver_strain.unwrap_or(0.0);
+            if report.over_budget {
+                gave.steps[k] += 1;
+                gave.strain.0 = gave.strain.0.max(strain);
+            } else {
+                gave.strain.1 = gave.strain.1.max(strain);
+            }
+            gave.cloth_steps += 1;
+        }
+    }
+
     /// Steps every cloth: side by side on the pool (`solver::run_cloths`, as the plugin
-    /// does), or one after another here.
+    /// does), or one after another here; within the budget's shares, if it has one.
     fn step_cloths(&mut self, pool: bool) {
+        self.share();
         let dt = self.dt;
         let mut cloths: Vec<&mut ClothSolver> = self
             .characters
@@ -555,8 +666,15 @@ pub struct CrowdCost {
     pub strain: [f64; 3],
     /// The substeps of the cloths' last step: fewest, most.
     pub substeps: (u32, u32),
-    /// Whether every cloth stayed stable in both runs.
-    pub stable: bool,
+    /// Whether every cloth held together: in every frame of the pool's run (warm-up
+    /// included) finite and no structural spring past
+    /// [`WHOLE_STRAIN`](bevy_cloth::headless::WHOLE_STRAIN), and finite at the end of
+    /// both runs.
+    pub whole: bool,
+    /// The world budget the cloths shared, ms a step at its planned cost (`None`: none).
+    pub budget_ms: Option<f32>,
+    /// What the pool's cloths gave to keep to it over the timed frames.
+    pub gave: Gave,
 }
 
 /// Medians and ranges of a frame's parts, ms.
@@ -564,6 +682,8 @@ pub struct CrowdCost {
 pub struct PartCosts {
     /// The cloths' step: median, min, max.
     pub step: [f64; 3],
+    /// The step's 99th percentile.
+    pub step_p99: f64,
     /// Driving the bodies.
     pub drive: [f64; 3],
     /// Drawing.
@@ -572,35 +692,57 @@ pub struct PartCosts {
     pub place: [f64; 3],
 }
 
+/// The 99th percentile of `v` (nearest rank).
+fn p99(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let rank = (0.99 * v.len() as f64).ceil() as usize;
+    v[rank.clamp(1, v.len()) - 1]
+}
+
 fn spread(mut v: Vec<f64>) -> [f64; 3] {
     v.sort_by(f64::total_cmp);
     let (least, most) = (v[0], v[v.len() - 1]);
     [super::median(&mut v), least, most]
 }
 
-/// Runs two crowds of `size` with `params` side by side for `warm + frames` frames, one
-/// on one thread and one on the pool, a frame of each in turn (so that the machine's
-/// noise falls on both alike), and gives each part's cost.
-pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize) -> CrowdCost {
-    let mut crowds = [Crowd::new(size, params), Crowd::new(size, params)];
+/// Runs two crowds of `size` with `params` (sharing `budget` among each crowd's cloths,
+/// if given) side by side for `warm + frames` frames, one on one thread and one on the
+/// pool, a frame of each in turn (so that the machine's noise falls on both alike), and
+/// gives each part's cost.
+pub fn measure(
+    size: CrowdSize,
+    params: &ClothParams,
+    budget: Option<ClothBudget>,
+    (warm, frames): (usize, usize),
+) -> CrowdCost {
+    let mut crowds = [0, 1].map(|_| Crowd::new(size, params).with_budget(budget));
     let mut costs: [Vec<FrameCost>; 2] = [Vec::new(), Vec::new()];
-    let mut strains = Vec::new();
+    let (mut strains, mut whole) = (Vec::new(), true);
     for f in 0..warm + frames {
         for (k, crowd) in crowds.iter_mut().enumerate() {
+            if f == warm {
+                crowd.count_from_now();
+            }
             let pool = k == 1;
             solver::set_parallel(pool);
             let cost = crowd.frame(pool);
+            // The two crowds are the same bits: the pool's is checked every frame.
+            if pool {
+                let (strain, stable) = crowd.health();
+                whole &= stable && strain <= WHOLE_STRAIN;
+                if f >= warm {
+                    strains.push(strain as f64);
+                }
+            }
             if f >= warm {
                 costs[k].push(cost);
-                if pool {
-                    strains.push(crowd.health().0 as f64);
-                }
             }
         }
     }
     solver::set_parallel(true);
     let parts = costs.map(|c| PartCosts {
         step: spread(c.iter().map(|c| c.step).collect()),
+        step_p99: p99(c.iter().map(|c| c.step).collect()),
         drive: spread(c.iter().map(|c| c.drive).collect()),
         draw: spread(c.iter().map(|c| c.draw).collect()),
         place: spread(c.iter().map(|c| c.place).collect()),
@@ -619,6 +761,8 @@ pub fn measure(size: CrowdSize, params: &ClothParams, warm: usize, frames: usize
         substeps: crowds[1].cloths().fold((u32::MAX, 0), |(least, most), c| {
             (least.min(c.substeps()), most.max(c.substeps()))
         }),
-        stable: health[0].1 && health[1].1,
+        whole: whole && health[0].1 && health[1].1,
+        budget_ms: budget.and_then(|b| b.milliseconds),
+        gave: crowds[1].gave.clone(),
     }
 }

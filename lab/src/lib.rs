@@ -14,6 +14,7 @@ pub mod fps;
 pub mod peers;
 pub mod soak;
 pub mod stability;
+pub mod storm;
 
 use std::time::Instant;
 

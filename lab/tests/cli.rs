@@ -772,3 +772,90 @@ fn a_refused_set_says_its_key_once() {
         assert!(err.contains("must be"), "{spec}: {err}");
     }
 }
+
+/// `cloth storm`: every cell of a short storm holds together; mass-spring's substeps
+/// stay at its stability bound in any wind, XPBD's follow the wind with accuracy first
+/// and stay within the default budget's 30 (4 ms at 200 ns over 651 particles) inside
+/// it, where the gale's steps give accuracy and strain more.
+#[test]
+fn a_storm_maps_each_model_and_keeps_the_budgeted_flag_to_its_substeps() {
+    let out = run_ok(["storm", "--seconds", "1", "--winds", "0,20", "--json"]);
+    let cells: Vec<serde_json::Value> = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(
+        cells.len(),
+        12,
+        "3 models × 2 winds × self-collision off and on"
+    );
+    let find = |model: &str, wind: f64, on: bool| {
+        cells
+            .iter()
+            .find(|c| c["model"] == model && c["wind"] == wind && c["self_collision"] == on)
+            .unwrap_or_else(|| panic!("no cell {model} {wind} {on}"))
+    };
+    let n = |c: &serde_json::Value, k: &str| c[k].as_f64().unwrap();
+    for c in &cells {
+        assert_eq!(c["whole"], true, "{c}");
+        assert_eq!(c["steps"], 62, "{c}");
+    }
+    for on in [false, true] {
+        let spring = [0.0, 20.0].map(|w| n(find("mass-spring", w, on), "most_substeps"));
+        assert_eq!(
+            spring[0], spring[1],
+            "mass-spring's bound does not see the wind"
+        );
+        let (calm, gale) = (find("xpbd", 0.0, on), find("xpbd", 20.0, on));
+        assert!(
+            n(gale, "most_substeps") > 4.0 * n(calm, "most_substeps"),
+            "accuracy first follows the wind: {calm} {gale}"
+        );
+        assert_eq!(n(gale, "steps_over_budget"), 0.0, "{gale}");
+        let budget = find("xpbd-budget", 20.0, on);
+        assert!(n(budget, "most_substeps") <= 30.0, "{budget}");
+        assert!(n(budget, "steps_over_budget") > 0.0, "{budget}");
+        assert!(
+            n(budget, "largest_strain") > n(gale, "largest_strain"),
+            "within the budget the gale strains the flag more: {budget} {gale}"
+        );
+        let calm_budget = find("xpbd-budget", 0.0, on);
+        assert_eq!(n(calm_budget, "steps_over_budget"), 0.0, "{calm_budget}");
+    }
+}
+
+/// `cloth crowd --budget-ms`: a world budget shared among the crowd's cloths caps each
+/// XPBD cloth's substeps at its share (1 ms of 200 ns particle-substeps over four cloths
+/// of 384 particles: 3 each) and says which cloths gave accuracy; it caps no
+/// mass-spring cloth.
+#[test]
+fn a_crowds_world_budget_caps_its_cloths_and_says_which_gave_accuracy() {
+    let crowd = |budget: Option<&str>, params: &str| {
+        let mut args = vec![
+            "crowd",
+            "--characters",
+            "2",
+            "--frames",
+            "10",
+            "--warm",
+            "5",
+        ];
+        args.extend(["--params", params, "--json"]);
+        if let Some(ms) = budget {
+            args.extend(["--budget-ms", ms]);
+        }
+        let out = run_ok(args);
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).expect("JSON")
+    };
+    let polyester = r#"(model: Xpbd(()), fabric: Some("polyester"))"#;
+    let free = crowd(None, polyester);
+    assert!(free["substeps"][1].as_u64().unwrap() > 3, "{free}");
+    let capped = crowd(Some("1"), polyester);
+    assert_eq!(capped["substeps"], serde_json::json!([3, 3]), "{capped}");
+    let gave = &capped["gave"];
+    assert_eq!(gave["cappable"], 4, "{gave}");
+    assert_eq!(gave["cloth_steps"], 40, "{gave}");
+    assert_eq!(gave["steps"], serde_json::json!([10, 10, 10, 10]), "{gave}");
+    assert!(gave["strain"][0].as_f64().unwrap() > 0.0, "{gave}");
+    assert_eq!(capped["whole"], true);
+    let springs = crowd(Some("1"), "()");
+    assert_eq!(springs["gave"]["cappable"], 0, "{springs}");
+    assert_eq!(springs["gave"]["steps"], serde_json::json!([0, 0, 0, 0]));
+}

@@ -16,8 +16,8 @@ use plotters::coord::cartesian::Cartesian2d;
 use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 
-const FONT: &str = "sans-serif";
-const PALETTE: [RGBColor; 6] = [
+pub(crate) const FONT: &str = "sans-serif";
+pub(crate) const PALETTE: [RGBColor; 6] = [
     RGBColor(200, 40, 40),
     RGBColor(30, 100, 200),
     RGBColor(30, 150, 60),
@@ -26,7 +26,7 @@ const PALETTE: [RGBColor; 6] = [
     RGBColor(0, 160, 170),
 ];
 
-type Result<T> = std::result::Result<T, String>;
+pub(crate) type Result<T> = std::result::Result<T, String>;
 
 fn register_font() -> Result<()> {
     plotters::style::register_font(FONT, FontStyle::Normal, epaint_default_fonts::UBUNTU_LIGHT)
@@ -34,13 +34,13 @@ fn register_font() -> Result<()> {
 }
 
 /// A chart that draws itself on any plotters backend: the PNG and the SVG.
-trait Chart {
+pub(crate) trait Chart {
     fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> Result<()>;
 }
 
 /// Draws `chart` to `png` (checked by [`check_path`] before measuring) and to the same
 /// name with `.svg`.
-fn both(png: &Path, size: (u32, u32), chart: &impl Chart) -> Result<()> {
+pub(crate) fn both(png: &Path, size: (u32, u32), chart: &impl Chart) -> Result<()> {
     register_font()?;
     if let Some(dir) = png.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| format!("--chart {}: {e}", png.display()))?;
@@ -86,7 +86,7 @@ pub fn check_path(png: &Path) -> Result<()> {
 }
 
 /// A log range around `values` with some margin.
-fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
+pub(crate) fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
@@ -100,7 +100,7 @@ fn log_range(values: impl Iterator<Item = f64>) -> Range<f64> {
 
 /// Ticks at 1, 2 and 5 times the powers of ten inside `range` (plotters' log axes label
 /// only the powers, which leaves a narrow range bare).
-fn ticks_125(range: &Range<f64>) -> Vec<f64> {
+pub(crate) fn ticks_125(range: &Range<f64>) -> Vec<f64> {
     let (lo, hi) = (
         range.start.log10().floor() as i32,
         range.end.log10().ceil() as i32,
@@ -112,14 +112,14 @@ fn ticks_125(range: &Range<f64>) -> Vec<f64> {
 }
 
 /// A tick label with as many decimals as the value needs.
-fn tick_label(v: &f64) -> String {
+pub(crate) fn tick_label(v: &f64) -> String {
     let decimals = (-v.log10().floor()).max(0.0) as usize;
     format!("{v:.decimals$}")
 }
 
 /// The legend of a chart's labelled series at `position`, in `size`-point text on a
 /// translucent white box.
-fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+pub(crate) fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
     chart: &mut ChartContext<'a, DB, CT>,
     position: SeriesLabelPosition,
     size: u32,
@@ -169,7 +169,7 @@ fn log_log_panel<'a, DB: DrawingBackend>(
     Ok(chart)
 }
 
-fn err<E: std::fmt::Display>(e: E) -> String {
+pub(crate) fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 

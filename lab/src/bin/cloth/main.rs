@@ -49,6 +49,7 @@ mod peers;
 mod run;
 mod soak;
 mod stability;
+mod storm;
 
 use std::io::Write;
 use std::process::ExitCode;
@@ -97,6 +98,10 @@ enum Verb {
     /// The drape test (Cusick): a 30 cm circle of fabric clamped between 18 cm discs,
     /// its drape coefficient from its shadow, with a picture of the shadows side by side.
     Drape(drape::DrapeArgs),
+    /// Where each method fails in the weather: the flag in air from calm to a gale,
+    /// self-collision off and on, mass-spring, XPBD and XPBD inside the plugin's frame
+    /// budget; each cell's cost, substeps, strain and whether it held together.
+    Storm(storm::StormArgs),
 }
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
@@ -124,6 +129,7 @@ fn main() -> ExitCode {
         Verb::Cantilever(args) => cantilever::cantilever(args),
         Verb::Drape(args) => drape::drape(args),
         Verb::Crowd(args) => crowd::crowd(args),
+        Verb::Storm(args) => storm::storm(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

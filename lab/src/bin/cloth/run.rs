@@ -37,7 +37,7 @@ pub(crate) struct RunArgs {
     #[arg(long)]
     pub(crate) quiet: bool,
     /// Runs inside the plugin's default frame budget (`ClothBudget::default()`: 4 ms a
-    /// step for all cloths, 1 ms for any one) instead of accuracy first.
+    /// step for all cloths, no cap of one cloth's own) instead of accuracy first.
     #[arg(long)]
     pub(crate) budget: bool,
     /// The budget's milliseconds for all cloths a step (implies --budget).
