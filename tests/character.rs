@@ -767,7 +767,9 @@ fn a_back_stop_keeps_a_walking_skirt_off_the_body_without_colliders() {
         radius: 0.3,
     };
     let out = triangles_of(&skirt_cone());
-    let walk = |stopped: bool, inward: bool| -> f32 {
+    // The deepest any particle went into its back stop, and the frames measured (the
+    // frames after the skirt's simulation was built).
+    let walk = |stopped: bool, inward: bool| -> (f32, usize) {
         let mut app = bevy_cloth::headless::headless_app();
         let hip_rest = Transform::from_xyz(0.0, 0.92, 0.0);
         let hips = app.world_mut().spawn(hip_rest).id();
@@ -795,7 +797,7 @@ fn a_back_stop_keeps_a_walking_skirt_off_the_body_without_colliders() {
             });
         }
         let skirt = skirt.id();
-        let mut deepest = f32::MIN;
+        let (mut deepest, mut measured) = (f32::MIN, 0);
         for frame in 0..360 {
             let t = frame as f32 / 60.0;
             let tau = std::f32::consts::TAU;
@@ -819,14 +821,24 @@ fn a_back_stop_keeps_a_walking_skirt_off_the_body_without_colliders() {
                 &normals,
                 stop,
             ));
+            measured += 1;
         }
-        deepest
+        (deepest, measured)
     };
-    let (deepest, inward, free) = (walk(true, false), walk(true, true), walk(false, false));
+    let runs = [walk(true, false), walk(true, true), walk(false, false)];
+    let [(deepest, _), (inward, _), (free, _)] = runs;
     eprintln!(
         "deepest into a back stop over 6 s: {deepest} m, wound inward with normals out \
-         {inward} m (without back stops {free} m)"
+         {inward} m (without back stops {free} m); frames measured {:?}",
+        runs.map(|r| r.1)
     );
+    // Each skirt built on its first frame, and measured on every one after.
+    for (_, measured) in runs {
+        assert!(
+            measured >= 359,
+            "the skirt was measured in {measured} of 360 frames"
+        );
+    }
     assert!(
         deepest <= 1e-4,
         "a skirt particle went {deepest} m into its back stop"
@@ -942,7 +954,7 @@ fn a_plain_mesh_keeps_within_its_painted_distances_of_its_frame() {
             Transform::from_xyz(0.0, 1.0, 0.0),
         ))
         .id();
-    let (mut pinned_off, mut over) = (0.0f32, f32::MIN);
+    let (mut pinned_off, mut over, mut measured) = (0.0f32, f32::MIN, 0);
     for frame in 0..120 {
         let t = frame as f32 / 60.0;
         let place = Transform::from_xyz(t, 1.0, 0.0).with_rotation(Quat::from_rotation_y(t));
@@ -959,8 +971,13 @@ fn a_plain_mesh_keeps_within_its_painted_distances_of_its_frame() {
                 over = over.max(off - distance[k]);
             }
         }
+        measured += 1;
     }
-    eprintln!("distance 0: {pinned_off} m off; the rest: {over} m over");
+    eprintln!("distance 0: {pinned_off} m off; the rest: {over} m over; {measured} frames");
+    assert!(
+        measured >= 119,
+        "the cloth was measured in {measured} of 120 frames"
+    );
     assert!(
         pinned_off <= 1e-5,
         "the top row is {pinned_off} m off its frame"

@@ -185,10 +185,16 @@ fn a_swinging_inextensible_chain_stays_within_half_a_percent() {
     assert!(worst < 5e-3, "strain while swinging {:.4}%", worst * 100.0);
 }
 
-/// Tethers (long-range attachments) on an inextensible chain.
+/// Tethers (long-range attachments) on an inextensible chain, its links swept: solved
+/// along their line the links alone hold the chain (below), so only a sweep shows what
+/// the tethers do.
 fn tethered(substeps: u32) -> ClothParams {
     ClothParams {
-        model: Model::Xpbd(XpbdParams::default()),
+        model: Model::Xpbd(XpbdParams {
+            tethers: true,
+            solve: XpbdSolve::Sweep,
+            ..XpbdParams::default()
+        }),
         drag: 2e-3,
         ..xpbd(f32::INFINITY, 1e-3, substeps)
     }

@@ -397,7 +397,7 @@ mod tests {
     }
 
     /// The noise stays in [−1, 1], is continuous across lattice cells, averages about
-    /// 0, and depends on its seed.
+    /// 0, depends on its seed and passes through the lattice's values.
     #[test]
     fn noise_is_bounded_smooth_and_seeded() {
         let (mut sum, mut n) = (0.0f64, 0);
@@ -413,7 +413,11 @@ mod tests {
         assert!((sum / n as f64).abs() < 0.1, "mean {}", sum / n as f64);
         let p = Vec3::new(0.3, 1.7, 2.2);
         assert_ne!(noise3(1, p), noise3(2, p));
-        assert_eq!(noise3(1, p), noise3(1, p));
+        // At a lattice point it is that point's value, in every direction.
+        for (x, y, z) in [(2, -3, 5), (-1, 0, 7), (0, 0, 0)] {
+            let at = Vec3::new(x as f32, y as f32, z as f32);
+            assert_eq!(noise3(1, at), lattice(1, x, y, z), "at {at}");
+        }
         assert!((noise1(3, 4.999_9) - noise1(3, 5.0)).abs() < 1e-3);
     }
 
