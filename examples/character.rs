@@ -346,7 +346,7 @@ fn setup(
             .with_pins(ClothPins::None)
             .with_params(ClothParams {
                 node_mass: 2e-4,
-                ..default()
+                ..ClothParams::seeds()
             }),
         // Never more than 2 cm into the body, however the hips turn.
         ClothBackStop::Uniform {
@@ -370,7 +370,7 @@ fn setup(
             .with_pins(ClothPins::None)
             .with_params(ClothParams {
                 node_mass: 2e-4,
-                ..default()
+                ..ClothParams::seeds()
             }),
         Transform::from_xyz(RADIUS, HIP + SPINE + 0.2, -0.19),
         ClothAttachments(vec![ClothAttachment::indices(spine, (0..width).collect())]),

@@ -272,7 +272,7 @@ fn walk(time: Res<Time>, mut characters: Query<(&mut Walk, &mut Transform)>) {
     }
 }
 
-/// The crowd's cloths: the default mass-spring, its strain limiter sweeping until every
+/// The crowd's cloths: the seeds' mass-spring (`ClothParams::seeds`), its strain limiter sweeping until every
 /// spring is within 1% of its limit, at most eight times, rather than always taking four.
 /// Most of the crowd is calm and stops after one sweep; the capes in the gusts take more.
 /// Against four sweeps always, `cloth crowd` measured 0.8 of the cost at the same strain;
@@ -281,6 +281,6 @@ fn params() -> ClothParams {
     ClothParams {
         strain_limit_tolerance: Some(0.01),
         strain_limit_iterations: 8,
-        ..default()
+        ..ClothParams::seeds()
     }
 }

@@ -104,7 +104,7 @@ fn setup(
     commands.spawn((
         Cloth::grid(WIDTH, HEIGHT, SPACING).with_params(ClothParams {
             node_mass: 3e-4,
-            ..default()
+            ..ClothParams::seeds()
         }),
         Transform::from_xyz(1.0 + POLE_RADIUS + 0.015 + half, POLE_TOP - 0.02, 0.0),
         ClothAttachments(vec![ClothAttachment::indices(pole, edge)]),

@@ -70,7 +70,7 @@ fn setup(
                     .with_pins(ClothPins::Indices(edge.clone()))
                     .with_params(ClothParams {
                         node_mass: 3e-4,
-                        ..default()
+                        ..ClothParams::seeds()
                     }),
                 Transform::from_xyz(x + POLE_RADIUS + 0.015 + half, POLE_TOP - 0.02, z),
                 MeshMaterial3d(materials.add(StandardMaterial {

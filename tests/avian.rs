@@ -19,7 +19,7 @@ fn rest_on(collider: bevy_cloth::solver::Collider, start: Vec3) -> Vec3 {
         &[],
         &ClothParams {
             drag: 0.0,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         },
         Affine3A::IDENTITY,
     )
@@ -196,7 +196,7 @@ fn run_cape(self_collision: bool) -> CapeRun {
         ))
         .id();
     let (width, height) = (12, 14);
-    let mut params = ClothParams::default();
+    let mut params = ClothParams::seeds();
     params.self_collision.enabled = self_collision;
     let cape = app
         .world_mut()
@@ -334,7 +334,7 @@ fn hammock_holds_a_ball(child_collider: bool) {
                 .with_pins(ClothPins::Indices(vec![0, n - 1, n * (n - 1), n * n - 1]))
                 .with_params(ClothParams {
                     drag: 0.02,
-                    ..ClothParams::default()
+                    ..ClothParams::seeds()
                 }),
             Transform::from_xyz(0.0, 1.0, -0.375)
                 .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2)),

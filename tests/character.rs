@@ -30,11 +30,7 @@ fn free_grid(width: u32, height: u32) -> bevy_cloth::solver::ClothSolver {
         spacing: 0.05,
     };
     shape
-        .build_solver(
-            &ClothPins::None,
-            &ClothParams::default(),
-            Affine3A::IDENTITY,
-        )
+        .build_solver(&ClothPins::None, &ClothParams::seeds(), Affine3A::IDENTITY)
         .unwrap()
 }
 
@@ -220,7 +216,7 @@ fn distances_painted_anew_attach_and_let_go_the_right_particles() {
     let mut cloth = shape
         .build_solver(
             &ClothPins::Indices(vec![5]),
-            &ClothParams::default(),
+            &ClothParams::seeds(),
             // Lying flat, so that a particle let go falls.
             Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2),
         )
@@ -1825,7 +1821,7 @@ fn bad_teleport_thresholds_are_refused() {
     ] {
         let params = ClothParams {
             teleport,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         match params.validate() {
             Err(ClothError::InvalidParameter { field: f, .. }) => assert_eq!(f, field),
@@ -1888,7 +1884,7 @@ fn a_spinning_character_keeps_its_cape_with_half_inertia() {
         strain_limit: Some(limit),
         strain_limit_tolerance: Some(0.002),
         strain_limit_iterations: 64,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let spun = |params: ClothParams, share: f32| {
         let inertia = Inertia::scaled(share);
@@ -1903,7 +1899,7 @@ fn a_spinning_character_keeps_its_cape_with_half_inertia() {
     assert!(half <= limit + 0.01, "half inertia: {half}");
     assert!(local <= limit + 0.005, "fully local: {local}");
     assert!(world > limit + 0.01, "world space is flung out: {world}");
-    let default = ClothParams::default();
+    let default = ClothParams::seeds();
     let [world, half, local] = [1.0, 0.5, 0.0].map(|share| spun(default, share));
     eprintln!("four limiter sweeps: world {world:.4}, half {half:.4}, local {local:.4}");
     assert!(local < half && half < 0.6 * world);
@@ -1939,7 +1935,7 @@ fn bad_inertia_is_refused() {
     ] {
         let params = ClothParams {
             inertia,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         match params.validate() {
             Err(ClothError::InvalidParameter { field: f, .. }) => assert_eq!(f, field),
@@ -1949,7 +1945,7 @@ fn bad_inertia_is_refused() {
     let patches = ClothParams {
         model: Model::Patches(Default::default()),
         inertia: Inertia::scaled(0.5),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     assert!(matches!(
         patches.validate(),
@@ -1988,11 +1984,11 @@ fn a_cape_past_its_speed_cap_is_carried_as_if_standing() {
             max_speed: 0.0,
             ..Inertia::WORLD
         },
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
-    let standing = run(ClothParams::default(), 0.0);
+    let standing = run(ClothParams::seeds(), 0.0);
     let carried = run(capped, 20.0);
-    let streamed = run(ClothParams::default(), 20.0);
+    let streamed = run(ClothParams::seeds(), 20.0);
     let apart = |a: &[Vec3], b: &[Vec3]| {
         a.iter()
             .zip(b)

@@ -36,7 +36,7 @@ fn lying_cloth(model: Model, substeps: u32, y: f32) -> ClothSolver {
         model,
         substeps: Substeps::Fixed(substeps),
         drag: 0.0,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let frame = Affine3A::from_rotation_translation(
         Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
@@ -86,7 +86,7 @@ fn particle(at: Vec3, substeps: u32) -> ClothSolver {
     let params = ClothParams {
         substeps: Substeps::Fixed(substeps),
         drag: 0.0,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     ClothSolver::new(
         Layout::from_springs(&[at], &[]).unwrap(),
@@ -195,7 +195,7 @@ fn a_ball_fired_through_a_curtain_at_20_m_s_leaves_no_particle_inside_it() {
     let params = ClothParams {
         model: Model::Xpbd(XpbdParams::default()),
         substeps: Substeps::Fixed(1),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let mut cloth = Cloth::grid(24, 24, 0.05)
         .shape
@@ -261,7 +261,7 @@ fn a_cloth_dropped_across_a_rope_hangs_over_it() {
     ] {
         let params = ClothParams {
             model,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         let frame = Affine3A::from_rotation_translation(
             Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
@@ -363,7 +363,7 @@ fn edge_first_drop(model: Model, substeps: Substeps, below: Collider) -> (f32, f
     let params = ClothParams {
         model,
         substeps,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     // Tilted 2° out of its plane, as any real drop is: a sheet exactly upright balanced
     // on its edge has no way to fall but in its own plane, pivoting about the rope.
@@ -449,7 +449,7 @@ fn a_level_cloth_dropped_onto_a_rope_at_5_m_s_hangs_over_it() {
         let params = ClothParams {
             model,
             drag: 0.0,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         let frame = Affine3A::from_rotation_translation(
             Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2),
@@ -490,7 +490,7 @@ fn fastest(cloth: &ClothSolver) -> f32 {
 fn started_through_a_ball(model: Model) -> (Option<usize>, f32) {
     let params = ClothParams {
         model,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     assert_eq!(params.max_depenetration_speed, 1.0);
     let frame = Affine3A::from_translation(Vec3::new(0.0, 1.0, 0.0));
@@ -575,7 +575,7 @@ fn a_cape_spawned_5_cm_into_its_capsule_is_out_within_10_steps() {
     // cap, out within 10 steps.
     let params = ClothParams {
         model: Model::Xpbd(XpbdParams::default()),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let (width, spacing) = (14, 0.045);
     // The grid hangs in a plane 0.25 m behind the axis: 5 cm inside the back.

@@ -40,7 +40,7 @@ fn hung(fabric: Fabric, side: u32, model: Model) -> ClothSolver {
         fabric: Some(fabric),
         drag: 2.0 * fabric.areal_density * spacing * spacing,
         strain_limit: None,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let shape = ClothShape::Grid {
         width: side,
@@ -103,7 +103,7 @@ fn models_without_springs_and_clothes_without_triangles_refuse_a_fabric() {
     let params = ClothParams {
         model: Model::ShapeMatching(ShapeMatchingParams::default()),
         fabric: Some(Fabric::DENIM),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     assert!(matches!(
         params.validate(),
@@ -112,7 +112,7 @@ fn models_without_springs_and_clothes_without_triangles_refuse_a_fabric() {
     let rope = Layout::from_springs(&[Vec3::ZERO, Vec3::X], &[[0, 1]]).unwrap();
     let params = ClothParams {
         fabric: Some(Fabric::DENIM),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let e = ClothSolver::new(rope, &[], &params, Affine3A::IDENTITY).unwrap_err();
     assert!(matches!(e, ClothError::FabricNeedsSurface), "{e}");
@@ -136,7 +136,7 @@ fn level_sheet(fabric: Fabric, side: u32, air: Air, steps: usize, pins: ClothPin
     let params = ClothParams {
         fabric: Some(fabric),
         drag: 0.0,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let shape = ClothShape::Grid {
         width: side,
@@ -240,7 +240,7 @@ fn the_lightest_seed_material_in_the_curtains_air_keeps_its_strain_limit() {
     let params = ClothParams {
         model: Model::Xpbd(Default::default()),
         node_mass: 1e-6,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let shape = ClothShape::Grid {
         width: 40,
@@ -313,7 +313,7 @@ fn a_fabric_set_on_a_built_cloth_bends_like_one_built_with_it() {
     // The hinges are built when a fabric first arrives, at build or by `set_params`.
     let params = ClothParams {
         fabric: Some(Fabric::DENIM),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let shape = ClothShape::Grid {
         width: 9,
@@ -326,7 +326,7 @@ fn a_fabric_set_on_a_built_cloth_bends_like_one_built_with_it() {
         .build_solver(&ClothPins::TopRow, &params, level)
         .unwrap();
     let mut later = shape
-        .build_solver(&ClothPins::TopRow, &ClothParams::default(), level)
+        .build_solver(&ClothPins::TopRow, &ClothParams::seeds(), level)
         .unwrap();
     later.set_params(&params).unwrap();
     let env = Environment::default();
@@ -366,7 +366,7 @@ fn a_fabric_too_light_for_its_spacing_is_refused() {
             areal_density: density,
             ..Fabric::DENIM
         }),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let error = shape
         .build_solver(&ClothPins::TopRow, &params(1e-9), Affine3A::IDENTITY)
@@ -399,7 +399,7 @@ fn a_fabric_meets_still_air_unless_told_otherwise() {
             fabric,
             still_air,
             drag: 0.0,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         let shape = ClothShape::Grid {
             width: 6,

@@ -311,7 +311,7 @@ fn mutated_garments_and_patterns_load_cleanly_or_fail_cleanly() {
             }
             Ok(layout) => {
                 loaded += 1;
-                let params = ClothParams::default();
+                let params = ClothParams::seeds();
                 if let Ok(mut cloth) =
                     ClothSolver::new(layout.into_layout(), &[], &params, Affine3A::IDENTITY)
                 {

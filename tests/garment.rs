@@ -325,7 +325,7 @@ fn broken_garments_name_the_file_and_what_is_wrong() {
 fn drop_particle(start: Vec3, collider: Collider, seconds: f32) -> ClothSolver {
     let params = ClothParams {
         drag: 0.0,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let mut cloth = ClothSolver::new(
         Layout::from_springs(&[start], &[]).unwrap(),
@@ -946,7 +946,7 @@ fn named_runs_list_their_particles_and_bad_ones_are_refused() {
         let solver = ClothSolver::new(
             layout.clone().into_layout(),
             &[],
-            &ClothParams::default(),
+            &ClothParams::seeds(),
             Affine3A::IDENTITY,
         )
         .unwrap();

@@ -14,7 +14,7 @@ fn curtain() -> ClothSolver {
 fn curtain_of(model: Model) -> ClothSolver {
     let params = ClothParams {
         model,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     ClothShape::Grid {
         width: 10,

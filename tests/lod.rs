@@ -34,7 +34,10 @@ fn scene(distance: f32) -> (App, Entity, Entity) {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(24, 24, 0.05).with_pins(ClothPins::TopRow),
+            Cloth::grid(24, 24, 0.05)
+                .with_pins(ClothPins::TopRow)
+                // The patch model takes no fabric: the seeds' springs.
+                .with_params(ClothParams::seeds()),
             ClothLod::default(),
             ClothSleep::never(),
             Transform::from_xyz(0.0, 2.0, 0.0),
@@ -208,7 +211,7 @@ fn a_settled_cloth_switches_without_a_jump() {
     for (from, to) in [(0, 2), (2, 4), (4, 8), (8, 4), (4, 2), (2, 0)] {
         let params = ClothParams {
             model: model(from),
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         let build = || {
             shape
@@ -263,7 +266,10 @@ fn an_app_without_level_of_detail_keeps_the_cloths_model() {
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(24, 24, 0.05).with_pins(ClothPins::TopRow),
+            Cloth::grid(24, 24, 0.05)
+                .with_pins(ClothPins::TopRow)
+                // The patch model takes no fabric: the seeds' springs.
+                .with_params(ClothParams::seeds()),
             ClothLod::default(),
             Transform::from_xyz(0.0, 2.0, 0.0),
         ))
@@ -292,11 +298,11 @@ fn an_app_without_level_of_detail_keeps_the_cloths_model() {
 fn a_cloth_the_patch_model_refuses_keeps_its_model_far_away() {
     let self_colliding = ClothParams {
         self_collision: SelfCollision::on(),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let denim = ClothParams {
         fabric: Some(Fabric::DENIM),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     for params in [self_colliding, denim] {
         let (mut app, cloth, camera) = scene(1.5);

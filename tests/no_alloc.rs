@@ -89,7 +89,7 @@ fn steps_allocate_nothing() {
             damping: 0.001,
             ..SpringParams::default()
         },
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let mut cloth = grid_cloth(&params);
     let env = Environment {
@@ -127,7 +127,7 @@ fn patch_steps_allocate_nothing_even_with_a_state_dependent_pull() {
     });
     let mut cloth = grid_cloth(&ClothParams {
         model,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     });
     let env = Environment::default();
     cloth.step(0.016, &env); // warm-up: the patch lattice is built on the first step
@@ -148,7 +148,7 @@ fn self_collision_steps_allocate_nothing() {
     let _alone = COUNTING.lock().unwrap_or_else(|e| e.into_inner());
     let params = ClothParams {
         self_collision: SelfCollision::on(),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let shape = ClothShape::Grid {
         width: 16,
@@ -190,7 +190,7 @@ fn a_large_cloth_on_the_pool_allocates_nothing_on_its_threads() {
     let _alone = COUNTING.lock().unwrap_or_else(|e| e.into_inner());
     let params = ClothParams {
         substeps: bevy_cloth::params::Substeps::Fixed(4),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let shape = ClothShape::Grid {
         width: 128,

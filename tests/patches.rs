@@ -59,7 +59,7 @@ fn one_by_one_parts_reduce_to_the_mass_spring_model() {
             damping: 0.001,
             ..SpringParams::default()
         },
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let env = Environment {
         wind: Wind {
@@ -117,7 +117,7 @@ fn undeformed_targets_are_the_rest_positions() {
                     gh,
                     ClothParams {
                         model: Model::Patches(p),
-                        ..ClothParams::default()
+                        ..ClothParams::seeds()
                     },
                     ClothPins::None,
                     Affine3A::IDENTITY,
@@ -157,7 +157,7 @@ fn rigidly_moved_cloths_have_targets_on_their_particles() {
                 gh,
                 ClothParams {
                     model: Model::Patches(patch(w, h)),
-                    ..ClothParams::default()
+                    ..ClothParams::seeds()
                 },
                 ClothPins::None,
                 motion,
@@ -273,7 +273,7 @@ fn patches_need_a_grid_and_valid_sizes() {
     let bad = |p: PatchParams| {
         (ClothParams {
             model: Model::Patches(p),
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         })
         .validate()
     };
@@ -289,7 +289,7 @@ fn patches_need_a_grid_and_valid_sizes() {
     let positions = [Vec3::ZERO, Vec3::X, Vec3::Y];
     let params = ClothParams {
         model: Model::Patches(patch(2, 2)),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     assert!(
         ClothSolver::new(
@@ -307,7 +307,7 @@ fn switching_to_patches_mid_motion_keeps_the_cloth_in_place_and_grabs_pull_parts
     let mut c = grid(
         16,
         12,
-        ClothParams::default(),
+        ClothParams::seeds(),
         ClothPins::TopCorners,
         Affine3A::IDENTITY,
     );
@@ -347,7 +347,7 @@ fn torn_part_springs_split_the_drawn_cloth() {
         model: Model::Patches(patch(4, 4)),
         tear_ratio: Some(1.3),
         strain_limit: None,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let mut c = grid(16, 16, params, ClothPins::TopRow, Affine3A::IDENTITY);
     let env = Environment {
@@ -375,7 +375,7 @@ fn a_free_falling_patch_cloth_falls_like_the_mass_spring_cloth() {
     let base = ClothParams {
         drag: 0.0,
         substeps: Substeps::Fixed(10),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let env = Environment::default();
     let start = grid(16, 16, base, ClothPins::None, Affine3A::IDENTITY)
@@ -423,7 +423,7 @@ fn tiles_skip_the_pull_and_take_only_the_lattices_substeps() {
             stiffness: 2000.0,
             ..patch(4, 4)
         }),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let env = Environment::default();
     let mut pulled = grid(16, 16, params(false), ClothPins::TopRow, Affine3A::IDENTITY);
@@ -460,7 +460,7 @@ fn a_cloth_one_part_across_resists_stretch_along_that_axis() {
         4,
         ClothParams {
             model: Model::Patches(patch(4, 4)),
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         },
         ClothPins::None,
         Affine3A::IDENTITY,
@@ -498,7 +498,7 @@ fn sag(model: Model) -> f32 {
             damping: 0.002,
             ..SpringParams::default()
         },
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let mut c = grid(16, 16, params, ClothPins::TopRow, Affine3A::IDENTITY);
     let bottom = |c: &ClothSolver| c.positions()[16 * 15..].iter().map(|p| p.y).sum::<f32>() / 16.0;
@@ -546,7 +546,7 @@ fn pins_hold_particles_and_their_parts_swing_about_them() {
         16,
         ClothParams {
             model: Model::Patches(patch(8, 8)),
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         },
         ClothPins::TopCorners,
         Affine3A::IDENTITY,
@@ -593,7 +593,7 @@ fn part_centres_meet_the_colliders() {
         16,
         ClothParams {
             model: Model::Patches(patch(4, 4)),
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         },
         ClothPins::None,
         flat,

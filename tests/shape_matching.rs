@@ -46,7 +46,7 @@ fn card(params: ShapeMatchingParams, pins: ClothPins) -> ClothSolver {
         model: Model::ShapeMatching(params),
         node_mass: 2e-5,
         drag: 0.0,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     ClothShape::Grid {
         width: 8,
@@ -145,7 +145,7 @@ fn degenerate_shapes_give_finite_goals() {
             // A straight strip of particles (rank-1 A_pq).
             let strip_params = ClothParams {
                 model: Model::ShapeMatching(params),
-                ..ClothParams::default()
+                ..ClothParams::seeds()
             };
             let positions: Vec<Vec3> = (0..6)
                 .map(|i| Vec3::new(i as f32 * 0.01, 0.0, 0.0))
@@ -360,7 +360,7 @@ fn larger_exponents_return_faster_from_far_and_slower_from_near() {
 fn bad_shape_matching_parameters_name_their_field() {
     let field = |params: ShapeMatchingParams| match (ClothParams {
         model: Model::ShapeMatching(params),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     })
     .validate()
     {
@@ -422,7 +422,7 @@ fn shape_matching_works_with_pins_gravity_and_wind_and_never_tears() {
         model: Model::ShapeMatching(params),
         node_mass: 2e-5,
         tear_ratio: Some(1.01),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let mut c = ClothShape::Grid {
         width: 8,

@@ -23,7 +23,7 @@ fn sleeping_curtain() -> (App, Entity, Entity) {
     let mut app = bevy_cloth::headless::headless_app();
     let params = ClothParams {
         drag: 2e-2,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let cloth = app
         .world_mut()

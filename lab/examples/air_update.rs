@@ -27,7 +27,7 @@ fn run(update: AirUpdate, wind: Vec3, flag: bool, model: Model) -> Outcome {
     let params = ClothParams {
         model,
         fabric: Some(Fabric::POLYESTER),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let pins = if flag {
         ClothPins::Indices((0..HEIGHT).map(|j| j * WIDTH).collect())

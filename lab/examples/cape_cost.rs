@@ -59,7 +59,7 @@ fn run(solve: XpbdSolve, substeps: Substeps) -> Run {
         }),
         fabric: Some(Fabric::DENIM),
         substeps,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let (turn, at) = body(0.0);
     let frame = Affine3A::from_rotation_translation(turn, at + turn * collar(WIDTH / 2));

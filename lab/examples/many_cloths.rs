@@ -20,7 +20,7 @@ fn params() -> ClothParams {
     ClothParams {
         model: Model::Xpbd(XpbdParams::default()),
         substeps: Substeps::Fixed(10),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     }
 }
 

@@ -26,11 +26,7 @@ fn main() {
             spacing: 0.02,
         };
         let mut solver = shape
-            .build_solver(
-                &ClothPins::None,
-                &ClothParams::default(),
-                Affine3A::IDENTITY,
-            )
+            .build_solver(&ClothPins::None, &ClothParams::seeds(), Affine3A::IDENTITY)
             .expect("a grid builds");
         let rest = solver.positions().to_vec();
         let distance = vec![0.0; rest.len()];

@@ -35,11 +35,7 @@ fn main() {
         height: h,
         spacing: 0.04,
     }
-    .build_solver(
-        &ClothPins::None,
-        &ClothParams::default(),
-        Affine3A::IDENTITY,
-    )
+    .build_solver(&ClothPins::None, &ClothParams::seeds(), Affine3A::IDENTITY)
     .expect("a grid builds");
     let (rest, tris) = (cape.rest_positions(), cape.triangles());
     let fine = refined(rest, w, h, k);

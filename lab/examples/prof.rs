@@ -18,7 +18,7 @@ fn main() {
         let params = ClothParams {
             strain_limit: limit,
             strain_limit_iterations: iters,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         let (w, h) = bevy_cloth_lab::grid_for(n);
         let shape = ClothShape::Grid {

@@ -156,7 +156,7 @@ impl BareGrid {
 /// The bare kernel's median ns per particle-substep on a `count`-particle grid: `repeats`
 /// timings of 8 substeps each (one 16 ms step of the default curtain), after a warm-up.
 pub fn ns_per_particle_substep(count: usize, repeats: usize) -> f64 {
-    let params = bevy_cloth::params::ClothParams::default();
+    let params = bevy_cloth::params::ClothParams::seeds();
     let k = params.springs.structural.stiffness;
     let mut grid = BareGrid::new(count, 0.05, params.node_mass, k);
     for _ in 0..8 {

@@ -200,7 +200,7 @@ fn strip_params(fabric: Fabric, model: StripModel, spacing: f32, rate: f32) -> C
         substeps: Substeps::Auto { max: 8192 },
         strain_limit: None,
         drag: rate * fabric.areal_density * spacing * spacing,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     }
 }
 

@@ -626,14 +626,14 @@ fn each_character(
     solver::share_items(each, |(k, c)| work(k, c));
 }
 
-/// The crowd's cloths, as the example's: the default mass-spring, its strain limiter
+/// The crowd's cloths, as the example's: the seeds' mass-spring, its strain limiter
 /// sweeping until every spring is within 1% of its limit, at most eight times (most of
 /// the crowd is calm and stops after one; the capes in the gusts take more).
 pub fn params() -> ClothParams {
     ClothParams {
         strain_limit_tolerance: Some(0.01),
         strain_limit_iterations: 8,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     }
 }
 

@@ -142,7 +142,7 @@ fn specimen(
         substeps: Substeps::Auto { max: 8192 },
         strain_limit: None,
         drag: 5.0 * fabric.areal_density * spacing * spacing,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     // Level: the local xy plane turned to the ground's, 1 m up.
     let level = Affine3A::from_rotation_translation(

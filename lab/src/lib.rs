@@ -77,7 +77,7 @@ pub fn seed_model_params(model: &str) -> Option<ClothParams> {
         "1" => Model::MassSpring,
         "2" => Model::ShapeMatching(ShapeMatchingParams {
             stiffness: SHAPE_MATCHING_STIFFNESS_FACTOR
-                * ClothParams::default().springs.structural.stiffness,
+                * ClothParams::seeds().springs.structural.stiffness,
             ..ShapeMatchingParams::default()
         }),
         "3a" => patches(2),
@@ -88,7 +88,7 @@ pub fn seed_model_params(model: &str) -> Option<ClothParams> {
     };
     Some(ClothParams {
         model,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     })
 }
 

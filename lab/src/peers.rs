@@ -425,7 +425,7 @@ pub fn ours_params(substeps: u32, tethers: bool, lines: bool) -> ClothParams {
         drag: DAMPING_RATE * NODE_MASS,
         substeps: Substeps::Fixed(substeps),
         strain_limit: None,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     params.springs.structural = SpringFamily::new(f32::INFINITY);
     params.springs.shear = SpringFamily::new(f32::INFINITY);

@@ -303,8 +303,9 @@ fn dumps_are_the_same_bits_on_one_thread_and_on_all() {
     assert!(dumps[0] == dumps[1], "the dumps differ");
 }
 
-/// A small curtain scene for `cloth choose` (8×6, corner pins, no wind).
-const SMALL_SCENE: &str = "(timestep: 0.016, cloths: [(name: \"small curtain\", translation: (0.0, 2.0, 0.0), cloth: (shape: Grid(width: 8, height: 6, spacing: 0.05), pins: TopCorners))])";
+/// A small curtain scene for `cloth choose` (8×6, corner pins, no wind), on the seeds'
+/// springs so that every model applies.
+const SMALL_SCENE: &str = "(timestep: 0.016, cloths: [(name: \"small curtain\", translation: (0.0, 2.0, 0.0), cloth: (shape: Grid(width: 8, height: 6, spacing: 0.05), pins: TopCorners, params: (model: MassSpring, fabric: None)))])";
 
 /// `cloth choose` on the small scene with `goal` (`--max-error E` or `--budget-ms B`):
 /// its JSON, and the scene it wrote.
@@ -855,7 +856,7 @@ fn a_crowds_world_budget_caps_its_cloths_and_says_which_gave_accuracy() {
     assert_eq!(gave["steps"], serde_json::json!([10, 10, 10, 10]), "{gave}");
     assert!(gave["strain"][0].as_f64().unwrap() > 0.0, "{gave}");
     assert_eq!(capped["whole"], true);
-    let springs = crowd(Some("1"), "()");
+    let springs = crowd(Some("1"), "(model: MassSpring, fabric: None)");
     assert_eq!(springs["gave"]["cappable"], 0, "{springs}");
     assert_eq!(springs["gave"]["steps"], serde_json::json!([0, 0, 0, 0]));
 }

@@ -406,7 +406,7 @@ mod tests {
             }
             .build_solver(
                 &ClothPins::None,
-                &crate::params::ClothParams::default(),
+                &crate::params::ClothParams::seeds(),
                 Affine3A::IDENTITY,
             )
             .unwrap()

@@ -399,7 +399,7 @@ mod tests {
         let mut cloth = shape
             .build_solver(
                 &ClothPins::None,
-                &crate::params::ClothParams::default(),
+                &crate::params::ClothParams::seeds(),
                 bevy::math::Affine3A::IDENTITY,
             )
             .unwrap();

@@ -16,7 +16,7 @@ pub fn lying_cloth(centre: Vec3) -> (Cloth, Transform) {
         .with_pins(ClothPins::None)
         .with_params(ClothParams {
             drag: 0.0,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         });
     let place = Transform::from_translation(centre)
         .with_rotation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2));
@@ -129,9 +129,9 @@ pub fn app() -> App {
     bevy_cloth::headless::headless_app()
 }
 
-/// Default parameters: automatic substeps keep them stable.
+/// The seeds' parameters (`ClothParams::seeds`): automatic substeps keep them stable.
 pub fn quiet_params() -> ClothParams {
-    ClothParams::default()
+    ClothParams::seeds()
 }
 
 pub fn sim_time(app: &App, e: Entity) -> f32 {

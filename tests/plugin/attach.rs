@@ -6,8 +6,9 @@ use bevy_cloth::prelude::*;
 
 use crate::common::*;
 
-/// A "shoulder" entity 2 m up and an 8 × 6 cloth (5 cm, no pins) beside it, held by the
-/// attachments `held` makes for the shoulder: (shoulder, cloth).
+/// A "shoulder" entity 2 m up and an 8 × 6 cloth (5 cm, no pins, the seeds' springs: let
+/// go, it falls as in a vacuum) beside it, held by the attachments `held` makes for the
+/// shoulder: (shoulder, cloth).
 fn cloth_on_a_shoulder(
     app: &mut App,
     held: impl FnOnce(Entity) -> Vec<ClothAttachment>,
@@ -17,7 +18,9 @@ fn cloth_on_a_shoulder(
     let cloth = app
         .world_mut()
         .spawn((
-            Cloth::grid(8, 6, 0.05).with_pins(ClothPins::None),
+            Cloth::grid(8, 6, 0.05)
+                .with_pins(ClothPins::None)
+                .with_params(ClothParams::seeds()),
             place,
             ClothAttachments(held(shoulder)),
         ))

@@ -21,7 +21,7 @@ fn flag() -> (Cloth, Transform) {
         .with_params(ClothParams {
             model: Model::Xpbd(XpbdParams::default()),
             fabric: Some(Fabric::POLYESTER),
-            ..default()
+            ..ClothParams::seeds()
         });
     (cloth, Transform::from_xyz(0.0, 2.0, 0.0))
 }

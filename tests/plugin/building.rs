@@ -73,7 +73,7 @@ fn tearing_cloth() -> Cloth {
     let params = ClothParams {
         tear_ratio: Some(1.3),
         strain_limit: None,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     Cloth::grid(5, 5, 0.1)
         .with_pins(ClothPins::TopRow)
@@ -116,7 +116,7 @@ fn invalid_cloths_are_logged_and_skipped_not_panicked() {
         .world_mut()
         .spawn(Cloth::grid(4, 4, 0.1).with_params(ClothParams {
             node_mass: -1.0,
-            ..default()
+            ..ClothParams::seeds()
         }))
         .id();
     let bad_pin = app

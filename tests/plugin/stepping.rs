@@ -76,7 +76,7 @@ fn several_cloths_step_together() {
         .world_mut()
         .spawn(Cloth::grid(4, 4, 0.1).with_params(ClothParams {
             substeps: Substeps::Fixed(40),
-            ..default()
+            ..ClothParams::seeds()
         }))
         .id();
     let heavy = app
@@ -84,7 +84,7 @@ fn several_cloths_step_together() {
         .spawn((
             Cloth::grid(8, 8, 0.05).with_params(ClothParams {
                 substeps: Substeps::Fixed(60),
-                ..default()
+                ..ClothParams::seeds()
             }),
             Transform::from_xyz(2.0, 0.0, 0.0),
         ))
@@ -117,16 +117,16 @@ fn pause_stops_every_cloth() {
 
 #[test]
 fn stiffness_edits_change_the_next_step() {
-    // Two identical cloths; one gets stiffer springs: the next step differs.
+    // Two identical cloths on the seeds' springs (a fabric's stiffness replaces them);
+    // one gets stiffer springs: the next step differs.
     let mut app = app();
-    let a = app
-        .world_mut()
-        .spawn(Cloth::grid(5, 5, 0.1).with_pins(ClothPins::TopRow))
-        .id();
-    let b = app
-        .world_mut()
-        .spawn(Cloth::grid(5, 5, 0.1).with_pins(ClothPins::TopRow))
-        .id();
+    let spawn = |app: &mut App| {
+        let cloth = Cloth::grid(5, 5, 0.1)
+            .with_pins(ClothPins::TopRow)
+            .with_params(ClothParams::seeds());
+        app.world_mut().spawn(cloth).id()
+    };
+    let (a, b) = (spawn(&mut app), spawn(&mut app));
     for _ in 0..5 {
         app.update();
     }

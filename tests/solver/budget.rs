@@ -63,7 +63,7 @@ fn contact_pushes_do_not_drive_the_substeps_up() {
     let scene = |ball: bool| {
         let text = format!(
             "(cloths: [(cloth: (shape: Grid(width: 16, height: 16, spacing: 0.05), \
-             pins: TopRow, params: (model: Xpbd(()))))], colliders: [{}])",
+             pins: TopRow, params: (model: Xpbd(()), fabric: None)))], colliders: [{}])",
             if ball {
                 "(translation: (0.0, -0.35, 0.0), collider: (shape: Sphere(radius: 0.2)))"
             } else {

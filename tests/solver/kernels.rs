@@ -48,7 +48,7 @@ fn the_grid_stencil_steps_as_the_general_path() {
     let params = ClothParams {
         strain_limit: None,
         substeps: Substeps::Fixed(8),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let (mut stencil, mut general) = stencil_and_general(&params);
     let env = Environment::default();
@@ -73,7 +73,7 @@ fn the_grid_stencil_steps_as_the_general_path() {
 fn the_coloured_limiter_limits_as_the_sequential_one() {
     let params = ClothParams {
         substeps: Substeps::Fixed(8),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let (mut stencil, mut general) = stencil_and_general(&params);
     let env = Environment::default();
@@ -108,7 +108,7 @@ fn xpbd_on_the_stencil_projects_as_the_general_path() {
             }),
             substeps: Substeps::Fixed(20),
             strain_limit: limit,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         params.springs.damping = damping;
         let (mut stencil, mut general) = stencil_and_general(&params);
@@ -142,7 +142,7 @@ fn a_symmetric_curtain_stays_symmetric() {
     // A tight limit (1%), so the limiter moves particles in every substep.
     let params = ClothParams {
         strain_limit: Some(0.01),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let (mut cloth, _) = stencil_and_general_at(&params, Vec3::ZERO);
     let env = Environment {
@@ -178,9 +178,9 @@ fn a_large_cloth_steps_to_the_same_bits_on_one_thread_and_on_the_pool() {
     let xpbd = ClothParams {
         model: Model::Xpbd(XpbdParams::default()),
         substeps: Substeps::Fixed(10),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
-    for params in [ClothParams::default(), xpbd] {
+    for params in [ClothParams::seeds(), xpbd] {
         same_bits_on_one_thread_and_on_the_pool(&params);
     }
 }

@@ -123,7 +123,7 @@ fn grid_topology_matches_sladovics() {
                 bend_diagonal: SpringFamily::new(10.0),
                 ..SpringParams::default()
             },
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         },
         Affine3A::IDENTITY,
     )
@@ -158,7 +158,7 @@ fn bad_parameters_return_their_error() {
         height: 4,
         spacing: 0.1,
     };
-    let ok = ClothParams::default();
+    let ok = ClothParams::seeds();
     let build = |shape: &ClothShape, pins: &ClothPins, params: &ClothParams| {
         shape.build_solver(pins, params, Affine3A::IDENTITY).err()
     };
@@ -308,7 +308,7 @@ fn square_mesh(n: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
 fn hang_mesh(positions: &[Vec3], triangles: &[[u32; 3]]) -> (ClothSolver, f32) {
     let params = ClothParams {
         springs: SpringParams::from_structural(50.0),
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let layout = Layout::from_mesh(positions, triangles).unwrap();
     let pins = ClothPins::TopRow.resolve_for(&layout).unwrap();
@@ -381,7 +381,7 @@ fn an_attached_particle_reaches_its_target_every_step_and_falls_when_let_go() {
     ] {
         let params = ClothParams {
             model,
-            ..ClothParams::default()
+            ..ClothParams::seeds()
         };
         let mut cloth = ClothShape::Grid {
             width: 6,
@@ -424,7 +424,7 @@ fn a_refusal_states_its_limit_from_the_constant() {
     use bevy_cloth::limits::{MAX_NODE_MASS, MAX_POSITION, MIN_NODE_MASS};
     let light = ClothParams {
         node_mass: -1.0,
-        ..ClothParams::default()
+        ..ClothParams::seeds()
     };
     let e = light.validate().unwrap_err().to_string();
     assert!(e.contains(&format!("{MIN_NODE_MASS:e}")), "{e}");

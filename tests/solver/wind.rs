@@ -16,7 +16,7 @@ fn banner(at: Vec3) -> ClothSolver {
     shape
         .build_solver(
             &ClothPins::TopRow,
-            &ClothParams::default(),
+            &ClothParams::seeds(),
             Affine3A::from_translation(at),
         )
         .unwrap()

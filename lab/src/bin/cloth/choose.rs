@@ -65,11 +65,13 @@ pub(crate) fn choose(args: ChooseArgs) -> Result<(), String> {
     };
     // The reference is the cloth's springs as mass-spring, whatever model it runs now.
     let case = Case::new(&name, &scene, args.cloth, args.seconds).map_err(|e| e.to_string())?;
-    // Every configuration that applies: the patch model needs a grid.
+    // Every configuration that applies: the patch model needs a grid, and a fabric in
+    // physical units takes only mass-spring and XPBD (the others refuse it).
     let grid = matches!(entry.cloth.shape, ClothShape::Grid { .. });
     let configs: Vec<_> = accuracy::configs(&case.base())
         .into_iter()
         .filter(|c| grid || !matches!(c.params.model, Model::Patches(_)))
+        .filter(|c| c.params.validate().is_ok())
         .collect();
     let bar = progress(configs.len(), "configurations");
     let (reference, rows) = accuracy::measure(&case, &configs, args.repeats, |_| bar.inc(1))
