@@ -9,10 +9,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 
 use bevy::math::{Affine3A, Vec3};
 use bevy_cloth::params::{
-    Environment, Model, PatchParams, SelfCollision, SpringParams, Wind, WindField,
+    Environment, Model, PatchParams, SelfCollision, SpringParams, Wind, WindField, WindZone,
+    ZoneShape,
 };
 use bevy_cloth::prelude::*;
-use bevy_cloth::solver::ClothSolver;
+use bevy_cloth::solver::shapes::Capsule;
+use bevy_cloth::solver::{ClothSolver, Collider, ColliderShape, Motion};
 
 struct Counting;
 
@@ -222,4 +224,58 @@ fn a_large_cloth_on_the_pool_allocates_nothing_on_its_threads() {
         others, 0,
         "the pool's threads allocated {others} times in {steps} steps"
     );
+}
+
+/// What a game runs: the default cloth (XPBD along lines in twill, meeting the air on its
+/// triangles) in gusty air and a wind zone, against a capsule that moves every step,
+/// its colliders and zones handed over every step as the plugin hands them over.
+#[test]
+fn a_games_cloth_in_air_zones_and_contact_allocates_nothing_a_step() {
+    let _alone = COUNTING.lock().unwrap_or_else(|e| e.into_inner());
+    let mut cloth = grid_cloth(&ClothParams::default());
+    let env = Environment {
+        air: Some(Air {
+            velocity: Vec3::new(2.0, 0.0, 1.0),
+            field: WindField::Trigonometric,
+            ..Air::default()
+        }),
+        ..Environment::default()
+    };
+    let zones = [WindZone {
+        shape: ZoneShape::Sphere { radius: 2.0 },
+        velocity: Vec3::Z * 4.0,
+        ..WindZone::default()
+    }];
+    // A capsule across the cloth's middle, 2 cm in front of it, swaying into it.
+    let capsule = |t: f32| {
+        let at = Vec3::new(0.0, -0.4, 0.02 - 0.1 * t.sin());
+        Collider {
+            shape: ColliderShape::from(Capsule {
+                a: at - Vec3::X * 0.5,
+                b: at + Vec3::X * 0.5,
+                radius: 0.05,
+            }),
+            thickness: 0.01,
+            friction: 0.3,
+            motion: Motion::NONE,
+        }
+    };
+    let dt = 0.016;
+    let step = |cloth: &mut ClothSolver, k: usize| {
+        let t = k as f32 * dt;
+        cloth.set_colliders([capsule(t)]);
+        cloth.set_wind_zones(&zones, t).unwrap();
+        cloth.step(dt, &env);
+    };
+    for k in 0..3 {
+        step(&mut cloth, k); // warm-up: the substeps and the contact sets sized
+    }
+    let allocated = allocations_during(|| {
+        for k in 3..63 {
+            step(&mut cloth, k);
+        }
+    });
+    assert!(cloth.is_stable());
+    assert!(!cloth.wind_zones().is_empty(), "the zone reaches the cloth");
+    assert_eq!(allocated, 0, "{allocated} allocations in 60 steps");
 }

@@ -242,12 +242,13 @@ fn act(
     Ok(())
 }
 
-/// Soaks cloth `index` of `scene` for `duration` of wall-clock time with `seed`.
+/// Soaks cloth `index` of `scene` for `duration` of wall-clock time, or `most_steps`
+/// steps if they come first, with `seed` (the same seed and steps, the same soak).
 /// `progress` is called about once a second with the summary so far.
 pub fn soak(
     scene: &ClothScene,
     index: usize,
-    duration: Duration,
+    (duration, most_steps): (Duration, Option<u64>),
     seed: u64,
     mut progress: impl FnMut(&SoakSummary),
 ) -> Result<SoakSummary, String> {
@@ -271,7 +272,8 @@ pub fn soak(
     let mut last_report = start;
     let mut settled = false;
     let mut grab = Grabbing::default();
-    while start.elapsed() < duration {
+    let steps_left = |done: u64| most_steps.is_none_or(|most| done < most);
+    while start.elapsed() < duration && steps_left(summary.steps) {
         let t = summary.steps as f32 * dt;
         // Gusty wind: the scene's, swelling and turning, with random gusts.
         env.wind.strength = base_env.wind.strength.max(2e-4)
@@ -294,7 +296,8 @@ pub fn soak(
             cloth.reset();
         }
         // Memory: settled after the first tenth of the run, then sampled every second.
-        if !settled && start.elapsed() >= duration / 10 {
+        let tenth = most_steps.is_some_and(|most| summary.steps >= most / 10);
+        if !settled && (start.elapsed() >= duration / 10 || tenth) {
             settled = true;
             summary.rss_start_mb = resident_mb();
         }

@@ -564,7 +564,7 @@ fn once_fatal_inputs() -> Vec<BadInput> {
 }
 
 #[test]
-fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
+fn the_inputs_that_took_it_down_exit_2_under_a_memory_and_cpu_cap() {
     // Each under `ulimit -v` of 256 MB (a good run of the curtain needs ~20 MB resident):
     // refused before anything of the asked size is allocated or looped over.
     let root = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
@@ -582,9 +582,11 @@ fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
             .map(|a| a.replace("{curtain}", &curtain).replace("{fold}", &fold))
             .collect();
         let start = std::time::Instant::now();
+        // Memory and CPU time capped: an input that makes it allocate or loop is killed
+        // (a signal, not exit 2); a loaded machine slows the wall clock, not the CPU time.
         let out = Command::new("sh")
             .arg("-c")
-            .arg("ulimit -v 262144 && exec \"$0\" \"$@\"")
+            .arg("ulimit -v 262144 && ulimit -t 5 && exec \"$0\" \"$@\"")
             .arg(env!("CARGO_BIN_EXE_cloth"))
             .args(&args)
             .current_dir(&dir)
@@ -598,7 +600,6 @@ fn the_inputs_that_took_it_down_exit_2_within_a_second_under_a_memory_cap() {
             "{args:?}: {err}"
         );
         assert_eq!(err.trim_end().lines().count(), 1, "{args:?}: {err}");
-        assert!(took.as_secs_f32() < 1.0, "{args:?}: {took:?}");
         println!(
             "{args:?}: {:.0} ms: {}",
             took.as_secs_f64() * 1e3,
@@ -626,17 +627,20 @@ fn a_summary_into_a_closed_pipe_ends_quietly() {
 
 #[test]
 fn a_short_soak_finds_nothing() {
-    // The soak's CI variant: 3 s of the curtain with every kind of disturbance (the hour
-    // run is in the README).
+    // The soak's CI variant: 300 steps of the curtain with every kind of disturbance (the
+    // hour run is in the README), bounded by steps, not by the clock (an hour's cap that a
+    // loaded machine does not reach).
     let out = run_ok([
         "soak",
         "assets/scenes/curtain.ron",
+        "--steps",
+        "300",
         "--minutes",
-        "0.05",
+        "60",
         "--json",
     ]);
     let summary: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
-    assert!(summary["steps"].as_u64().unwrap() > 100, "{summary}");
+    assert_eq!(summary["steps"], 300, "{summary}");
     assert_eq!(summary["non_finite_steps"], 0, "{summary}");
     assert_eq!(summary["accepted_invalid_edits"], 0, "{summary}");
 }

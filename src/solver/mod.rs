@@ -48,7 +48,7 @@ pub use many::{begin_cloths, run_cloths};
 pub use many::{begin_together, substep_together};
 pub use models::{patches, shape_matching};
 pub(crate) use parallel::for_each_indexed;
-pub use parallel::{set_parallel, threads};
+pub use parallel::{on_one_thread, set_parallel, threads};
 pub use proxy::ProxyBinding;
 // Used by the lab through `crate::lab`: hidden from the docs.
 #[doc(hidden)]

@@ -3,6 +3,7 @@
 //! element is computed the same way whichever thread takes its piece, so results do not
 //! depend on the number of threads.
 
+use std::cell::Cell;
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::sync::{Mutex, OnceLock, PoisonError};
 
@@ -35,19 +36,46 @@ pub(super) const XPBD_PARALLEL_FROM: usize = 4 * PARALLEL_FROM;
 /// Whether a cloth's kernels may use the compute pool (the default).
 static PARALLEL: AtomicBool = AtomicBool::new(true);
 
+thread_local! {
+    /// Kernels and shares started from this thread stay on it ([`on_one_thread`]).
+    static ONE_THREAD_HERE: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Whether kernels and shares started from this thread may use the pool.
+fn parallel_here() -> bool {
+    PARALLEL.load(Ordering::Relaxed) && !ONE_THREAD_HERE.with(Cell::get)
+}
+
+/// Runs `work` with every cloth kernel and every share of cloths it starts kept on the
+/// calling thread, whatever other threads do: a thread count for one run, where
+/// [`set_parallel`] sets it for the process. Work started from other threads (an app's
+/// systems on Bevy's executor) is not affected. The results are the same bits as on the
+/// pool; this is for comparing the two side by side.
+pub fn on_one_thread<R>(work: impl FnOnce() -> R) -> R {
+    /// Puts the thread's setting back, on a panic too.
+    struct Restore(bool);
+    impl Drop for Restore {
+        fn drop(&mut self) {
+            ONE_THREAD_HERE.with(|c| c.set(self.0));
+        }
+    }
+    let _restore = Restore(ONE_THREAD_HERE.with(|c| c.replace(true)));
+    work()
+}
+
 /// Lets a cloth's kernels use Bevy's compute task pool (`true`, the default) or keeps
 /// every kernel on the calling thread (`false`), for the whole process. Results are the
 /// same bits either way; this is for measuring what the second core buys (`cloth bench`)
-/// and for checking that it changes nothing.
+/// and for checking that it changes nothing ([`on_one_thread`] for one run only).
 pub fn set_parallel(on: bool) {
     PARALLEL.store(on, Ordering::Relaxed);
 }
 
 /// The threads a large cloth's kernels use: the compute pool's threads and the calling
 /// thread (which works on a scope's tasks while it waits), at most one per core; 1 with
-/// [`set_parallel`]`(false)`.
+/// [`set_parallel`]`(false)` or inside [`on_one_thread`].
 pub fn threads() -> usize {
-    if PARALLEL.load(Ordering::Relaxed) {
+    if parallel_here() {
         (pool().thread_num() + 1).min(cores())
     } else {
         1
@@ -88,7 +116,7 @@ pub(super) fn for_each<T: Send>(
 /// Whether a kernel of `len` elements with threshold `from` runs in order on the calling
 /// thread (as [`for_each_from`] decides), where a kernel may take a serial shortcut.
 pub(super) fn on_this_thread(from: usize, len: usize) -> bool {
-    len < from || !PARALLEL.load(Ordering::Relaxed)
+    len < from || !parallel_here()
 }
 
 /// [`for_each`] for a kernel whose own measurements put its threshold at `from` elements.

@@ -187,13 +187,19 @@ fn a_large_cloth_steps_to_the_same_bits_on_one_thread_and_on_the_pool() {
 
 fn same_bits_on_one_thread_and_on_the_pool(params: &ClothParams) {
     let run = |parallel: bool| {
-        bevy_cloth::solver::set_parallel(parallel);
-        let mut cloth = corner_hung_grid_with(256, 256, params);
-        let start = cloth.positions().to_vec();
-        for _ in 0..20 {
-            cloth.step(0.016, &Environment::default());
-        }
-        bevy_cloth::solver::set_parallel(true);
+        let steps = || {
+            let mut cloth = corner_hung_grid_with(256, 256, params);
+            let start = cloth.positions().to_vec();
+            for _ in 0..20 {
+                cloth.step(0.016, &Environment::default());
+            }
+            (start, cloth)
+        };
+        let (start, cloth) = if parallel {
+            steps()
+        } else {
+            bevy_cloth::solver::on_one_thread(steps)
+        };
         let moved = start
             .iter()
             .zip(cloth.positions())
@@ -211,4 +217,20 @@ fn same_bits_on_one_thread_and_on_the_pool(params: &ClothParams) {
         "{model}: {differ} of {} particles differ",
         one.len()
     );
+}
+
+/// One thread for one run: inside `on_one_thread` the kernels this thread starts stay on
+/// it (one thread), while another thread's still use the pool, and the pool is back after.
+/// So "one thread against the pool" compares what it says even with tests side by side.
+#[test]
+fn one_thread_for_one_run_leaves_other_threads_on_the_pool() {
+    use bevy_cloth::solver::{on_one_thread, threads};
+    let pool = threads();
+    let inside = on_one_thread(|| (threads(), std::thread::spawn(threads).join().unwrap()));
+    assert_eq!(
+        inside,
+        (1, pool),
+        "inside, and another thread at the same time"
+    );
+    assert_eq!(threads(), pool, "after");
 }

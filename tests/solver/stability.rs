@@ -236,7 +236,10 @@ fn the_step_report_counts_substeps_times_stages_and_measures_xpbd_strain() {
     assert_eq!(report.taken, report.substeps);
     assert!(report.finite && !report.under_resolved);
     let t = report.time;
-    assert!(t.forces > t.fit_targets && t.constraints > std::time::Duration::ZERO);
+    // The stages that work here are timed (no comparison of one time with another: a
+    // loaded machine may stretch any of them).
+    let zero = std::time::Duration::ZERO;
+    assert!(t.forces > zero && t.constraints > zero, "{t:?}");
     assert_eq!(
         t.total(),
         t.begin

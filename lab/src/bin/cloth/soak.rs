@@ -17,6 +17,10 @@ pub(crate) struct SoakArgs {
     /// Which of the scene's cloths (its index).
     #[arg(long, default_value_t = 0)]
     pub(crate) cloth: usize,
+    /// Stops after this many steps if they come before the minutes are up (the same
+    /// seed and steps, the same soak, on any machine).
+    #[arg(long, value_parser = steps)]
+    pub(crate) steps: Option<usize>,
     /// The random generator's seed (the same seed, the same soak).
     #[arg(long, default_value_t = 1)]
     pub(crate) seed: u64,
@@ -31,7 +35,8 @@ pub(crate) fn soak(args: SoakArgs) -> Result<(), String> {
     let scene = ClothScene::load(&args.scene).map_err(|e| e.to_string())?;
     let duration = std::time::Duration::from_secs_f32(args.minutes * 60.0);
     let mut next = 60.0;
-    let summary = bevy_cloth_lab::soak::soak(&scene, args.cloth, duration, args.seed, |s| {
+    let length = (duration, args.steps.map(|n| n as u64));
+    let summary = bevy_cloth_lab::soak::soak(&scene, args.cloth, length, args.seed, |s| {
         if s.seconds >= next {
             next += 60.0;
             eprintln!(
