@@ -15,7 +15,7 @@ use crate::ecs::sleep::ClothSleep;
 use crate::ecs::step::{StepProgress, begin_steps};
 use crate::error::ClothError;
 use crate::params::check;
-use crate::solver::{BudgetClaim, StepReport, share_budget};
+use crate::solver::{BudgetClaim, GIVE_WAY_STRAIN, StepReport, share_budget};
 
 /// What the cloths may cost, a resource: the plugin shares `milliseconds` of each fixed
 /// step among the cloths that step (by [`ClothPriority`] when it is short), no cloth
@@ -28,7 +28,9 @@ use crate::solver::{BudgetClaim, StepReport, share_budget};
 /// the flag gives at each wind).
 /// The explicit models (mass-spring, shape matching, patches) keep the substeps their
 /// stability needs, and a fixed count is the cloth's own; both are counted against the
-/// budget first.
+/// budget first. And the budget gives way before a cloth does: one whose last step ended
+/// past [`GIVE_WAY_STRAIN`] (25%) takes what its accuracy asks for in its next step, and
+/// counts as over budget until it is back within both.
 ///
 /// Time becomes work through a planned cost a particle-substep
 /// (`nanoseconds_per_particle_substep`), so the caps are the same on every machine and
@@ -374,9 +376,9 @@ fn share_out(
 
 /// A cloth's crossing of its budget, either way: the event on its entity and a log line
 /// (`was`: it was over before this step).
-fn announce(commands: &mut Commands, who: Named, report: &StepReport, was: bool) {
+fn announce(commands: &mut Commands, who: Named, report: &StepReport, (was, now): (bool, bool)) {
     let entity = who.0;
-    if report.over_budget && !was {
+    if now && !was {
         let strain = report.solver_strain.or(report.max_strain).unwrap_or(0.0);
         warn!(
             "{who} is over its cloth budget: its accuracy asks for {} substeps, it takes {} \
@@ -391,7 +393,7 @@ fn announce(commands: &mut Commands, who: Named, report: &StepReport, was: bool)
             allowed: report.substeps,
             strain,
         });
-    } else if !report.over_budget && was {
+    } else if !now && was {
         info!("{who} is within its cloth budget again");
         commands.trigger(ClothWithinBudget { entity });
     }
@@ -423,13 +425,16 @@ fn end_stage(
         count += 1;
         over += usize::from(report.over_budget);
         let was = state.as_ref().is_some_and(|s| s.0);
-        announce(&mut commands, Named(entity, name), &report, was);
+        // A cloth over budget that the budget gave way to (its strain past
+        // `GIVE_WAY_STRAIN`, uncapped for a step) is still in trouble: not within again.
+        let strain = report.max_strain.unwrap_or_else(|| sim.solver.strain().max);
+        let giving_way = was && strain > GIVE_WAY_STRAIN;
+        let now = report.over_budget || giving_way;
+        announce(&mut commands, Named(entity, name), &report, (was, now));
         match state {
-            Some(mut s) => s.0 = report.over_budget,
+            Some(mut s) => s.0 = now,
             None => {
-                commands
-                    .entity(entity)
-                    .insert(OverBudget(report.over_budget));
+                commands.entity(entity).insert(OverBudget(now));
             }
         }
     }

@@ -23,14 +23,27 @@ pub struct BudgetClaim {
     pub cappable: bool,
 }
 
+/// A cloth whose last step ended with a structural spring stretched past this is not
+/// capped in its next step: the budget gives way before the cloth does (what gives is
+/// accuracy, never stability). Half the 50% past which a cloth no longer looks like
+/// itself.
+pub const GIVE_WAY_STRAIN: f32 = 0.25;
+
 impl BudgetClaim {
-    /// The claim of `cloth` from its last step, at `priority`.
+    /// The claim of `cloth` from its last step, at `priority`. A cloth whose last step
+    /// ended past [`GIVE_WAY_STRAIN`] is not capped.
     pub fn of(cloth: &super::ClothSolver, priority: f32) -> Self {
+        let report = cloth.last_report();
+        // The step's own measure when it took one (XPBD's closed loop), else measured now.
+        let straining = || {
+            let strain = report.max_strain.unwrap_or_else(|| cloth.strain().max);
+            strain > GIVE_WAY_STRAIN
+        };
         BudgetClaim {
             particles: cloth.particle_count(),
-            needed: cloth.last_report().needed,
+            needed: report.needed,
             priority,
-            cappable: cloth.budget_caps(),
+            cappable: cloth.budget_caps() && !straining(),
         }
     }
 }
@@ -47,16 +60,10 @@ impl BudgetClaim {
 pub fn share_budget(claims: &[BudgetClaim], work: f64, caps: &mut Vec<Option<u32>>) {
     caps.clear();
     caps.resize(claims.len(), None);
-    let demand = |c: &BudgetClaim| c.particles.max(1) as f64 * f64::from(c.needed.max(1));
     let fixed: f64 = claims.iter().filter(|c| !c.cappable).map(demand).sum();
-    let mut left = (work - fixed).max(0.0);
-    let weight = |c: &BudgetClaim| f64::from(c.priority.max(0.0));
+    let left = (work - fixed).max(0.0);
     let wanted: f64 = claims.iter().filter(|c| c.cappable).map(demand).sum();
-    let mut weights: f64 = claims.iter().filter(|c| c.cappable).map(weight).sum();
-    let cap = |c: &BudgetClaim, share: f64| {
-        let n = (share / c.particles.max(1) as f64).floor();
-        Some(n.clamp(1.0, u32::MAX as f64) as u32)
-    };
+    let weights: f64 = claims.iter().filter(|c| c.cappable).map(weight).sum();
     if wanted <= left {
         let spare = left - wanted;
         for (c, out) in claims
@@ -75,7 +82,41 @@ pub fn share_budget(claims: &[BudgetClaim], work: f64, caps: &mut Vec<Option<u32
     }
     // Water-filling: the cloths in order of need per unit of priority, each taking the
     // smaller of its need and its share of what is left.
-    let mut order: Vec<usize> = (0..claims.len()).filter(|&i| claims[i].cappable).collect();
+    ORDER.with_borrow_mut(|order| water_fill(claims, order, caps, (left, weights)));
+}
+
+/// A claim's work: its particles times the substeps it needs.
+fn demand(c: &BudgetClaim) -> f64 {
+    c.particles.max(1) as f64 * f64::from(c.needed.max(1))
+}
+
+/// A claim's weight in the sharing: its priority (0 for a negative one).
+fn weight(c: &BudgetClaim) -> f64 {
+    f64::from(c.priority.max(0.0))
+}
+
+/// The substeps `share` of work buys a claim's particles, at least one.
+fn cap(c: &BudgetClaim, share: f64) -> Option<u32> {
+    let n = (share / c.particles.max(1) as f64).floor();
+    Some(n.clamp(1.0, u32::MAX as f64) as u32)
+}
+
+thread_local! {
+    /// [`share_budget`]'s order of the cloths it caps, kept so a step allocates nothing.
+    static ORDER: std::cell::RefCell<Vec<usize>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Water-filling: the cappable cloths of `claims` in order of need per unit of priority
+/// (sorted into `order`), each capped at the smaller of its need and its share of what
+/// is `left` (the work), shared by `weights` (their priorities' sum).
+fn water_fill(
+    claims: &[BudgetClaim],
+    order: &mut Vec<usize>,
+    caps: &mut [Option<u32>],
+    (mut left, mut weights): (f64, f64),
+) {
+    order.clear();
+    order.extend((0..claims.len()).filter(|&i| claims[i].cappable));
     let per_weight = |i: &usize| {
         let c = &claims[*i];
         let w = weight(c);
@@ -86,7 +127,7 @@ pub fn share_budget(claims: &[BudgetClaim], work: f64, caps: &mut Vec<Option<u32
         }
     };
     order.sort_by(|a, b| per_weight(a).total_cmp(&per_weight(b)).then(a.cmp(b)));
-    for i in order {
+    for &i in order.iter() {
         let c = &claims[i];
         let share = if weights > 0.0 {
             left * weight(c) / weights

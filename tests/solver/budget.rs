@@ -184,3 +184,46 @@ fn the_world_budget_is_shared_and_checked() {
     };
     assert!(bad.validate().is_err());
 }
+
+/// The budget gives way before the cloth does: a cloth whose last step ended past
+/// `GIVE_WAY_STRAIN` (25%) is not capped in its next; the same cloth before it stretched
+/// is. A soft, heavy XPBD cloth (structural springs of 1 N/m, 5 g particles, no limit)
+/// hanging from its top row.
+#[test]
+fn a_cloth_straining_past_the_give_way_strain_is_not_capped() {
+    use bevy_cloth::params::{Environment, Model, SpringParams, XpbdParams};
+    use bevy_cloth::solver::{BudgetClaim, GIVE_WAY_STRAIN};
+    let mut params = ClothParams {
+        model: Model::Xpbd(XpbdParams::default()),
+        node_mass: 5e-3,
+        strain_limit: None,
+        ..ClothParams::seeds()
+    };
+    params.springs = SpringParams::from_structural(1.0);
+    let shape = ClothShape::Grid {
+        width: 8,
+        height: 8,
+        spacing: 0.05,
+    };
+    let mut cloth = shape
+        .build_solver(&ClothPins::TopRow, &params, bevy::math::Affine3A::IDENTITY)
+        .unwrap();
+    let env = Environment::default();
+    cloth.step(0.016, &env);
+    let early = cloth.strain().max;
+    assert!(early < GIVE_WAY_STRAIN, "{early}");
+    assert!(
+        BudgetClaim::of(&cloth, 1.0).cappable,
+        "a cloth within its strain is capped"
+    );
+    for _ in 0..60 {
+        cloth.step(0.016, &env);
+    }
+    let late = cloth.strain().max;
+    println!("strain after one step {early:.3}, after 61 {late:.3}");
+    assert!(late > GIVE_WAY_STRAIN, "the soft cloth stretches: {late}");
+    assert!(
+        !BudgetClaim::of(&cloth, 1.0).cappable,
+        "a straining cloth is not capped"
+    );
+}
