@@ -430,7 +430,9 @@ fn edge_first_onto_a_rope(cases: &[(&str, Model, Substeps)]) {
         eprintln!(
             "{name}: rose {rise:.3} m after meeting the rope ({plate_rise:.3} on a plate), top at {end:.3} after 2 s"
         );
-        assert!(end > -0.5, "{name}: fell off the rope (top at {end})");
+        // Folded over the rope its top is at the rope (measured 4.3 cm above it, XPBD);
+        // one that slipped off falls metres in the 2 s.
+        assert!(end > -0.05, "{name}: fell off the rope (top at {end})");
         assert!(
             rise <= plate_rise.max(0.0) + 0.01,
             "{name}: the rope made it bounce: rose {rise}, on a plate {plate_rise}"
@@ -484,10 +486,21 @@ fn fastest(cloth: &ClothSolver) -> f32 {
         .fold(0.0, f32::max)
 }
 
+/// How a cloth started through a ball came out ([`started_through_a_ball`]).
+struct OutOfBall {
+    /// The step at which no particle was inside any more (if within 1 s).
+    out_at: Option<usize>,
+    /// The fastest particle seen until then, m/s.
+    fastest: f32,
+    /// How the particles that started inside had moved by then: the mean of their moves
+    /// along the cloth's normal (z), against the mean of their moves in its plane.
+    along_normal: f32,
+    in_plane: f32,
+}
+
 /// A cloth hung by its top row with a ball of radius 0.2 centred on its plane 0.65 m below
-/// the top, its lower rows starting inside: the step at which no particle is inside any
-/// more (if one is, within 1 s) and the fastest particle seen before then.
-fn started_through_a_ball(model: Model) -> (Option<usize>, f32) {
+/// the top, its lower rows starting inside, stepped until no particle is inside (or 1 s).
+fn started_through_a_ball(model: Model) -> OutOfBall {
     let params = ClothParams {
         model,
         ..ClothParams::seeds()
@@ -511,17 +524,33 @@ fn started_through_a_ball(model: Model) -> (Option<usize>, f32) {
             .filter(|x| x.distance(center) < radius)
             .count()
     };
-    assert!(inside(&cloth) > 10);
-    let mut fastest_seen = 0.0f32;
+    let start = cloth.positions().to_vec();
+    let started_inside: Vec<usize> = (0..start.len())
+        .filter(|&i| start[i].distance(center) < radius)
+        .collect();
+    assert!(started_inside.len() > 10);
+    let mut out = OutOfBall {
+        out_at: None,
+        fastest: 0.0,
+        along_normal: 0.0,
+        in_plane: 0.0,
+    };
     for step in 1..=63 {
         cloth.step(DT, &Environment::default());
         assert!(cloth.is_stable());
-        fastest_seen = fastest_seen.max(fastest(&cloth));
+        out.fastest = out.fastest.max(fastest(&cloth));
         if inside(&cloth) == 0 {
-            return (Some(step), fastest_seen);
+            out.out_at = Some(step);
+            break;
         }
     }
-    (None, fastest_seen)
+    let n = started_inside.len() as f32;
+    for &i in &started_inside {
+        let moved = cloth.positions()[i] - start[i];
+        out.along_normal += moved.z.abs() / n;
+        out.in_plane += moved.truncate().length() / n;
+    }
+    out
 }
 
 fn models() -> [(&'static str, Model); 2] {
@@ -539,9 +568,13 @@ fn a_cloth_started_through_a_ball_leaves_it_along_its_normal_within_half_a_secon
     // inside at the cap speed, it only bends. Its neighbours, dragged out elastically,
     // overshoot that speed (about 2.5× it, measured at caps of 0.5, 1 and 2 m/s).
     for (name, model) in models() {
-        let (out_at, fastest_seen) = started_through_a_ball(model);
+        let out = started_through_a_ball(model);
+        let (out_at, fastest_seen) = (out.out_at, out.fastest);
         eprintln!(
-            "{name}: out of the ball after {out_at:?} steps, fastest particle {fastest_seen:.2} m/s"
+            "{name}: out of the ball after {out_at:?} steps, fastest particle \
+             {fastest_seen:.2} m/s; those inside moved {:.3} m along the normal, {:.3} m in \
+             the plane",
+            out.along_normal, out.in_plane
         );
         let out_at = out_at.expect("still inside after 1 s");
         assert!(
@@ -552,6 +585,15 @@ fn a_cloth_started_through_a_ball_leaves_it_along_its_normal_within_half_a_secon
             fastest_seen <= 3.0,
             "{name}: launched at {fastest_seen} m/s"
         );
+        // Along its normal: the particles that started inside moved out of the cloth's
+        // plane (measured 0.17 m) more than twice as far as within it (0.045–0.048 m); a
+        // push to the ball's nearest surface moves them within the plane, opening a hole.
+        assert!(
+            out.along_normal > 2.0 * out.in_plane,
+            "{name}: moved {} m along the normal, {} m in the plane",
+            out.along_normal,
+            out.in_plane
+        );
     }
 }
 
@@ -560,7 +602,7 @@ fn a_cloth_started_through_a_ball_leaves_it_along_its_normal_within_half_a_secon
             drag out overshoots it elastically (2.5 m/s XPBD, 2.7 m/s mass-spring)"]
 fn a_cloth_started_through_a_ball_is_moved_out_no_faster_than_the_cap() {
     for (name, model) in models() {
-        let (_, fastest_seen) = started_through_a_ball(model);
+        let fastest_seen = started_through_a_ball(model).fastest;
         assert!(
             fastest_seen <= 1.05,
             "{name}: launched at {fastest_seen} m/s"
@@ -610,7 +652,7 @@ fn a_cape_spawned_5_cm_into_its_capsule_is_out_within_10_steps() {
         );
     }
     assert_eq!(inside(&cloth), 0, "still inside after 10 steps");
-    // The target is the cap (1 m/s); measured 1.19 m/s as the cloth straightens after it
-    // is out (5.5 m/s before the cap and the fix of the approach's direction).
+    // The bound is the cap (1 m/s), what the depenetration promises; measured 0.32 m/s,
+    // out after 4 steps.
     assert!(fastest_seen <= 1.0, "launched at {fastest_seen} m/s");
 }

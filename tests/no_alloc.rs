@@ -7,14 +7,14 @@ use std::cell::Cell;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-use bevy::math::{Affine3A, Vec3};
+use bevy::math::{Affine3A, Quat, Vec3};
 use bevy_cloth::params::{
-    Environment, Model, PatchParams, SelfCollision, SpringParams, Wind, WindField, WindZone,
-    ZoneShape,
+    Environment, Inertia, Model, PatchParams, SelfCollision, SpringParams, Wind, WindField,
+    WindZone, ZoneShape,
 };
 use bevy_cloth::prelude::*;
 use bevy_cloth::solver::shapes::Capsule;
-use bevy_cloth::solver::{ClothSolver, Collider, ColliderShape, Motion};
+use bevy_cloth::solver::{BackStop, ClothSolver, Collider, ColliderShape, Motion, ProxyBinding};
 
 struct Counting;
 
@@ -278,4 +278,128 @@ fn a_games_cloth_in_air_zones_and_contact_allocates_nothing_a_step() {
     assert!(cloth.is_stable());
     assert!(!cloth.wind_zones().is_empty(), "the zone reaches the cloth");
     assert_eq!(allocated, 0, "{allocated} allocations in 60 steps");
+}
+
+/// What a character's cape runs: the default cloth held by motion constraints to a
+/// walking, turning body (a skinned cloth: the top row at its target, each row below 2 cm
+/// freer), back stops behind its targets, half the body's inertia, and a proxy mesh (each
+/// triangle's corners and middle) placed on it after each step, as the plugin draws it.
+#[test]
+fn a_skinned_cape_with_back_stops_inertia_and_a_proxy_allocates_nothing_a_step() {
+    let _alone = COUNTING.lock().unwrap_or_else(|e| e.into_inner());
+    let params = ClothParams {
+        inertia: Inertia::scaled(0.5),
+        ..ClothParams::default()
+    };
+    let mut cloth = grid_cloth(&params);
+    let rest = cloth.positions().to_vec();
+    let n = rest.len();
+    let radius: Vec<f32> = (0..n).map(|k| 0.02 * (k / 16) as f32).collect();
+    let stop = BackStop {
+        distance: 0.01,
+        radius: 0.3,
+    };
+    cloth.set_back_stops(&vec![stop; n]).unwrap();
+    let render: Vec<Vec3> = cloth
+        .triangles()
+        .iter()
+        .flat_map(|t| {
+            let [a, b, c] = t.map(|i| rest[i as usize]);
+            [a, b, c, (a + b + c) / 3.0]
+        })
+        .collect();
+    let mut binding = ProxyBinding::bind(&rest, cloth.triangles(), &render, None).unwrap();
+    let (mut drawn, mut drawn_normals) =
+        (vec![[0.0; 3]; render.len()], vec![[0.0; 3]; render.len()]);
+    let mut normals = vec![Vec3::ZERO; n];
+    let mut targets = vec![Vec3::ZERO; n];
+    let env = Environment::default();
+    let dt = 0.016;
+    let mut step = |cloth: &mut ClothSolver, k: usize| {
+        let t = k as f32 * dt;
+        let body = Affine3A::from_rotation_translation(
+            Quat::from_rotation_y(0.6 * (6.0 * t).sin()),
+            Vec3::new(0.0, 0.05 * (12.0 * t).sin(), 1.2 * t),
+        );
+        for (target, &x) in targets.iter_mut().zip(&rest) {
+            *target = body.transform_point3(x);
+        }
+        cloth.set_frame(body);
+        cloth.set_motion_constraints(&targets, &radius).unwrap();
+        cloth.step(dt, &env);
+        cloth.normals_into(&mut normals);
+        binding.place(
+            cloth.positions(),
+            &normals,
+            &mut drawn,
+            &mut drawn_normals,
+            None,
+        );
+    };
+    for k in 0..3 {
+        step(&mut cloth, k); // warm-up: the substeps and the scratch sized
+    }
+    let allocated = allocations_during(|| {
+        for k in 3..63 {
+            step(&mut cloth, k);
+        }
+    });
+    assert!(cloth.is_stable());
+    assert_eq!(allocated, 0, "{allocated} allocations in 60 steps");
+}
+
+/// The plugin's step in a headless app, on one thread (the multi-threaded executor
+/// allocates a task for each system it runs, and more of them run with a cloth, their
+/// run conditions met; so does the compute pool's scope for each share of several
+/// cloths): Bevy's own scheduling, counted apart in the same app without a cloth,
+/// allocates nothing an update. The cloth stage makes a few small lists a step of the
+/// cloths that step (Bevy's borrows of the cloths live for one system's run, so such a
+/// list cannot be kept from one step to the next): five with one cloth, whatever its
+/// size, and six with several (one more in sharing their substeps); nothing per particle
+/// or substep.
+#[test]
+fn the_plugins_step_allocates_a_few_lists_a_step_whatever_its_cloths_size() {
+    let _alone = COUNTING.lock().unwrap_or_else(|e| e.into_inner());
+    let over_60_updates = |cloths: &[u32]| -> usize {
+        let mut app = bevy_cloth::headless::headless_app();
+        app.finish();
+        app.cleanup();
+        for (_, schedule) in app
+            .world_mut()
+            .resource_mut::<bevy::ecs::schedule::Schedules>()
+            .iter_mut()
+        {
+            schedule.set_executor(bevy::ecs::schedule::SingleThreadedExecutor::new());
+        }
+        for (k, &size) in cloths.iter().enumerate() {
+            app.world_mut().spawn((
+                Cloth::grid(size, size, 0.05),
+                bevy::prelude::Transform::from_xyz(3.0 * k as f32, 3.0, 0.0),
+            ));
+        }
+        for _ in 0..30 {
+            app.update(); // built, drawn, the substeps settled
+        }
+        // Everything runs on this thread: its own count (other tests' threads starting
+        // while this one counts are not its).
+        allocations_during(|| {
+            bevy_cloth::solver::on_one_thread(|| {
+                for _ in 0..60 {
+                    app.update();
+                }
+            });
+        })
+    };
+    let bevy = over_60_updates(&[]);
+    let small = over_60_updates(&[16]);
+    let large = over_60_updates(&[48]);
+    let three = over_60_updates(&[32, 32, 32]);
+    eprintln!(
+        "60 updates: Bevy's own {bevy} allocations; with one cloth of 16 x 16 {small}, of \
+         48 x 48 {large}; with three of 32 x 32 {three}"
+    );
+    assert_eq!(bevy, 0, "Bevy's own scheduling allocated");
+    assert_eq!(small, 5 * 60, "one small cloth");
+    assert_eq!(large, 5 * 60, "one large cloth");
+    assert_eq!(three, 6 * 60, "three cloths");
 }

@@ -163,8 +163,10 @@ fn a_hanging_inextensible_chain_keeps_its_length_to_the_automatic_substeps_targe
     }
 }
 
+/// Solved along its line, the chain is exact to rounding: measured 1.1e-6 while it swings
+/// (the sweep left 0.17%); the bound is 10 times that.
 #[test]
-fn a_swinging_inextensible_chain_stays_within_half_a_percent() {
+fn a_swinging_inextensible_chain_keeps_its_length_to_rounding() {
     let (links, length) = (10, 0.1);
     let mut cloth = chain(links, length, &xpbd(f32::INFINITY, 1e-3, 20));
     // Released 45° to the side.
@@ -182,7 +184,7 @@ fn a_swinging_inextensible_chain_stays_within_half_a_percent() {
         }
     }
     println!("largest strain while swinging {worst:.3e}");
-    assert!(worst < 5e-3, "strain while swinging {:.4}%", worst * 100.0);
+    assert!(worst < 1e-5, "strain while swinging {:.4}%", worst * 100.0);
 }
 
 /// Tethers (long-range attachments) on an inextensible chain, its links swept: solved
@@ -303,8 +305,12 @@ fn a_small_pendulum_swings_with_the_period_2_pi_root_l_over_g() {
     let expected = 2.0 * std::f32::consts::PI * (length / G).sqrt() * (1.0 + angle * angle / 16.0);
     let error = (period - expected).abs() / expected;
     println!("period {period} s against {expected} s");
+    // Measured 0.059% (2.00821 s); 1.7 times that: the run is one particle on one
+    // thread, the same bits everywhere but for the platform's `sin` and `sqrt`. (The
+    // error grows with the substeps, not shrinks: 0.006% at 5, 0.59% at 80: rounding in
+    // f32 positions, whose differences are the velocities, at steps of 0.2 ms.)
     assert!(
-        error < 0.01,
+        error < 1e-3,
         "period {period} s, expected {expected} s ({:.3}% off)",
         error * 100.0
     );

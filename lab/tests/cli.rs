@@ -3,6 +3,10 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+// The golden dumps' check and bless, shared with the main crate's tests.
+#[path = "../../tests/common/golden.rs"]
+mod golden;
+
 fn cloth() -> Command {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_cloth"));
     // The workspace root, where `assets/` is.
@@ -202,13 +206,13 @@ fn bad_input_exits_2_with_one_line_naming_the_problem() {
 }
 
 /// The physics does not change under a refactoring: each scene's dump after 120 steps is
-/// byte-identical to the one stored in `tests/data/golden/` (positions printed as the
-/// shortest text that reads back to the same `f32`, so equal text is equal bits). After a
-/// change that is *meant* to change the physics, `BLESS=1 cargo test --test cli golden`
-/// rewrites them; the commit then says why.
+/// byte-identical to the one stored in `tests/data/golden/` (see `golden.rs` for the
+/// bless and its bound): the seeds' scenes on the models they name, and what a game runs
+/// today: the flag (XPBD along lines, polyester, gusty air, a pole) and a denim curtain
+/// in a wind zone (a scene of the tests' own).
 #[test]
 fn golden_dumps_of_the_scenes_are_unchanged() {
-    let cases: [(&str, &str, &[&str]); 6] = [
+    let cases: [(&str, &str, &[&str]); 8] = [
         ("curtain", "assets/scenes/curtain.ron", &[]),
         (
             "curtain_mass_spring",
@@ -234,8 +238,10 @@ fn golden_dumps_of_the_scenes_are_unchanged() {
         ),
         ("card", "assets/scenes/card.ron", &[]),
         ("tshirt", "assets/scenes/tshirt.ron", &[]),
+        ("flag", "assets/scenes/flag.ron", &[]),
+        ("wind_zone", "lab/tests/data/wind_zone.ron", &[]),
     ];
-    let bless = std::env::var_os("BLESS").is_some();
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/golden");
     let mut changed = Vec::new();
     for (name, scene, extra) in cases {
         let dump = temp(&format!("golden_{name}.csv"));
@@ -245,23 +251,8 @@ fn golden_dumps_of_the_scenes_are_unchanged() {
         run_ok(&args);
         let got = std::fs::read_to_string(&dump).unwrap();
         std::fs::remove_file(&dump).ok();
-        let stored = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-            .join("tests/data/golden")
-            .join(format!("{name}.csv"));
-        if bless {
-            std::fs::create_dir_all(stored.parent().unwrap()).unwrap();
-            std::fs::write(&stored, &got).unwrap();
-            continue;
-        }
-        let want = std::fs::read_to_string(&stored)
-            .unwrap_or_else(|e| panic!("{}: {e} (BLESS=1 writes it)", stored.display()));
-        if got != want {
-            let line = got
-                .lines()
-                .zip(want.lines())
-                .position(|(a, b)| a != b)
-                .map_or("the line count".to_string(), |i| format!("line {}", i + 1));
-            changed.push(format!("{name}: differs at {line}"));
+        if let Err(e) = golden::check(&dir, name, &got) {
+            changed.push(e);
         }
     }
     assert!(changed.is_empty(), "{}", changed.join("; "));
@@ -781,7 +772,8 @@ fn a_refused_set_says_its_key_once() {
 /// `cloth storm`: every cell of a short storm holds together; mass-spring's substeps
 /// stay at its stability bound in any wind, XPBD's follow the wind with accuracy first
 /// and stay within the default budget's 30 (4 ms at 200 ns over 651 particles) inside
-/// it, where the gale's steps give accuracy and strain more.
+/// it, where the gale's steps give accuracy and strain more (past 25% strain the budget
+/// gives way, up to what accuracy first takes).
 #[test]
 fn a_storm_maps_each_model_and_keeps_the_budgeted_flag_to_its_substeps() {
     let out = run_ok(["storm", "--seconds", "1", "--winds", "0,20", "--json"]);
@@ -815,7 +807,14 @@ fn a_storm_maps_each_model_and_keeps_the_budgeted_flag_to_its_substeps() {
         );
         assert_eq!(n(gale, "steps_over_budget"), 0.0, "{gale}");
         let budget = find("xpbd-budget", 20.0, on);
-        assert!(n(budget, "most_substeps") <= 30.0, "{budget}");
+        // Within its 30, unless the flag strained past 25%, when the budget gives way to
+        // what its accuracy asks for (never more than accuracy first takes).
+        let gave_way = n(budget, "largest_strain") > 0.25;
+        assert!(n(budget, "most_substeps") <= 30.0 || gave_way, "{budget}");
+        assert!(
+            n(budget, "most_substeps") <= n(gale, "most_substeps"),
+            "{budget} {gale}"
+        );
         assert!(n(budget, "steps_over_budget") > 0.0, "{budget}");
         assert!(
             n(budget, "largest_strain") > n(gale, "largest_strain"),

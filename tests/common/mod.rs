@@ -1,6 +1,8 @@
 //! What several test files share (each uses part of it).
 #![allow(dead_code)]
 
+pub mod golden;
+
 use bevy::math::{Affine3A, Vec3A};
 use bevy::mesh::{Mesh, VertexAttributeValues};
 use bevy::prelude::*;

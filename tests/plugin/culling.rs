@@ -24,8 +24,9 @@ fn camera(eye: Vec3, target: Vec3) -> impl Bundle {
 }
 
 /// Ten cloths in front of a camera and ten behind it: those behind take no substeps and
-/// are counted culled; turned round, the camera sees them and they step again, each
-/// starting at rest where its body is. One beyond `max_distance` in view is culled too.
+/// are counted culled; one carried 1 m while unseen, seen again when the camera turns
+/// round, starts at rest on its body, its shape carried with it (the golden dump
+/// `culled_and_seen`). One beyond `max_distance` in view is culled too.
 #[test]
 fn cloths_no_camera_sees_take_no_steps() {
     let mut app = app();
@@ -80,15 +81,52 @@ fn cloths_no_camera_sees_take_no_steps() {
     assert!(culled(&app, far), "beyond its distance");
     let stats = app.world().get::<ClothStats>(behind[0]);
     assert!(stats.is_none_or(|s| s.culled));
-    // Turned round: the cloths behind are seen, and step.
-    let before = time(&app, behind[0]);
+    // While unseen, the first cloth behind is carried 1 m to the side; turned round, the
+    // camera sees it again and it is put back on its body at rest: its whole shape moved
+    // with its body (within what one step from rest moves it) and nothing swinging.
+    let carried = behind[0];
+    let shape = positions_of(&app, carried);
+    let offset = Vec3::new(1.0, 0.0, 0.0);
+    app.world_mut()
+        .get_mut::<Transform>(carried)
+        .unwrap()
+        .translation += offset;
+    app.update();
+    assert!(culled(&app, carried), "still unseen while carried");
+    let before = time(&app, carried);
     app.world_mut()
         .entity_mut(eye)
         .insert(camera(Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.0, 1.0, 1.0)));
+    app.update();
+    assert!(!culled(&app, carried));
+    assert!(time(&app, carried) > before, "it steps again");
+    let sim = &app.world().get::<ClothSimulation>(carried).unwrap().solver;
+    let off_body = (sim.positions().iter().zip(&shape))
+        .map(|(x, x0)| x.distance(*x0 + offset))
+        .fold(0.0, f32::max);
+    let fastest = sim
+        .particles()
+        .velocity
+        .iter()
+        .map(|v| v.length())
+        .fold(0.0, f32::max);
+    eprintln!("seen again: {off_body:e} m off its carried shape, fastest {fastest:e} m/s");
+    // One 16 ms step from rest: gravity alone moves a particle g·dt² = 2.5 mm, at
+    // g·dt = 0.16 m/s (measured 0.34 mm, 0.028 m/s).
+    assert!(
+        off_body < 0.0025,
+        "{off_body} m off its shape carried with its body"
+    );
+    assert!(fastest < 0.16, "{fastest} m/s: swung across the gap");
+    golden::assert_golden("culled_and_seen", sim.positions());
     for _ in 0..10 {
         app.update();
     }
-    assert!(!culled(&app, behind[0]));
-    assert!(time(&app, behind[0]) > before, "it steps again");
     assert!(culled(&app, front[0]));
+}
+
+/// A cloth entity's particle positions now.
+fn positions_of(app: &App, e: Entity) -> Vec<Vec3> {
+    let sim = app.world().get::<ClothSimulation>(e).unwrap();
+    sim.solver.positions().to_vec()
 }

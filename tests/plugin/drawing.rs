@@ -187,7 +187,8 @@ fn finer_proxy(
 /// A cloth drawn with a proxy 3 × 3 times finer (9 times the vertices): once bound, the
 /// entity draws the proxy's mesh, and after 300 frames of sagging every render vertex is
 /// within 1e-5 m of its bound point on its simulation triangle (bound anew here from the
-/// rest shape), its normal a unit vector and its tangent at right angles to it.
+/// rest shape), its normal a unit vector and its tangent at right angles to it; the drawn
+/// vertices are those of the golden dump `proxy_drawn`.
 #[test]
 fn a_proxy_mesh_follows_its_simulation_triangles() {
     let mut app = app();
@@ -231,6 +232,9 @@ fn a_proxy_mesh_follows_its_simulation_triangles() {
     assert_eq!(drawn.len(), render_x.len());
     assert!(farthest < 1e-5, "{farthest} m");
     assert!(moved > 0.01, "the cloth sagged: {moved} m");
+    // What a game draws, as it was: the proxy's vertices after the 300 frames.
+    let drawn: Vec<Vec3> = drawn.into_iter().map(Vec3::from).collect();
+    golden::assert_golden("proxy_drawn", &drawn);
     let meshes = app.world().resource::<Assets<Mesh>>();
     let mesh = meshes.get(&own).unwrap();
     let (
