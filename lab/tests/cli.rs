@@ -863,3 +863,51 @@ fn a_crowds_world_budget_caps_its_cloths_and_says_which_gave_accuracy() {
     assert_eq!(springs["gave"]["cappable"], 0, "{springs}");
     assert_eq!(springs["gave"]["steps"], serde_json::json!([0, 0, 0, 0]));
 }
+
+/// `cloth run --stages` says where a step's time goes: every stage by name with its time
+/// and share, the stages' sum and the whole step; the flag's constraints take time, and
+/// the shares add up to the whole.
+#[test]
+fn run_stages_says_where_the_time_goes() {
+    let out = run_ok([
+        "run",
+        "assets/scenes/flag.ron",
+        "--steps",
+        "20",
+        "--stages",
+        "--one-thread",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("where a step's time goes, over 19 steps"),
+        "{err}"
+    );
+    let stage = |name: &str| -> (f64, f64) {
+        let line = err
+            .lines()
+            .find(|l| l.trim_start().starts_with(name))
+            .unwrap_or_else(|| panic!("no line for {name}: {err}"));
+        let numbers: Vec<f64> = line
+            .split_whitespace()
+            .filter_map(|w| w.trim_end_matches('%').parse().ok())
+            .collect();
+        (numbers[0], numbers.get(1).copied().unwrap_or(f64::NAN))
+    };
+    let names = [
+        "begin",
+        "forces",
+        "integrate",
+        "fit targets",
+        "constraints",
+        "self-collision",
+        "contact",
+        "end",
+    ];
+    let shares: f64 = names.iter().map(|n| stage(n).1).sum();
+    assert!(
+        (shares - 100.0).abs() < 0.5,
+        "the shares add to {shares}%: {err}"
+    );
+    assert!(stage("constraints").0 > 0.0, "{err}");
+    assert!(stage("the whole step").0 >= stage("the stages").0, "{err}");
+}

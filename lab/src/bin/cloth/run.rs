@@ -46,6 +46,10 @@ pub(crate) struct RunArgs {
     /// The budget's milliseconds for any one cloth a step (implies --budget).
     #[arg(long, value_name = "MS")]
     pub(crate) cloth_budget_ms: Option<f32>,
+    /// Prints where the step's time goes: each stage's milliseconds a step and share,
+    /// summed over the cloths (from their step reports), and the time outside them.
+    #[arg(long)]
+    pub(crate) stages: bool,
 }
 
 impl RunArgs {
@@ -107,8 +111,12 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
     } else {
         progress(steps, "steps")
     };
+    let mut stages = Stages::default();
     let summary = run.run(steps, |step, cloths| {
         bar.set_position(step as u64);
+        if args.stages {
+            stages.add(cloths);
+        }
         if let Some(d) = &mut dump
             && step % every == 0
             && dump_error.is_none()
@@ -135,6 +143,9 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
     }
     if !args.quiet {
         say_summary(scene_path, &summary);
+    }
+    if args.stages {
+        stages.say();
     }
     let json = serde_json::to_string_pretty(&summary).map_err(|e| e.to_string())?;
     println!("{json}");
@@ -170,6 +181,84 @@ fn say_summary(scene: &str, summary: &bevy_cloth::headless::RunSummary) {
             } else {
                 "NOT whole (non-finite or past 50% strain)"
             }
+        );
+    }
+}
+
+/// Each stage's time, summed over the run's steps and its cloths (`--stages`), and the
+/// wall time between the steps' ends.
+#[derive(Default)]
+struct Stages {
+    /// Per stage, in [`Stages::NAMES`]' order.
+    time: [std::time::Duration; 8],
+    /// From the first step's end to the last's: the steps after the first, whole.
+    wall: std::time::Duration,
+    /// Steps whose wall time is in `wall`.
+    steps: usize,
+    last: Option<std::time::Instant>,
+}
+
+impl Stages {
+    const NAMES: [&str; 8] = [
+        "begin (state, substeps, drivers, pair lists)",
+        "forces (gravity, air, springs)",
+        "integrate",
+        "fit targets",
+        "constraints (drivers and the model's)",
+        "self-collision",
+        "contact",
+        "end (finite check, tears, strain)",
+    ];
+
+    /// Adds the step just ended.
+    fn add(&mut self, cloths: &[(String, solver::ClothSolver)]) {
+        let now = std::time::Instant::now();
+        if let Some(last) = self.last {
+            self.wall += now - last;
+            self.steps += 1;
+            for (_, cloth) in cloths {
+                let t = cloth.last_report().time;
+                let each = [
+                    t.begin,
+                    t.forces,
+                    t.integrate,
+                    t.fit_targets,
+                    t.constraints,
+                    t.self_contact,
+                    t.contact,
+                    t.end,
+                ];
+                for (sum, d) in self.time.iter_mut().zip(each) {
+                    *sum += d;
+                }
+            }
+        }
+        self.last = Some(now);
+    }
+
+    /// The table, on stderr.
+    fn say(&self) {
+        let steps = self.steps.max(1) as f64;
+        let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3 / steps;
+        let sum: std::time::Duration = self.time.iter().sum();
+        eprintln!(
+            "where a step's time goes, over {} steps (the first left out), all cloths:",
+            self.steps
+        );
+        for (name, &d) in Self::NAMES.iter().zip(&self.time) {
+            eprintln!(
+                "  {name:<44} {:>8.3} ms  {:>5.1}%",
+                ms(d),
+                100.0 * d.as_secs_f64() / sum.as_secs_f64().max(1e-12)
+            );
+        }
+        eprintln!("  {:<44} {:>8.3} ms", "the stages", ms(sum));
+        eprintln!(
+            "  {:<44} {:>8.3} ms  (outside the stages: {:.3} ms: what cloths share, such as \
+             cloth-cloth contact's lists and the budget's shares, and the run's own)",
+            "the whole step, wall time",
+            ms(self.wall),
+            ms(self.wall.saturating_sub(sum))
         );
     }
 }
