@@ -15,7 +15,7 @@ use crate::ecs::sleep::ClothSleep;
 use crate::ecs::step::{StepProgress, begin_steps};
 use crate::error::ClothError;
 use crate::params::check;
-use crate::solver::{BudgetClaim, GIVE_WAY_STRAIN, StepReport, share_budget};
+use crate::solver::{BudgetClaim, StepReport, gives_way, share_budget};
 
 /// What the cloths may cost, a resource: the plugin shares `milliseconds` of each fixed
 /// step among the cloths that step (by [`ClothPriority`] when it is short), no cloth
@@ -29,8 +29,9 @@ use crate::solver::{BudgetClaim, GIVE_WAY_STRAIN, StepReport, share_budget};
 /// The explicit models (mass-spring, shape matching, patches) keep the substeps their
 /// stability needs, and a fixed count is the cloth's own; both are counted against the
 /// budget first. And the budget gives way before a cloth does: one whose last step ended
-/// past [`GIVE_WAY_STRAIN`] (25%) takes what its accuracy asks for in its next step, and
-/// counts as over budget until it is back within both.
+/// past [`GIVE_WAY_STRAIN`](crate::solver::GIVE_WAY_STRAIN) (25%) takes what its
+/// accuracy asks for in its next step, and counts as over budget until it is back within
+/// both.
 ///
 /// Time becomes work through a planned cost a particle-substep
 /// (`nanoseconds_per_particle_substep`), so the caps are the same on every machine and
@@ -427,9 +428,7 @@ fn end_stage(
         let was = state.as_ref().is_some_and(|s| s.0);
         // A cloth over budget that the budget gave way to (its strain past
         // `GIVE_WAY_STRAIN`, uncapped for a step) is still in trouble: not within again.
-        let strain = report.max_strain.unwrap_or_else(|| sim.solver.strain().max);
-        let giving_way = was && strain > GIVE_WAY_STRAIN;
-        let now = report.over_budget || giving_way;
+        let now = report.over_budget || (was && gives_way(&sim.solver));
         announce(&mut commands, Named(entity, name), &report, (was, now));
         match state {
             Some(mut s) => s.0 = now,

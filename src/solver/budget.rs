@@ -33,19 +33,24 @@ impl BudgetClaim {
     /// The claim of `cloth` from its last step, at `priority`. A cloth whose last step
     /// ended past [`GIVE_WAY_STRAIN`] is not capped.
     pub fn of(cloth: &super::ClothSolver, priority: f32) -> Self {
-        let report = cloth.last_report();
-        // The step's own measure when it took one (XPBD's closed loop), else measured now.
-        let straining = || {
-            let strain = report.max_strain.unwrap_or_else(|| cloth.strain().max);
-            strain > GIVE_WAY_STRAIN
-        };
         BudgetClaim {
             particles: cloth.particle_count(),
-            needed: report.needed,
+            needed: cloth.last_report().needed,
             priority,
-            cappable: cloth.budget_caps() && !straining(),
+            cappable: cloth.budget_caps() && !gives_way(cloth),
         }
     }
+}
+
+/// Whether the budget gives way to `cloth`: its last step ended past
+/// [`GIVE_WAY_STRAIN`] (the step's own measure when it took one, XPBD's closed loop;
+/// else measured now, a pass over the structural springs).
+pub fn gives_way(cloth: &super::ClothSolver) -> bool {
+    let strain = cloth
+        .last_report()
+        .max_strain
+        .unwrap_or_else(|| cloth.strain().max);
+    strain > GIVE_WAY_STRAIN
 }
 
 /// Shares `work` (particle-substeps a step) among `claims` and writes each cloth's cap

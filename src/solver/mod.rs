@@ -36,7 +36,7 @@ use constraints::{bending, chains, lattice, tethers, xpbd};
 use contact::self_contact;
 use models::switch;
 
-pub use budget::{BudgetClaim, GIVE_WAY_STRAIN, share_budget};
+pub use budget::{BudgetClaim, GIVE_WAY_STRAIN, gives_way, share_budget};
 pub use contact::shapes::{self, ColliderShape, ConvexHull, Placement, Shape};
 pub use contact::{Collider, ColliderImpulse, Motion};
 pub use diagnostics::{Energy, Strain};

@@ -70,8 +70,8 @@ impl RunArgs {
     }
 }
 
-pub(crate) fn run(args: RunArgs) -> Result<(), String> {
-    bevy_cloth::solver::set_parallel(!args.one_thread);
+/// The scene file with `--model` and every `--set` applied; refused without cloths.
+fn load_scene(args: &RunArgs) -> Result<ClothScene, String> {
     let scene_path = &args.scene;
     let mut scene = ClothScene::load(scene_path).map_err(|e| e.to_string())?;
     if let Some(model) = args.model {
@@ -88,6 +88,13 @@ pub(crate) fn run(args: RunArgs) -> Result<(), String> {
             "{scene_path}: the scene has no cloths: nothing to run"
         ));
     }
+    Ok(scene)
+}
+
+pub(crate) fn run(args: RunArgs) -> Result<(), String> {
+    bevy_cloth::solver::set_parallel(!args.one_thread);
+    let scene_path = &args.scene;
+    let scene = load_scene(&args)?;
     let (steps, every, timestep) = (args.steps, args.every, scene.timestep);
     // The solver's clock (its substeps' sum); a scene with no cloths has only the steps.
     let clock = |step: usize, cloths: &[(String, solver::ClothSolver)]| {
