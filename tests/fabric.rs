@@ -6,7 +6,7 @@ use bevy_cloth::error::ClothError;
 use bevy_cloth::fabric::Fabric;
 use bevy_cloth::layout::shape::{ClothPins, ClothShape};
 use bevy_cloth::params::{
-    Air, AirUpdate, ClothParams, Environment, Model, ShapeMatchingParams, Wind,
+    Air, AirUpdate, ClothParams, Environment, Model, ShapeMatchingParams, Substeps, Wind,
 };
 use bevy_cloth::solver::{ClothSolver, Layout};
 
@@ -434,5 +434,61 @@ fn a_fabric_meets_still_air_unless_told_otherwise() {
     assert!(
         (seeds / free - 1.0).abs() < 0.01,
         "{seeds} against g t = {free}"
+    );
+}
+
+/// A denim strip 2.5 cm wide and 4 cm past its clamp (5 mm spacing), clamped level by its
+/// first two rows and left 4 s to rest at a drag rate of 20/s, with XPBD at `substeps` a
+/// step: how far its last row has dropped, m, and the substeps the step took.
+fn clamped_strip_drop(substeps: Substeps) -> (f32, u32) {
+    let (spacing, across, along) = (0.005, 6, 10);
+    let fabric = Fabric::DENIM;
+    let params = ClothParams {
+        model: Model::Xpbd(Default::default()),
+        fabric: Some(fabric),
+        substeps,
+        strain_limit: None,
+        drag: 20.0 * fabric.areal_density * spacing * spacing,
+        ..ClothParams::seeds()
+    };
+    let shape = ClothShape::Grid {
+        width: across,
+        height: along,
+        spacing,
+    };
+    let level = Affine3A::from_rotation_x(-std::f32::consts::FRAC_PI_2);
+    let pins = ClothPins::Indices((0..2 * across).collect());
+    let mut cloth = shape.build_solver(&pins, &params, level).unwrap();
+    let mut env = Environment::default();
+    env.wind.strength = 0.0;
+    let mut taken = 0;
+    for _ in 0..250 {
+        taken = cloth.step(0.016, &env).substeps;
+    }
+    assert!(cloth.is_stable());
+    let x = cloth.positions();
+    let tip = (across * (along - 1)..across * along)
+        .map(|i| x[i as usize].y)
+        .sum::<f32>()
+        / across as f32;
+    (-tip, taken)
+}
+
+#[test]
+fn a_strip_bends_the_same_with_its_hinges_projected_every_substep_or_once_for_many() {
+    // XPBD projects a fabric's hinges as often as their stiffness asks (their automatic
+    // substeps, where a bending-only strip runs them every substep); at eight times as
+    // many substeps it projects each for eight, at eight times the compliance's step.
+    let (floor, n) = clamped_strip_drop(Substeps::Auto { max: 8192 });
+    let (many, _) = clamped_strip_drop(Substeps::Fixed(8 * n));
+    eprintln!(
+        "tip drop: {floor:.6} m at {n} substeps, {many:.6} m at {}",
+        8 * n
+    );
+    assert!(floor > 0.005, "the strip hardly bends: {floor} m");
+    assert!(
+        (many - floor).abs() < 0.01 * floor,
+        "tip drop {floor:.6} m at {n} substeps a step, {many:.6} m at {}",
+        8 * n
     );
 }

@@ -221,24 +221,7 @@ impl ClothSolver {
         let (Model::Xpbd(xpbd), Some(fabric)) = (self.params.model, self.params.fabric) else {
             return 0;
         };
-        let (w, hinges) = match self.clock.fabric_loads {
-            Some((params, w, hinges)) if params == self.params => (w, hinges),
-            _ => {
-                let (sum, free) = self
-                    .particles
-                    .inv_mass
-                    .iter()
-                    .filter(|&&w| w > 0.0)
-                    .fold((0.0f64, 0usize), |(s, n), &w| (s + f64::from(w), n + 1));
-                let w = (sum / free.max(1) as f64) as f32;
-                let hinges = self
-                    .structure
-                    .hinges
-                    .mean_load(&self.particles.inv_mass, fabric.bending);
-                self.clock.fabric_loads = Some((self.params, w, hinges));
-                (w, hinges)
-            }
-        };
+        let (w, hinges) = self.fabric_loads();
         let (structural, shear) = fabric.grid_springs();
         // Along lines the structural family is solved exactly, with no softening (a soft
         // grid settles at its static stretch at 20 substeps, `tests/xpbd.rs`): only the
@@ -253,6 +236,44 @@ impl ClothSolver {
         let most = springs.max(hinges / FABRIC_SOFTENING);
         let n = (dt * most.sqrt()).ceil();
         if n.is_finite() { (n as u32).max(1) } else { 1 }
+    }
+
+    /// How many times a step of `dt` projects a fabric's hinges (XPBD): the least that
+    /// keeps their softening within [`FABRIC_SOFTENING`], as [`Self::fabric_floor`] asks
+    /// of the substeps (1 without a fabric). A hinge is as soft as a cloth's bending, far
+    /// softer than its stretch: where the stretch asks for more substeps, the hinges are
+    /// projected once every few of them (`steps/xpbd.rs`).
+    pub(super) fn hinge_projections(&mut self, dt: f32) -> u32 {
+        if self.params.fabric.is_none() {
+            return 1;
+        }
+        let (_, hinges) = self.fabric_loads();
+        let n = (dt * (hinges / FABRIC_SOFTENING).sqrt()).ceil();
+        if n.is_finite() { (n as u32).max(1) } else { 1 }
+    }
+
+    /// The free particles' mean inverse mass and the fabric hinges' mean load
+    /// (`Hinges::mean_load`), kept while the parameters stay.
+    fn fabric_loads(&mut self) -> (f32, f32) {
+        let bending = self.params.fabric.map_or(0.0, |f| f.bending);
+        match self.clock.fabric_loads {
+            Some((params, w, hinges)) if params == self.params => (w, hinges),
+            _ => {
+                let (sum, free) = self
+                    .particles
+                    .inv_mass
+                    .iter()
+                    .filter(|&&w| w > 0.0)
+                    .fold((0.0f64, 0usize), |(s, n), &w| (s + f64::from(w), n + 1));
+                let w = (sum / free.max(1) as f64) as f32;
+                let hinges = self
+                    .structure
+                    .hinges
+                    .mean_load(&self.particles.inv_mass, bending);
+                self.clock.fabric_loads = Some((self.params, w, hinges));
+                (w, hinges)
+            }
+        }
     }
 
     /// The stretch a family's springs may take: 0 when inextensible, the strain limit when

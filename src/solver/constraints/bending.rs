@@ -126,15 +126,22 @@ impl Hinges {
     }
 
     /// Projects every hinge's constraint once (XPBD, Gauss–Seidel in hinge order) for
-    /// rigidity `b` over a substep `h`; each correction also goes to the velocity (`/h`).
-    pub fn project(&self, p: &mut Particles, b: f32, h: f32) {
+    /// rigidity `b`, on behalf of `substeps` substeps of length `h`; each correction also
+    /// goes to the velocity (`/h`).
+    ///
+    /// Projected once for `g` substeps, a hinge's compliance is `α/(g h²)`: while it is
+    /// soft against its particles' masses (`g h² Σ w K² ≪ α`, which `hinge_projections`
+    /// keeps), the correction is the impulse `h · g · f` its force `f` would have given
+    /// over the `g` substeps, so a cloth's bending costs what its stiffness needs, not what
+    /// its stretch does.
+    pub fn project(&self, p: &mut Particles, b: f32, h: f32, substeps: u32) {
         if b <= 0.0 {
             return;
         }
         // `Δλ = −C / (Σ w_k K_k² + α̃)` and `Δx_k = w_k K_k v̂ Δλ` with `C = |v|`: the length
         // cancels, `Δx_k = −w_k K_k v / (Σ w K² + α̃)` (no square root, and nothing to
-        // skip at `v = 0`). `α̃ = (A0 + A1)/(B h²)`.
-        let (inv_h, per_area) = (1.0 / h, 1.0 / (b * h * h));
+        // skip at `v = 0`). `α̃ = (A0 + A1)/(B g h²)`.
+        let (inv_h, per_area) = (1.0 / h, 1.0 / (b * substeps.max(1) as f32 * h * h));
         for e in 0..self.len() {
             let (corners, k) = (self.corners[e], self.weights[e]);
             let i = corners.map(|i| i as usize);

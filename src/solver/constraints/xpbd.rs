@@ -67,6 +67,9 @@ pub(in crate::solver) struct Constraints {
     /// The structural constraints as chains, solved exactly along each
     /// (`chains.rs`; [`XpbdSolve::Lines`](crate::params::XpbdSolve::Lines)).
     pub chains: Chains,
+    /// A fabric's hinges are projected once every this many substeps of the step, set
+    /// when it begins (`steps/xpbd.rs`).
+    pub hinge_every: u32,
 }
 
 /// What one family's constraints take in a substep.
@@ -139,6 +142,7 @@ impl Constraints {
             predicted: Vec::with_capacity(n),
             tethers: Tethers::default(),
             chains: Chains::default(),
+            hinge_every: 1,
         };
         debug_assert!(constraints.colours_are_disjoint(n));
         constraints

@@ -40,6 +40,16 @@ impl ModelSteps for XpbdParams {
         refresh_tethers(cloth, self);
     }
 
+    /// How often this step projects the fabric's hinges: at least as often as their
+    /// stiffness asks (`ClothSolver::hinge_projections`), spread evenly over the
+    /// substeps.
+    fn begin(&self, cloth: &mut ClothSolver, dt: f32, _ratio: Option<f32>) {
+        let projections = cloth.hinge_projections(dt);
+        if let ModelState::Xpbd(constraints) = &mut cloth.model {
+            constraints.hinge_every = (cloth.clock.substeps / projections).max(1);
+        }
+    }
+
     /// Gravity, wind and drag only: the springs are constraints.
     fn forces(&self, cloth: &mut ClothSolver, env: &Environment) {
         cloth.external_forces(env);
@@ -103,8 +113,21 @@ impl ModelSteps for XpbdParams {
             sweep_families(stencil, constraints, p, &after, h);
         }
         if let Some(fabric) = cloth.params.fabric {
-            let hinges = &cloth.structure.hinges;
-            hinges.project(&mut cloth.particles, fabric.bending, h);
+            // The hinges once every `hinge_every` substeps, each projection for the
+            // substeps since the last (the step's last substep projects what is left).
+            let (every, done) = (
+                constraints.hinge_every.max(1),
+                cloth.clock.substep_index + 1,
+            );
+            let group = match done % every {
+                0 => every,
+                left if done == cloth.clock.substeps => left,
+                _ => 0,
+            };
+            if group > 0 {
+                let hinges = &cloth.structure.hinges;
+                hinges.project(&mut cloth.particles, fabric.bending, h, group);
+            }
         }
         let pins = &cloth.drivers.pins;
         constraints.tethers.project(&mut cloth.particles, pins, h);
