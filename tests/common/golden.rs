@@ -18,13 +18,7 @@ use bevy::math::Vec3;
 /// order moves a settled cloth by float rounding (µm), a chaotic one (a cloth flapping in
 /// gusts, 120 steps) by up to a few mm; a move of centimetres is a change of behaviour,
 /// which the commit that makes it must own by raising this.
-///
-/// Raised to 40 cm for one bless: XPBD now projects a fabric's hinges once for several
-/// substeps where the stretch asks for more substeps than the bending does. The flag
-/// flapping in gusts moved up to 36 cm at step 120, the proxy over a falling sheet
-/// 5.5 cm, the walking skirt 2.2 cm, the curtain in the turbulent zone 3.3 cm; the
-/// strip at rest bends the same within 0.03% (`tests/fabric.rs`).
-pub const BLESS_BOUND_M: f32 = 0.4;
+pub const BLESS_BOUND_M: f32 = 0.005;
 
 /// The main crate's stored dumps.
 pub fn main_dir() -> PathBuf {
