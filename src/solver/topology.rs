@@ -62,6 +62,25 @@ impl Springs {
         self.a.is_empty()
     }
 
+    /// Whether a whole spring of `kind` with a free end (by `inv_mass`) is longer than
+    /// `max_stretch` times its rest length at `x`: what a strain limit's projection would
+    /// move (the same test, `len > max_stretch · l0`, so skipping it when none is changes
+    /// no bit).
+    pub(in crate::solver) fn any_longer_than(
+        &self,
+        kind: SpringKind,
+        x: &[Vec3],
+        inv_mass: &[f32],
+        max_stretch: f32,
+    ) -> bool {
+        self.ranges[kind as usize].clone().any(|k| {
+            let (a, b) = (self.a[k] as usize, self.b[k] as usize);
+            self.alive[k]
+                && inv_mass[a] + inv_mass[b] > 0.0
+                && x[a].distance(x[b]) > max_stretch * self.rest_length[k]
+        })
+    }
+
     /// The factor on spring `s`'s family stiffness (see `stiffness_scale`).
     #[inline]
     pub fn scale(&self, s: usize) -> f32 {
