@@ -19,6 +19,7 @@ fn main() {
         ..ClothParams::default()
     };
     let sets = [
+        ("ClothParams::seeds()", ClothParams::seeds()),
         ("ClothParams::default()", ClothParams::default()),
         ("XPBD, denim", xpbd(Fabric::DENIM)),
         ("XPBD, twill", xpbd(Fabric::TWILL)),
