@@ -1,9 +1,9 @@
 //! XPBD's step (Macklin, Müller and Chentanez 2016; small steps, Macklin et al. 2019,
 //! algorithm 1): predict from the external forces, project every spring's constraint once
 //! a substep (on a grid's stencil, `lattice/xpbd.rs`; otherwise `xpbd.rs`), a fabric's
-//! bending hinges (`bending.rs`), then the
-//! tethers to the pins (Kim, Chentanez and Müller 2012, `tethers.rs`); velocities are the
-//! change from the prediction over `h`.
+//! bending hinges (`bending.rs`) as often as their stiffness asks, then the tethers to
+//! the pins (Kim, Chentanez and Müller 2012, `tethers.rs`); velocities are the change
+//! from the prediction over `h`.
 
 use super::ModelSteps;
 use crate::params::{Environment, XpbdParams, XpbdSolve};
