@@ -114,8 +114,8 @@ impl ClothSolver {
         true
     }
 
-    /// Springs stretched past the tear ratio break and hide the faces they border (seed
-    /// 000 §3.2): the models whose springs act on the particles (mass-spring, XPBD).
+    /// Springs stretched past the tear ratio break and hide the faces they border (Sladović
+    /// 2014 §3.2): the models whose springs act on the particles (mass-spring, XPBD).
     pub(super) fn tear_overstretched(&mut self) {
         if let Some(ratio) = self.params.tear_ratio {
             self.structure

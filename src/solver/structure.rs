@@ -174,8 +174,8 @@ impl Structure {
         self.faces_changed = true;
     }
 
-    /// Seam-free springs stretched past `ratio` times their rest length at `x` tear (seed
-    /// 000 §3.2); they are this step's torn springs. Seams are sewn to a rest length of 0
+    /// Seam-free springs stretched past `ratio` times their rest length at `x` tear (Sladović
+    /// 2014 §3.2); they are this step's torn springs. Seams are sewn to a rest length of 0
     /// and do not tear.
     pub fn tear_overstretched(&mut self, x: &[Vec3], ratio: f32) {
         for k in 0..self.springs.ranges[SpringKind::Seam as usize].start {

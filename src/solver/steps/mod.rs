@@ -332,8 +332,8 @@ impl ClothSolver {
         }
     }
 
-    /// Stage 1: clears and accumulates the forces on every free particle (gravity, seed
-    /// 002 eq. 1.6; wind; linear drag `−c v`, Sladović 2014 eq. 31; the model's). Reads only
+    /// Stage 1: clears and accumulates the forces on every free particle (gravity,
+    /// Maslova eq. 1.6; wind; linear drag `−c v`, Sladović 2014 eq. 31; the model's). Reads only
     /// the old state, so the result does not depend on particle order (Sladović 2014 §3.2).
     /// Just after a model switch, the force that keeps the switch smooth (`switch.rs`).
     pub fn accumulate_forces(&mut self, env: &Environment) {
