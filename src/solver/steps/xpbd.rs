@@ -8,9 +8,12 @@
 use super::ModelSteps;
 use crate::params::{Environment, XpbdParams, XpbdSolve};
 use crate::solver::chains::Chains;
+use crate::solver::clock::Clock;
 use crate::solver::integrate::symplectic_euler;
 use crate::solver::lattice::Stencil;
-use crate::solver::{ClothSolver, ModelState, Particles, SpringKind, family_stiffness, xpbd};
+use crate::solver::{
+    ClothSolver, ModelState, Particles, SpringKind, Springs, family_stiffness, xpbd,
+};
 
 impl ModelSteps for XpbdParams {
     /// A cloth's springs never change (they only tear): the constraints are built once
@@ -40,22 +43,12 @@ impl ModelSteps for XpbdParams {
         refresh_tethers(cloth, self);
     }
 
-    /// How often this step projects the fabric's hinges: at least as often as their
-    /// stiffness asks (`ClothSolver::hinge_projections`), spread evenly over the
-    /// substeps; every substep with self-collision, which bounds how far a particle moves
-    /// in one substep: a hinge projected once for several substeps gives their whole
-    /// impulse in one, and in the doorway's gale (six denim strips tangling, accuracy
-    /// first) a strip then passed 50% strain after 2 s with one projection for about
-    /// twenty substeps, reached 36% with one for four, and 20–24% with one for two or
-    /// every substep.
+    /// How often this step projects the fabric's hinges
+    /// (`ClothSolver::hinge_every`).
     fn begin(&self, cloth: &mut ClothSolver, dt: f32, _ratio: Option<f32>) {
-        let projections = if cloth.params.self_collision.enabled {
-            cloth.clock.substeps
-        } else {
-            cloth.hinge_projections(dt)
-        };
+        let every = cloth.hinge_every(dt);
         if let ModelState::Xpbd(constraints) = &mut cloth.model {
-            constraints.hinge_every = (cloth.clock.substeps / projections).max(1);
+            constraints.hinge_every = every;
         }
     }
 
@@ -75,75 +68,24 @@ impl ModelSteps for XpbdParams {
     }
 
     /// Every spring's constraint projected once, the strain limit with the structural and
-    /// shear ones, then the tethers, last so the bound they keep holds at the end of the
-    /// substep.
+    /// shear ones, the fabric's hinges at their own rate, then the tethers, last so the
+    /// bound they keep holds at the end of the substep.
     fn constrain(&self, cloth: &mut ClothSolver) {
         let ModelState::Xpbd(constraints) = &mut cloth.model else {
             return;
         };
         let h = cloth.clock.h;
-        let (springs, limit) = (&cloth.params.springs_in_use(), cloth.params.strain_limit);
-        let families = SpringKind::ALL.map(|kind| {
-            let k = family_stiffness(springs, kind);
-            let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
-            xpbd::Family::new(k, springs.damping, h, limit.filter(|_| limited))
-        });
+        let families = families(&cloth.params, h);
         let (stencil, p) = (&mut cloth.structure.stencil, &mut cloth.particles);
-        let edges = &cloth.structure.springs;
-        if self.solve == XpbdSolve::Sweep {
-            sweep_families(stencil, constraints, p, &families, h);
-        } else {
-            // The other families swept, then the structural one along its lines (one
-            // Newton step of each line's lengths), then a sweep of the seams again (they
-            // pull against it: swept only before the lines, a seam of the T-shirt stayed
-            // 3.5 mm open) and of what bounds the structural length: an inextensible
-            // family projected on its own nonlinear lengths (the T-shirt's armpits, where
-            // seams meet, stretched to 8.5% without it and 5.2% with it), or a compliant
-            // family's strain limit.
-            let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
-            let mut before = families;
-            before[structural].on = false;
-            sweep_families(stencil, constraints, p, &before, h);
-            constraints.chains.solve(p, families[structural], h);
-            let mut after = [xpbd::Family::default(); 5];
-            after[seam] = families[seam];
-            let f = families[structural];
-            if f.on && f.compliance == 0.0 {
-                // Inextensible: a second, nonlinear projection is one more iteration.
-                after[structural] = f;
-            } else if f.on
-                && f.max_stretch.is_finite()
-                && edges.any_longer_than(
-                    SpringKind::Structural,
-                    &p.position,
-                    &p.inv_mass,
-                    f.max_stretch,
-                )
-            {
-                // Compliant: projected again it would be twice as stiff; only its limit,
-                // and only when a spring is past it (a sweep that moves nothing is a
-                // sixth of the crowd's step on denim).
-                after[structural] = xpbd::Family {
-                    on: true,
-                    compliance: f32::INFINITY,
-                    damping: 0.0,
-                    max_stretch: f.max_stretch,
-                };
+        match self.solve {
+            XpbdSolve::Sweep => sweep_families(stencil, constraints, p, &families, h),
+            XpbdSolve::Lines => {
+                let springs = &cloth.structure.springs;
+                along_lines(stencil, constraints, (p, springs), &families, h);
             }
-            sweep_families(stencil, constraints, p, &after, h);
         }
         if let Some(fabric) = cloth.params.fabric {
-            // The hinges once every `hinge_every` substeps, each projection for the
-            // substeps since the last (the step's last substep projects what is left).
-            let (every, done) = (
-                constraints.hinge_every.max(1),
-                cloth.clock.substep_index + 1,
-            );
-            let group = match done % every {
-                0 => every,
-                left if done == cloth.clock.substeps => left,
-                _ => 0,
-            };
+            let group = hinge_group(constraints.hinge_every, &cloth.clock);
             if group > 0 {
                 let hinges = &cloth.structure.hinges;
                 hinges.project(&mut cloth.particles, fabric.bending, h, group);
@@ -155,6 +97,76 @@ impl ModelSteps for XpbdParams {
 
     fn end(&self, cloth: &mut ClothSolver) {
         cloth.tear_overstretched();
+    }
+}
+
+/// Each family's constraint parameters for a substep of `h` (by [`SpringKind`]); the
+/// strain limit on the structural and shear ones.
+fn families(params: &crate::params::ClothParams, h: f32) -> [xpbd::Family; 5] {
+    let (springs, limit) = (&params.springs_in_use(), params.strain_limit);
+    SpringKind::ALL.map(|kind| {
+        let k = family_stiffness(springs, kind);
+        let limited = matches!(kind, SpringKind::Structural | SpringKind::Shear);
+        xpbd::Family::new(k, springs.damping, h, limit.filter(|_| limited))
+    })
+}
+
+/// The constraints with the structural family along its lines: the other families
+/// swept, then the structural one along its lines (one Newton step of each line's
+/// lengths), then a sweep of the seams again (they pull against it: swept only before
+/// the lines, a seam of the T-shirt stayed 3.5 mm open) and of what bounds the structural
+/// length: an inextensible family projected on its own nonlinear lengths (the T-shirt's
+/// armpits, where seams meet, stretched to 8.5% without it and 5.2% with it), or a
+/// compliant family's strain limit.
+fn along_lines(
+    stencil: &mut Option<Stencil>,
+    constraints: &mut xpbd::Constraints,
+    (p, springs): (&mut Particles, &Springs),
+    families: &[xpbd::Family; 5],
+    h: f32,
+) {
+    let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
+    let mut before = *families;
+    before[structural].on = false;
+    sweep_families(stencil, constraints, p, &before, h);
+    constraints.chains.solve(p, families[structural], h);
+    let mut after = [xpbd::Family::default(); 5];
+    after[seam] = families[seam];
+    let f = families[structural];
+    if f.on && f.compliance == 0.0 {
+        // Inextensible: a second, nonlinear projection is one more iteration.
+        after[structural] = f;
+    } else if f.on
+        && f.max_stretch.is_finite()
+        && springs.any_longer_than(
+            SpringKind::Structural,
+            &p.position,
+            &p.inv_mass,
+            f.max_stretch,
+        )
+    {
+        // Compliant: projected again it would be twice as stiff; only its limit, and
+        // only when a spring is past it (a sweep that moves nothing is a sixth of the
+        // crowd's step on denim).
+        after[structural] = xpbd::Family {
+            on: true,
+            compliance: f32::INFINITY,
+            damping: 0.0,
+            max_stretch: f.max_stretch,
+        };
+    }
+    sweep_families(stencil, constraints, p, &after, h);
+}
+
+/// How many substeps the hinges' projection in the current substep stands for, with
+/// hinges every `every` substeps: `every` at each `every`-th substep, what is left at the
+/// step's last, 0 (none) otherwise.
+fn hinge_group(every: u32, clock: &Clock) -> u32 {
+    let (every, done) = (every.max(1), clock.substep_index + 1);
+    match done % every {
+        0 => every,
+        left if done == clock.substeps => left,
+        _ => 0,
     }
 }
 
