@@ -73,6 +73,27 @@ pub const WAIT: f32 = 3.0;
 const SPEED: f32 = 1.2;
 const REACH: f32 = 3.0;
 
+/// The doorway headless, with no window or renderer, for its measurements and tests:
+/// `setup` in a headless app with `budget`, updated until its six strips are built.
+#[allow(dead_code)] // the example opens a window; its headless twin and a test use this
+pub fn headless(setup: Doorway, budget: ClothBudget) -> App {
+    let root = bevy_cloth::layout::garment::asset_root();
+    let mut app = bevy_cloth::headless::headless_base_in(root.to_string_lossy());
+    app.add_plugins(TransformPlugin)
+        .init_asset::<StandardMaterial>()
+        .insert_resource(setup);
+    scene(&mut app);
+    app.insert_resource(budget);
+    let mut sims = app.world_mut().query::<&ClothSimulation>();
+    for _ in 0..10 {
+        app.update();
+        if sims.iter(app.world()).count() == STRIPS {
+            break;
+        }
+    }
+    app
+}
+
 /// The doorway as a plugin: the cloth plugin, the air, the scene and the walk. Reads the
 /// [`Doorway`] resource (its default when absent).
 pub fn scene(app: &mut App) {

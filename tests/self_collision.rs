@@ -326,20 +326,13 @@ fn the_doorways_strips_stay_whole_in_a_gale_with_self_collision() {
     // fold against each other. With the fabric's hinges projected once for several
     // substeps under self-collision, a strip passed 50% at 2.0 s (75.5%); projected
     // every substep, the strips stay below 25% for 20 s.
-    use bevy::prelude::*;
-    use bevy_cloth::headless::headless_base_in;
-    use bevy_cloth::layout::garment::asset_root;
     use bevy_cloth::prelude::*;
-    let mut app = headless_base_in(asset_root().to_string_lossy());
-    app.add_plugins(TransformPlugin)
-        .init_asset::<StandardMaterial>()
-        .insert_resource(doorway::Doorway {
-            wind: 10.0,
-            self_collision: true,
-            gap: 0.02,
-        });
-    doorway::scene(&mut app);
-    app.insert_resource(ClothBudget::UNLIMITED);
+    let setup = doorway::Doorway {
+        wind: 10.0,
+        self_collision: true,
+        gap: 0.02,
+    };
+    let mut app = doorway::headless(setup, ClothBudget::UNLIMITED);
     let mut sims = app.world_mut().query::<&ClothSimulation>();
     let (mut worst, mut strips) = (0.0f32, 0);
     for _ in 0..190 {

@@ -9,8 +9,7 @@
 //!
 //! `cargo run -p bevy_cloth_lab --example doorway_cost [-- SECONDS]` (default 120)
 use bevy::prelude::*;
-use bevy_cloth::headless::{WHOLE_STRAIN, headless_base_in};
-use bevy_cloth::layout::garment::asset_root;
+use bevy_cloth::headless::WHOLE_STRAIN;
 use bevy_cloth::prelude::*;
 
 #[allow(dead_code)]
@@ -30,19 +29,8 @@ struct Measured {
 }
 
 fn measure(setup: doorway::Doorway, budget: ClothBudget, steps: usize) -> Measured {
-    let mut app = headless_base_in(asset_root().to_string_lossy());
-    app.add_plugins(TransformPlugin)
-        .init_asset::<StandardMaterial>()
-        .insert_resource(setup);
-    doorway::scene(&mut app);
-    app.insert_resource(budget);
+    let mut app = doorway::headless(setup, budget);
     let mut sims = app.world_mut().query::<&ClothSimulation>();
-    for _ in 0..10 {
-        app.update();
-        if sims.iter(app.world()).count() == doorway::STRIPS {
-            break;
-        }
-    }
     let mut m = Measured {
         stage_ms: Vec::with_capacity(steps),
         strain: 0.0,
