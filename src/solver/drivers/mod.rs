@@ -72,13 +72,13 @@ pub(super) struct MotionConstraints {
 pub struct BackStop {
     /// How far behind its target the particle may go, m (≥ 0).
     pub distance: f32,
-    /// The sphere's radius, m (≥ 0; 0: none). A large radius makes the stop a plane at
-    /// `distance` behind the target; a small one lets the particle round it sideways.
+    /// The sphere's radius, m (≥ 0; 0: none). A large radius makes the back stop a plane
+    /// at `distance` behind the target; a small one lets the particle round it sideways.
     pub radius: f32,
 }
 
 impl BackStop {
-    /// Moves `x` out of this stop's sphere behind `target` along `normal` (the targets'
+    /// Moves `x` out of this back stop's sphere behind `target` along `normal` (the targets'
     /// normal, any length): out to its surface the nearest way, along the line from its
     /// centre. Whether it moved.
     #[inline(always)]
