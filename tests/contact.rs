@@ -498,9 +498,13 @@ struct OutOfBall {
     in_plane: f32,
 }
 
-/// A cloth hung by its top row with a ball of radius 0.2 centred on its plane 0.65 m below
-/// the top, its lower rows starting inside, stepped until no particle is inside (or 1 s).
-fn started_through_a_ball(model: Model) -> OutOfBall {
+const BALL_CENTER: Vec3 = Vec3::new(0.0, 0.35, 0.0);
+const BALL_RADIUS: f32 = 0.2;
+
+/// A 16 × 16 cloth (5 cm) hung by its top row at y = 1 with a frictionless ball of radius
+/// 0.2 centred on its plane 0.65 m below the top: its lower rows start inside. The seeds'
+/// parameters, the depenetration cap at 1 m/s.
+fn hung_through_a_ball(model: Model) -> ClothSolver {
     let params = ClothParams {
         model,
         ..ClothParams::seeds()
@@ -511,13 +515,19 @@ fn started_through_a_ball(model: Model) -> OutOfBall {
         .shape
         .build_solver(&ClothPins::TopRow, &params, frame)
         .unwrap();
-    let (center, radius) = (Vec3::new(0.0, 0.35, 0.0), 0.2);
     let mut ball = collider(ColliderShape::Sphere(bevy_cloth::solver::shapes::Sphere {
-        center,
-        radius,
+        center: BALL_CENTER,
+        radius: BALL_RADIUS,
     }));
     ball.friction = 0.0;
     cloth.set_colliders([ball]);
+    cloth
+}
+
+/// [`hung_through_a_ball`], stepped until no particle is inside (or 1 s).
+fn started_through_a_ball(model: Model) -> OutOfBall {
+    let (center, radius) = (BALL_CENTER, BALL_RADIUS);
+    let mut cloth = hung_through_a_ball(model);
     let inside = |c: &ClothSolver| {
         c.positions()
             .iter()
@@ -598,13 +608,22 @@ fn a_cloth_started_through_a_ball_leaves_it_along_its_normal_within_half_a_secon
 }
 
 #[test]
-#[ignore = "target not met yet: the particles pushed out move at the cap, but the cloth they \
-            drag out overshoots it elastically (2.5 m/s XPBD, 2.7 m/s mass-spring)"]
 fn a_cloth_started_through_a_ball_is_moved_out_no_faster_than_the_cap() {
+    // The particles pushed out move at the cap; the cloth around them is carried along
+    // without taking speed from the push (measured 0.73 m/s XPBD, 0.82 mass-spring).
+    // Without the carry the neighbours overshot (2.3 m/s XPBD, 2.7 mass-spring), pulled
+    // in and out every substep by springs tied to particles still inside. Hung without
+    // the ball, the cloth moves at most 0.39 m/s in these steps.
     for (name, model) in models() {
-        let fastest_seen = started_through_a_ball(model).fastest;
+        let mut cloth = hung_through_a_ball(model);
+        let mut fastest_seen = 0.0f32;
+        for _ in 0..30 {
+            cloth.step(DT, &Environment::default());
+            fastest_seen = fastest_seen.max(fastest(&cloth));
+        }
+        eprintln!("{name}: fastest particle over the first 30 steps {fastest_seen:.3} m/s");
         assert!(
-            fastest_seen <= 1.05,
+            fastest_seen <= 1.0 + 1e-4,
             "{name}: launched at {fastest_seen} m/s"
         );
     }

@@ -56,8 +56,9 @@ fn self_collision_does_not_drive_the_substeps_up() {
 
 /// A 16 × 16 cloth pinned by its top row with its lower rows started inside a ball:
 /// contact pushes them out over several steps, and the stretch that leaves is not the
-/// solver's error. The loop took 175 substeps for it against 6 without the ball; now at
-/// most three times (2.6× measured).
+/// solver's error. The loop took 175 substeps for it against 6 without the ball, then 18
+/// against 7 while the cloth's constraints fought the push; with the cloth carried along
+/// with the push, 7 against 7. At most twice.
 #[test]
 fn contact_pushes_do_not_drive_the_substeps_up() {
     let scene = |ball: bool| {
@@ -81,7 +82,7 @@ fn contact_pushes_do_not_drive_the_substeps_up() {
     );
     assert!(b.whole);
     assert!(
-        b.most_substeps <= 3 * a.most_substeps,
+        b.most_substeps <= 2 * a.most_substeps,
         "{} substeps through the ball against {} without",
         b.most_substeps,
         a.most_substeps

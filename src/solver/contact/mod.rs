@@ -6,10 +6,12 @@
 use crate::solver::state::mark;
 use bevy::math::{Quat, Vec3};
 
+mod carry;
 mod collider;
 pub(super) mod self_contact;
 pub mod shapes;
 
+pub(crate) use carry::DEEP_OVERLAP;
 pub(crate) use collider::Bounds;
 pub use collider::{Collider, ColliderImpulse, Motion};
 use shapes::Shape;
@@ -40,6 +42,18 @@ pub(super) struct Contact {
     /// The capsules and cylinders thinner than the cloth's longest edge, which the edge
     /// pass tests (set with the colliders: neither changes between steps).
     pub thin: Vec<usize>,
+    /// The particles this substep moved out of an overlap they started in, and by how
+    /// much: the cloth around them is carried along ([`Contact::carry`]).
+    pub lifted: Vec<(u32, Vec3)>,
+    /// Each particle's overlap left at the end of the last substep (what its lift did
+    /// not undo), m.
+    pub left_inside: Vec<f32>,
+    /// The most any particle's overlap grew since the last substep left it, m: an
+    /// overlap that appears at once (a spawn through a body, a collider that jumped), not
+    /// one pressed in over many substeps.
+    pub newest_overlap: f32,
+    /// The carry's scratch (kept for its storage).
+    pub carry: carry::Scratch,
 }
 
 impl Contact {
@@ -146,17 +160,34 @@ impl Contact {
             depenetration,
         };
         let pushes = &mut self.pushes;
+        self.lifted.clear();
+        self.newest_overlap = 0.0;
+        self.left_inside.resize(p.position.len(), 0.0);
         for i in 0..p.position.len() {
             let w = p.inv_mass[i];
+            let left = std::mem::take(&mut self.left_inside[i]);
             if w == 0.0 {
                 continue;
             }
             let (x, previous) = (p.position[i], p.previous[i]);
             pushes.clear();
             let exit = || normal(&p.position, i).try_normalize();
-            let Some((x, previous)) = world.resolve_particle(x, previous, exit, pushes) else {
+            let Some(Resolved {
+                x,
+                previous,
+                lifted,
+                overlap,
+            }) = world.resolve_particle(x, previous, exit, pushes)
+            else {
                 continue;
             };
+            // What of the overlap is new since the last substep left it.
+            self.newest_overlap = self.newest_overlap.max(overlap - left);
+            self.left_inside[i] = (overlap - lifted.length()).max(0.0);
+            // A lift of float noise (a particle resting on the surface) is none.
+            if lifted.length_squared() > LIFT_NOISE * LIFT_NOISE * depenetration * depenetration {
+                self.lifted.push((i as u32, lifted));
+            }
             // The reaction: each collider takes the particle's momentum change it caused,
             // the other way (`m Δv`, `Δv = (push − previous's shift)/h`).
             for &(k, push) in pushes.iter() {
@@ -362,6 +393,19 @@ struct Hit {
     swept: bool,
 }
 
+/// A particle kept out of the colliders by [`World::resolve_particle`].
+struct Resolved {
+    /// Its position and `previous`.
+    x: Vec3,
+    previous: Vec3,
+    /// How far it was moved out of an overlap it started in (pre-stabilised: `previous`
+    /// moved with it).
+    lifted: Vec3,
+    /// How deep that overlap was, m (it comes out over several substeps when deeper than
+    /// the cap).
+    overlap: f32,
+}
+
 /// The colliders of one substep, placed, with their boxes and turns, and how far a
 /// particle that started inside one is moved out in the substep at most.
 struct World<'a> {
@@ -386,7 +430,7 @@ impl World<'_> {
     }
 
     /// A particle that moved from `previous` to `x` in the substep, kept outside every
-    /// collider: its new position and `previous`, and each collider's share of the
+    /// collider: where it ends ([`Resolved`]), and each collider's share of the
     /// correction (less the shift of `previous`) in `pushes`; `None` when no collider
     /// touched it.
     fn resolve_particle(
@@ -395,10 +439,12 @@ impl World<'_> {
         previous: Vec3,
         exit: impl Fn() -> Option<Vec3>,
         pushes: &mut Vec<(usize, Vec3)>,
-    ) -> Option<(Vec3, Vec3)> {
+    ) -> Option<Resolved> {
         let start = x;
         let mut x = x;
         let mut shift = Vec3::ZERO; // of `previous`
+        let mut lifted = Vec3::ZERO; // the part of `shift` that undid an overlap
+        let mut overlap = 0.0f32;
         // The collider whose surface takes the friction (`friction`): the one that pushed
         // most.
         let mut most: Option<(usize, f32, Vec3)> = None;
@@ -427,8 +473,12 @@ impl World<'_> {
             let before = (depth - own).max(0.0);
             // Of that, no more than the cap this substep: the rest waits for the next.
             shift += n * before;
+            lifted += n * before;
+            overlap = overlap.max(before);
             if before > self.depenetration {
+                let at = x;
                 (x, shift) = self.capped_exit((k, n, before), x, previous, shift, &exit, pushes);
+                lifted += x - at;
             }
             add_push(pushes, k, push - n * before);
             // Stopped where its path met the surface, its motion into the surface ends
@@ -447,7 +497,12 @@ impl World<'_> {
         let friction = self.friction(k, x - start, x, previous);
         x += friction;
         add_push(pushes, k, friction);
-        Some((x, previous))
+        Some(Resolved {
+            x,
+            previous,
+            lifted,
+            overlap,
+        })
     }
 
     /// A particle at `x` that was `before` deep in collider `k` (outward normal `n`) at
@@ -618,6 +673,11 @@ impl World<'_> {
         (past < 0.0).then_some((-past, n))
     }
 }
+
+/// The lift below which a particle counts as resting on the surface rather than started
+/// inside: this fraction of the substep's cap on the lift (float noise in the push less the
+/// particle's own approach).
+const LIFT_NOISE: f32 = 0.01;
 
 /// How much farther than its depth a particle that started deep in a collider may have to
 /// go along its cloth's normal to leave that way rather than toward the nearest surface.

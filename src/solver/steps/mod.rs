@@ -30,6 +30,7 @@ use std::time::Duration;
 use bevy::math::Vec3;
 use bevy::platform::time::Instant;
 
+use super::contact::DEEP_OVERLAP;
 use super::{ClothSolver, SpringKind};
 use crate::params::{Environment, Model, Substeps};
 
@@ -385,6 +386,12 @@ impl ClothSolver {
             &mut self.particles,
             (tau, h, depenetration),
             |x, i| structure.normal_sum(x, i),
+            &mut self.touched,
+        );
+        self.contact.carry(
+            &mut self.particles,
+            &self.structure.springs,
+            self.structure.longest_edge * DEEP_OVERLAP,
             &mut self.touched,
         );
         self.contact.resolve_edges(
