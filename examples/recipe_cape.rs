@@ -2,7 +2,6 @@
 //! The whole file is the recipe in `docs/recipes.md` (a test keeps the two equal).
 
 use bevy::prelude::*;
-use bevy_cloth::params::{Model, XpbdParams};
 use bevy_cloth::prelude::*;
 
 fn main() {

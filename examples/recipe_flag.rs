@@ -2,7 +2,7 @@
 //! The whole file is the recipe in `docs/recipes.md` (a test keeps the two equal).
 
 use bevy::prelude::*;
-use bevy_cloth::params::{Environment, Model, WindField, XpbdParams};
+use bevy_cloth::params::WindField;
 use bevy_cloth::prelude::*;
 
 fn main() {

@@ -6,7 +6,6 @@ use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::mesh::{Indices, PrimitiveTopology, VertexAttributeValues};
 use bevy::prelude::*;
 use bevy_cloth::ATTRIBUTE_MAX_DISTANCE;
-use bevy_cloth::params::{Model, XpbdParams};
 use bevy_cloth::prelude::*;
 
 fn main() {

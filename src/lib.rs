@@ -76,7 +76,8 @@ pub mod prelude {
     pub use crate::fabric::Fabric;
     pub use crate::layout::shape::{ClothPins, ClothShape};
     pub use crate::params::{
-        Air, ClothParams, Inertia, SelfCollision, Teleport, TeleportMode, Turbulence, ZoneShape,
+        Air, ClothParams, Environment, Inertia, Model, SelfCollision, Substeps, Teleport,
+        TeleportMode, Turbulence, XpbdParams, ZoneShape,
     };
     pub use crate::scene::ClothScene;
 }
