@@ -2,7 +2,8 @@
 //! substeps. It moves in one place, [`Clock::advance`] at the end of each substep, so the
 //! pins' path and the colliders' sweep read the same fraction of the step.
 
-use super::substeps::{SubstepCache, SubstepLoop};
+use super::substeps::SubstepCache;
+use super::xpbd_substeps::SubstepLoop;
 
 /// Time and substeps of a cloth.
 #[derive(Clone, Debug, Default)]

@@ -30,6 +30,7 @@ mod structure;
 mod substeps;
 pub mod topology;
 pub(crate) mod unit;
+mod xpbd_substeps;
 
 // The rooms' modules the other stages name.
 use constraints::{bending, chains, lattice, tethers, xpbd};
