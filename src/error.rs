@@ -10,6 +10,7 @@ use thiserror::Error;
 /// (Reflected as an opaque value: an inspector shows it whole.)
 #[derive(Clone, Debug, Error, PartialEq, Reflect)]
 #[reflect(opaque, Debug, PartialEq, Clone)]
+#[non_exhaustive]
 pub enum ClothError {
     /// A number outside its allowed range (or not finite).
     #[error("`{field}` must be {expected}, got {value}")]
