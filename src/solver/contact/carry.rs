@@ -24,14 +24,62 @@ pub(in crate::solver) const CARRY_PASSES: usize = 16;
 /// after contact leaves, and a fraction of any overlap a spawn or a jump makes.
 pub(crate) const DEEP_OVERLAP: f32 = 0.25;
 
-/// The carry's scratch, kept for its storage.
+/// The overlaps a substep lifted particles out of, and the carry's own state (its
+/// storage kept, so a step allocates nothing once it has grown).
 #[derive(Clone, Debug, Default)]
-pub(crate) struct Scratch {
+pub(crate) struct Carry {
+    /// The particles this substep moved out of an overlap they started in, and by how
+    /// much.
+    lifted: Vec<(u32, Vec3)>,
+    /// Each particle's overlap left at the end of the last substep (what its lift did not
+    /// undo), m.
+    left_inside: Vec<f32>,
+    /// The most any particle's overlap grew since the last substep left it, m: an overlap
+    /// that appears at once (a spawn through a body, a collider that jumped), not one
+    /// pressed in over many substeps.
+    newest_overlap: f32,
     /// Each particle's move this substep by the lift and the carry.
     moved: Vec<Vec3>,
     /// Whether a deep overlap is coming out (some particle has been lifted in every
     /// substep since one appeared that deep).
     carrying: bool,
+}
+
+/// The lift below which a particle counts as resting on the surface rather than started
+/// inside: this fraction of the substep's cap on the lift (float noise in the push less the
+/// particle's own approach).
+const LIFT_NOISE: f32 = 0.01;
+
+impl Carry {
+    /// Starts a substep's contact over `n` particles.
+    pub fn begin(&mut self, n: usize) {
+        self.lifted.clear();
+        self.newest_overlap = 0.0;
+        self.left_inside.resize(n, 0.0);
+    }
+
+    /// Particle `i`'s overlap left by the last substep, forgotten (it is noted again if
+    /// the particle is still in).
+    #[inline]
+    pub fn take_left(&mut self, i: usize) -> f32 {
+        let left = self.left_inside[i];
+        if left != 0.0 {
+            self.left_inside[i] = 0.0;
+        }
+        left
+    }
+
+    /// Notes that particle `i`, `left` inside since the last substep, started this one
+    /// `overlap` deep and was `lifted` out of it, at most `cap` (m) a substep.
+    #[inline]
+    pub fn note(&mut self, i: usize, left: f32, (lifted, overlap): (Vec3, f32), cap: f32) {
+        self.newest_overlap = self.newest_overlap.max(overlap - left);
+        self.left_inside[i] = (overlap - lifted.length()).max(0.0);
+        // A lift of float noise (a particle resting on the surface) is none.
+        if lifted.length_squared() > LIFT_NOISE * LIFT_NOISE * cap * cap {
+            self.lifted.push((i as u32, lifted));
+        }
+    }
 }
 
 impl Contact {
@@ -49,18 +97,19 @@ impl Contact {
         // colliders, or into a thin pole by a projection after contact), or pressed in
         // over many substeps (the bottom of a stack), is contact's own business; one that
         // appears that deep at once is carried until its last particle is out.
-        if self.lifted.is_empty() {
-            self.carry.carrying = false;
+        let c = &mut self.carry;
+        if c.lifted.is_empty() {
+            c.carrying = false;
             return;
         }
-        self.carry.carrying |= self.newest_overlap > deep;
-        if !self.carry.carrying {
+        c.carrying |= c.newest_overlap > deep;
+        if !c.carrying {
             return;
         }
-        let moved = &mut self.carry.moved;
+        let moved = &mut c.moved;
         moved.clear();
         moved.resize(p.position.len(), Vec3::ZERO);
-        for &(i, lift) in &self.lifted {
+        for &(i, lift) in &c.lifted {
             moved[i as usize] = lift;
         }
         restore_lengths(p, springs, moved);

@@ -44,18 +44,9 @@ pub(super) struct Contact {
     /// The capsules and cylinders thinner than the cloth's longest edge, which the edge
     /// pass tests (set with the colliders: neither changes between steps).
     pub thin: Vec<usize>,
-    /// The particles this substep moved out of an overlap they started in, and by how
-    /// much: the cloth around them is carried along ([`Contact::carry`]).
-    pub lifted: Vec<(u32, Vec3)>,
-    /// Each particle's overlap left at the end of the last substep (what its lift did
-    /// not undo), m.
-    pub left_inside: Vec<f32>,
-    /// The most any particle's overlap grew since the last substep left it, m: an
-    /// overlap that appears at once (a spawn through a body, a collider that jumped), not
-    /// one pressed in over many substeps.
-    pub newest_overlap: f32,
-    /// The carry's scratch (kept for its storage).
-    pub carry: carry::Scratch,
+    /// The overlaps lifted out this substep, and the cloth carried out with them
+    /// ([`Contact::carry`]).
+    pub carry: carry::Carry,
 }
 
 impl Contact {
@@ -162,46 +153,38 @@ impl Contact {
             depenetration,
         };
         let pushes = &mut self.pushes;
-        self.lifted.clear();
-        self.newest_overlap = 0.0;
-        self.left_inside.resize(p.position.len(), 0.0);
+        self.carry.begin(p.position.len());
         for i in 0..p.position.len() {
             let w = p.inv_mass[i];
-            let left = std::mem::take(&mut self.left_inside[i]);
+            let left = self.carry.take_left(i);
             if w == 0.0 {
                 continue;
             }
             let (x, previous) = (p.position[i], p.previous[i]);
             pushes.clear();
             let exit = || normal(&p.position, i).try_normalize();
-            let Some(Resolved {
-                x,
-                previous,
-                lifted,
-                overlap,
-            }) = world.resolve_particle(x, previous, exit, pushes)
-            else {
+            let Some(out) = world.resolve_particle(x, previous, exit, pushes) else {
                 continue;
             };
-            // What of the overlap is new since the last substep left it.
-            self.newest_overlap = self.newest_overlap.max(overlap - left);
-            self.left_inside[i] = (overlap - lifted.length()).max(0.0);
-            // A lift of float noise (a particle resting on the surface) is none.
-            if lifted.length_squared() > LIFT_NOISE * LIFT_NOISE * depenetration * depenetration {
-                self.lifted.push((i as u32, lifted));
-            }
-            // The reaction: each collider takes the particle's momentum change it caused,
-            // the other way (`m Δv`, `Δv = (push − previous's shift)/h`).
-            for &(k, push) in pushes.iter() {
-                let impulse = push / (w * h);
-                self.collider_impulses[k].linear -= impulse;
-                self.collider_impulses[k].angular -= x.cross(impulse);
-            }
-            p.position[i] = x;
-            p.previous[i] = previous;
-            p.velocity[i] = (x - previous) / h;
+            self.carry
+                .note(i, left, (out.lifted, out.overlap), depenetration);
+            give_reaction(&mut self.collider_impulses, pushes, out.x, w * h);
+            p.position[i] = out.x;
+            p.previous[i] = out.previous;
+            p.velocity[i] = (out.x - out.previous) / h;
             mark(touched, i);
         }
+    }
+}
+
+/// The reaction to one particle's contact, now at `x`, of inverse mass over the substep
+/// `w_h` (`w h`): each collider takes the particle's momentum change it caused, the other
+/// way (`m Δv`, `Δv = (push − previous's shift)/h`).
+fn give_reaction(impulses: &mut [ColliderImpulse], pushes: &[(usize, Vec3)], x: Vec3, w_h: f32) {
+    for &(k, push) in pushes {
+        let impulse = push / w_h;
+        impulses[k].linear -= impulse;
+        impulses[k].angular -= x.cross(impulse);
     }
 }
 
@@ -220,7 +203,8 @@ struct Hit {
 
 /// A particle kept out of the colliders by [`World::resolve_particle`].
 struct Resolved {
-    /// Its position and `previous`.
+    /// Its position and `previous` (while [`World::push_out`] works: the shift of
+    /// `previous` so far).
     x: Vec3,
     previous: Vec3,
     /// How far it was moved out of an overlap it started in (pre-stabilised: `previous`
@@ -266,10 +250,12 @@ impl World<'_> {
         pushes: &mut Vec<(usize, Vec3)>,
     ) -> Option<Resolved> {
         let start = x;
-        let mut x = x;
-        let mut shift = Vec3::ZERO; // of `previous`
-        let mut lifted = Vec3::ZERO; // the part of `shift` that undid an overlap
-        let mut overlap = 0.0f32;
+        let mut out = Resolved {
+            x,
+            previous: Vec3::ZERO, // the shift of `previous` until the end
+            lifted: Vec3::ZERO,
+            overlap: 0.0,
+        };
         // The collider whose surface takes the friction (`friction`): the one that pushed
         // most.
         let mut most: Option<(usize, f32, Vec3)> = None;
@@ -281,53 +267,64 @@ impl World<'_> {
             if pass == 1 && met < 2 {
                 break;
             }
-            let Some(Hit { k, depth, n, swept }) = self.deepest(pass, previous, x, &mut met) else {
+            let Some(hit) = self.deepest(pass, previous, out.x, &mut met) else {
                 break;
             };
-            let push = n * depth;
-            x += push;
-            // Pre-stabilisation: a push deeper than the particle's own motion over the
-            // substep (relative to the body) undoes an overlap it started in; that part
-            // moves `previous` too, so it adds no velocity. A push never sends a particle
-            // off faster than it came in.
-            // Its own motion into the surface (a particle moving out on its own has none:
-            // taking the length instead counted an outward motion as an approach, and its
-            // push then added that much velocity, doubling it a substep).
-            let moved = x - push - self.start(k, previous + shift);
-            let own = (-moved.dot(n)).max(0.0);
-            let before = (depth - own).max(0.0);
-            // Of that, no more than the cap this substep: the rest waits for the next.
-            shift += n * before;
-            lifted += n * before;
-            overlap = overlap.max(before);
-            if before > self.depenetration {
-                let at = x;
-                (x, shift) = self.capped_exit((k, n, before), x, previous, shift, &exit, pushes);
-                lifted += x - at;
-            }
-            add_push(pushes, k, push - n * before);
-            // Stopped where its path met the surface, its motion into the surface ends
-            // there (Müller 2007 §3.5: the collision's velocity update, no restitution).
-            if swept {
-                let into = (x - previous - shift).dot(n);
-                if into < 0.0 {
-                    shift += n * into;
-                    add_push(pushes, k, -n * into);
-                }
-            }
+            let k = hit.k;
+            self.push_out(&mut out, hit, previous, &exit, pushes);
             keep_most(&mut most, pushes, k);
         }
         let (k, _, _) = most?;
-        let previous = previous + shift;
-        let friction = self.friction(k, x - start, x, previous);
-        x += friction;
+        out.previous += previous;
+        let friction = self.friction(k, out.x - start, out.x, out.previous);
+        out.x += friction;
         add_push(pushes, k, friction);
-        Some(Resolved {
-            x,
-            previous,
-            lifted,
-            overlap,
-        })
+        Some(out)
+    }
+
+    /// One push of a particle (from `previous`, on its way `out` so far, `out.previous`
+    /// holding its `previous`'s shift) out of the collider of `hit`, its share added to
+    /// `pushes`.
+    fn push_out(
+        &self,
+        out: &mut Resolved,
+        Hit { k, depth, n, swept }: Hit,
+        previous: Vec3,
+        exit: &impl Fn() -> Option<Vec3>,
+        pushes: &mut Vec<(usize, Vec3)>,
+    ) {
+        let push = n * depth;
+        out.x += push;
+        // Pre-stabilisation: a push deeper than the particle's own motion over the
+        // substep (relative to the body) undoes an overlap it started in; that part
+        // moves `previous` too, so it adds no velocity. A push never sends a particle
+        // off faster than it came in.
+        // Its own motion into the surface (a particle moving out on its own has none:
+        // taking the length instead counted an outward motion as an approach, and its
+        // push then added that much velocity, doubling it a substep).
+        let moved = out.x - push - self.start(k, previous + out.previous);
+        let own = (-moved.dot(n)).max(0.0);
+        let before = (depth - own).max(0.0);
+        // Of that, no more than the cap this substep: the rest waits for the next.
+        out.previous += n * before;
+        out.lifted += n * before;
+        out.overlap = out.overlap.max(before);
+        if before > self.depenetration {
+            let at = out.x;
+            (out.x, out.previous) =
+                self.capped_exit((k, n, before), out.x, previous, out.previous, exit, pushes);
+            out.lifted += out.x - at;
+        }
+        add_push(pushes, k, push - n * before);
+        // Stopped where its path met the surface, its motion into the surface ends
+        // there (Müller 2007 §3.5: the collision's velocity update, no restitution).
+        if swept {
+            let into = (out.x - previous - out.previous).dot(n);
+            if into < 0.0 {
+                out.previous += n * into;
+                add_push(pushes, k, -n * into);
+            }
+        }
     }
 
     /// A particle at `x` that was `before` deep in collider `k` (outward normal `n`) at
@@ -498,11 +495,6 @@ impl World<'_> {
         (past < 0.0).then_some((-past, n))
     }
 }
-
-/// The lift below which a particle counts as resting on the surface rather than started
-/// inside: this fraction of the substep's cap on the lift (float noise in the push less the
-/// particle's own approach).
-const LIFT_NOISE: f32 = 0.01;
 
 /// How much farther than its depth a particle that started deep in a collider may have to
 /// go along its cloth's normal to leave that way rather than toward the nearest surface.
