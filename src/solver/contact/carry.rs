@@ -22,7 +22,7 @@ pub(in crate::solver) const CARRY_PASSES: usize = 16;
 /// How deep, in the cloth's longest edges, an overlap must appear at once for the cloth
 /// to be carried out with it: a quarter of an edge is far past anything a projection
 /// after contact leaves, and a fraction of any overlap a spawn or a jump makes.
-pub(crate) const DEEP_OVERLAP: f32 = 0.25;
+const DEEP_OVERLAP: f32 = 0.25;
 
 /// The overlaps a substep lifted particles out of, and the carry's own state (its
 /// storage kept, so a step allocates nothing once it has grown).
@@ -89,10 +89,16 @@ impl Contact {
     /// moved by inverse mass (the lifted ones too, so two lifted different ways keep
     /// their spring), positions and `previous` alike: velocities are unchanged.
     ///
-    /// Only while an overlap that appeared deeper than `deep` (m) at once comes out: from
-    /// the substep it appears in until one that lifts nothing. Each particle it moves is
-    /// marked in `touched`.
-    pub fn carry(&mut self, p: &mut Particles, springs: &Springs, deep: f32, touched: &mut [bool]) {
+    /// Only while an overlap that appeared at once deeper than [`DEEP_OVERLAP`] of the
+    /// cloth's `longest_edge` (m) comes out: from the substep it appears in until one that
+    /// lifts nothing. Each particle it moves is marked in `touched`.
+    pub fn carry(
+        &mut self,
+        p: &mut Particles,
+        springs: &Springs,
+        longest_edge: f32,
+        touched: &mut [bool],
+    ) {
         // An overlap shallower than that (a particle nudged into a crease of two
         // colliders, or into a thin pole by a projection after contact), or pressed in
         // over many substeps (the bottom of a stack), is contact's own business; one that
@@ -102,7 +108,7 @@ impl Contact {
             c.carrying = false;
             return;
         }
-        c.carrying |= c.newest_overlap > deep;
+        c.carrying |= c.newest_overlap > DEEP_OVERLAP * longest_edge;
         if !c.carrying {
             return;
         }

@@ -12,7 +12,6 @@ mod edges;
 pub(super) mod self_contact;
 pub mod shapes;
 
-pub(crate) use carry::DEEP_OVERLAP;
 pub(crate) use collider::Bounds;
 pub use collider::{Collider, ColliderImpulse, Motion};
 pub(in crate::solver) use edges::EDGES;

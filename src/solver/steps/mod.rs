@@ -30,7 +30,6 @@ use std::time::Duration;
 use bevy::math::Vec3;
 use bevy::platform::time::Instant;
 
-use super::contact::DEEP_OVERLAP;
 use super::{ClothSolver, SpringKind};
 use crate::params::{Environment, Model, Substeps};
 
@@ -391,7 +390,7 @@ impl ClothSolver {
         self.contact.carry(
             &mut self.particles,
             &self.structure.springs,
-            self.structure.longest_edge * DEEP_OVERLAP,
+            self.structure.longest_edge,
             &mut self.touched,
         );
         self.contact.resolve_edges(
