@@ -265,11 +265,45 @@ fn a_sewn_t_shirt_dropped_off_its_mannequin_keeps_front_and_back_apart() {
 /// 2 cm/s, and of any step under 20 cm/s. (Each cloth keeping apart from where the others
 /// were when the step began, not where they are in each substep, they jittered by up to
 /// 1 m/s for as long as they lay there; solved along lines at each cloth's own substep
-/// count, at 0.28 m/s. A resting stack still has a rare one-step pop of about 0.1 m/s, on
-/// lines and on the sweep alike, so the worst step alone does not say it rests.)
+/// count, at 0.28 m/s.) A resting stack still has a rare one-step pop, and when it comes
+/// is chaos: gravity changed in its seventh digit moves the worst step of a run between
+/// 0.6 cm/s and 40 cm/s, and the typical step between 0.2 and 4 cm/s. So it is run five times
+/// so changed and the median run is held to the bounds: one run says which bits the
+/// build rounds to, not whether the stack rests.
 #[test]
 fn a_stack_of_cloths_comes_to_rest() {
-    let mut run = SceneRun::new(&scene("stack", true, "xpbd")).expect("builds");
+    let runs = 5;
+    let (mut typical, mut worst) = (Vec::new(), Vec::new());
+    for k in 0..runs {
+        let mut scene = scene("stack", true, "xpbd");
+        scene.environment.gravity *= 1.0 + 1e-6 * k as f32;
+        let (t, w) = stack_at_rest(&scene);
+        typical.push(t);
+        worst.push(w);
+    }
+    eprintln!(
+        "fastest particle over the last half second, in {runs} runs: {typical:?} m/s \
+         typically, {worst:?} at worst"
+    );
+    let median = |v: &mut Vec<f32>| {
+        v.sort_by(f32::total_cmp);
+        v[v.len() / 2]
+    };
+    let (typical, worst) = (median(&mut typical), median(&mut worst));
+    assert!(
+        typical < 0.02,
+        "the stack still moves: {typical} m/s in a typical step of the median run"
+    );
+    assert!(
+        worst < 0.2,
+        "the stack jitters: {worst} m/s in the median run"
+    );
+}
+
+/// The fastest particle over the half second after 8 s of `scene`: in a typical step
+/// (the median over the steps) and in the fastest, m/s.
+fn stack_at_rest(scene: &ClothScene) -> (f32, f32) {
+    let mut run = SceneRun::new(scene).expect("builds");
     let dt = run.timestep;
     run.run((8.0 / dt).round() as usize, |_, _| {});
     let mut before: Vec<Vec<Vec3>> = run
@@ -289,15 +323,7 @@ fn a_stack_of_cloths_comes_to_rest() {
         fastest.push(step);
     });
     fastest.sort_by(f32::total_cmp);
-    let (typical, worst) = (fastest[fastest.len() / 2], fastest[fastest.len() - 1]);
-    eprintln!(
-        "fastest particle over the last half second: {typical} m/s typically, {worst} at worst"
-    );
-    assert!(
-        typical < 0.02,
-        "the stack still moves: {typical} m/s in a typical step"
-    );
-    assert!(worst < 0.2, "the stack jitters: {worst} m/s");
+    (fastest[fastest.len() / 2], fastest[fastest.len() - 1])
 }
 
 /// A self-collision distance below 0.1 mm is refused at the door, naming its field (1e-30

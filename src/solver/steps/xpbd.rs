@@ -25,7 +25,10 @@ impl ModelSteps for XpbdParams {
             let general = cloth.structure.stencil.is_none();
             let springs = &cloth.structure.springs;
             let mut constraints = xpbd::Constraints::new(springs, n, general);
-            constraints.chains = Chains::new(springs, &cloth.structure.local_rest);
+            // A grid's lines are its rows and columns on the stencil (`lattice/lines.rs`).
+            if general {
+                constraints.chains = Chains::new(springs, &cloth.structure.local_rest);
+            }
             cloth.model = ModelState::Xpbd(Box::new(constraints));
         }
     }
@@ -113,11 +116,8 @@ fn families(params: &crate::params::ClothParams, h: f32) -> [xpbd::Family; 5] {
 
 /// The constraints with the structural family along its lines: the other families
 /// swept, then the structural one along its lines (one Newton step of each line's
-/// lengths), then a sweep of the seams again (they pull against it: swept only before
-/// the lines, a seam of the T-shirt stayed 3.5 mm open) and of what bounds the structural
-/// length: an inextensible family projected on its own nonlinear lengths (the T-shirt's
-/// armpits, where seams meet, stretched to 8.5% without it and 5.2% with it), or a
-/// compliant family's strain limit.
+/// lengths), then the sweep [`after_lines`] asks for. On a grid's stencil all of it on
+/// its lanes, loaded once and stored once.
 fn along_lines(
     stencil: &mut Option<Stencil>,
     constraints: &mut xpbd::Constraints,
@@ -125,26 +125,49 @@ fn along_lines(
     families: &[xpbd::Family; 5],
     h: f32,
 ) {
-    let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
+    let structural = SpringKind::Structural as usize;
     let mut before = *families;
     before[structural].on = false;
-    sweep_families(stencil, constraints, p, &before, h);
-    constraints.chains.solve(p, families[structural], h);
+    let f = families[structural];
+    let Some(stencil) = stencil else {
+        sweep_families(&mut None, constraints, p, &before, h);
+        constraints.chains.solve(p, f, h);
+        let (x, w) = (&p.position, &p.inv_mass);
+        let after = after_lines(families, |max| {
+            springs.any_longer_than(SpringKind::Structural, x, w, max)
+        });
+        sweep_families(&mut None, constraints, p, &after, h);
+        return;
+    };
+    stencil.begin_xpbd(p, families);
+    stencil.sweep_xpbd(&p.inv_mass, &before);
+    stencil.solve_lines(&p.inv_mass, f);
+    let w = &p.inv_mass;
+    let after = after_lines(families, |max| {
+        stencil.any_longer(SpringKind::Structural, w, max)
+    });
+    stencil.sweep_xpbd(w, &after);
+    stencil.end_xpbd(p, h);
+}
+
+/// What is swept after the lines: the seams again (they pull against them: swept only
+/// before the lines, a seam of the T-shirt stayed 3.5 mm open) and what bounds the
+/// structural length: an inextensible family projected on its own nonlinear lengths
+/// (the T-shirt's armpits, where seams meet, stretched to 8.5% without it and 5.2% with
+/// it), or a compliant family's strain limit when `longer(max_stretch)` finds a spring
+/// past it.
+fn after_lines(
+    families: &[xpbd::Family; 5],
+    longer: impl FnOnce(f32) -> bool,
+) -> [xpbd::Family; 5] {
+    let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
     let mut after = [xpbd::Family::default(); 5];
     after[seam] = families[seam];
     let f = families[structural];
     if f.on && f.compliance == 0.0 {
         // Inextensible: a second, nonlinear projection is one more iteration.
         after[structural] = f;
-    } else if f.on
-        && f.max_stretch.is_finite()
-        && springs.any_longer_than(
-            SpringKind::Structural,
-            &p.position,
-            &p.inv_mass,
-            f.max_stretch,
-        )
-    {
+    } else if f.on && f.max_stretch.is_finite() && longer(f.max_stretch) {
         // Compliant: projected again it would be twice as stiff; only its limit, and
         // only when a spring is past it (a sweep that moves nothing is a sixth of the
         // crowd's step on denim).
@@ -155,7 +178,7 @@ fn along_lines(
             max_stretch: f.max_stretch,
         };
     }
-    sweep_families(stencil, constraints, p, &after, h);
+    after
 }
 
 /// How many substeps the hinges' projection in the current substep stands for, with

@@ -38,15 +38,15 @@ use crate::solver::parallel::{self, CHUNK};
 use crate::solver::xpbd::Family;
 use crate::solver::{Particles, SpringKind, Springs};
 
-/// Chains side by side in a tile: the width the solve's loops run over.
-pub(in crate::solver) const LANES: usize = 8;
+mod thomas;
+
+pub(in crate::solver) use thomas::{LANES, Row, solve_tile};
+
 /// No particle, no constraint (a padding slot, or a chain's last particle).
 const NONE: u32 = u32::MAX;
 /// Two edges continue each other through a particle when the angle between them is
 /// within 60° of straight.
 const STRAIGHT: f32 = 0.5;
-
-type Lane = [f32; LANES];
 
 /// The chains of a cloth's structural constraints, in sets solved one after another.
 #[derive(Clone, Debug, Default)]
@@ -70,26 +70,6 @@ struct ChainSet {
     slot_of: Vec<u32>,
     /// The tiles in pieces of about [`CHUNK`] slots, for the compute pool.
     pieces: Vec<Range<usize>>,
-}
-
-/// One particle along each of a tile's chains, and the constraint to the next: what the
-/// solve reads and writes at one step down the chains, together.
-#[derive(Clone, Copy, Debug, Default)]
-struct Row {
-    /// Positions in, moves out.
-    x: [Lane; 3],
-    /// Positions at the substep's start (read when damped).
-    prev: [Lane; 3],
-    /// Inverse masses.
-    w: Lane,
-    /// The constraint to the next row: its rest length and 1 while it acts (0 torn or
-    /// none), synced once a step; its direction, Thomas's modified upper diagonal and
-    /// right-hand side (then `Δλ`), per solve.
-    rest: Lane,
-    live: Lane,
-    n: [Lane; 3],
-    cp: Lane,
-    dp: Lane,
 }
 
 impl Chains {
@@ -402,112 +382,6 @@ fn gather(rows: &mut [Row], particle: &[u32], p: &Particles, damped: bool) {
                 (row.prev[0][j], row.prev[1][j], row.prev[2][j]) = (prev.x, prev.y, prev.z);
             }
         }
-    }
-}
-
-/// The Thomas algorithm on a tile's chains (see the module doc), leaving each row's
-/// move in its `x`. Every loop runs over the lanes of local arrays, without branches,
-/// so it vectorises.
-#[inline(always)]
-fn solve_tile<const DAMPED: bool>(rows: &mut [Row], f: Family) {
-    if rows.len() < 2 {
-        rows.iter_mut().for_each(|row| row.x = [ZERO; 3]);
-        return;
-    }
-    eliminate::<DAMPED>(rows, f);
-    substitute(rows);
-    moves(rows);
-}
-
-const ZERO: Lane = [0.0; LANES];
-
-/// Forward elimination, constraint by constraint down the chains: each row's direction,
-/// modified upper diagonal (of the row before, once this one's off-diagonal is known)
-/// and right-hand side. What a constraint hands the next is carried in locals.
-#[inline(always)]
-fn eliminate<const DAMPED: bool>(rows: &mut [Row], f: Family) {
-    let g = 1.0 + f.damping;
-    let (mut n_before, mut inv_before, mut d_before) = ([ZERO; 3], ZERO, ZERO);
-    let mut xa = rows[0].x;
-    let mut pa = if DAMPED { rows[0].prev } else { [ZERO; 3] };
-    for k in 0..rows.len() - 1 {
-        let (wa, rest, live) = (rows[k].w, rows[k].rest, rows[k].live);
-        let (xb, wb) = (rows[k + 1].x, rows[k + 1].w);
-        let pb = if DAMPED { rows[k + 1].prev } else { [ZERO; 3] };
-        let (mut n, mut inv_m, mut d, mut c_before) = ([ZERO; 3], ZERO, ZERO, ZERO);
-        for j in 0..LANES {
-            let dx = [
-                xb[0][j] - xa[0][j],
-                xb[1][j] - xa[1][j],
-                xb[2][j] - xa[2][j],
-            ];
-            let len = (dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]).sqrt();
-            let wsum = wa[j] + wb[j];
-            let on = live[j] > 0.0 && wsum > 0.0 && len > f32::EPSILON * rest[j];
-            let inv = if on {
-                1.0 / len.max(f32::MIN_POSITIVE)
-            } else {
-                0.0
-            };
-            let nj = [dx[0] * inv, dx[1] * inv, dx[2] * inv];
-            let mut rhs = if on { rest[j] - len } else { 0.0 };
-            if DAMPED {
-                let rel = [
-                    (xb[0][j] - pb[0][j]) - (xa[0][j] - pa[0][j]),
-                    (xb[1][j] - pb[1][j]) - (xa[1][j] - pa[1][j]),
-                    (xb[2][j] - pb[2][j]) - (xa[2][j] - pa[2][j]),
-                ];
-                rhs -= f.damping * (nj[0] * rel[0] + nj[1] * rel[1] + nj[2] * rel[2]);
-            }
-            let diag = if on { g * wsum + f.compliance } else { 1.0 };
-            let dot = n_before[0][j] * nj[0] + n_before[1][j] * nj[1] + n_before[2][j] * nj[2];
-            let off = -g * wa[j] * dot;
-            c_before[j] = off * inv_before[j];
-            inv_m[j] = 1.0 / (diag - off * c_before[j]);
-            d[j] = (rhs - off * d_before[j]) * inv_m[j];
-            (n[0][j], n[1][j], n[2][j]) = (nj[0], nj[1], nj[2]);
-        }
-        if k > 0 {
-            rows[k - 1].cp = c_before;
-        }
-        (rows[k].n, rows[k].dp) = (n, d);
-        (n_before, inv_before, d_before, xa, pa) = (n, inv_m, d, xb, pb);
-    }
-}
-
-/// Back substitution: each constraint's `Δλ` into its row's `dp`.
-#[inline(always)]
-fn substitute(rows: &mut [Row]) {
-    let m = rows.len();
-    let mut after = rows[m - 2].dp;
-    for row in rows[..m - 2].iter_mut().rev() {
-        for ((d, c), a) in row.dp.iter_mut().zip(&row.cp).zip(&after) {
-            *d -= c * a;
-        }
-        after = row.dp;
-    }
-}
-
-/// Each particle's move, `w_k (n_{k−1} Δλ_{k−1} − n_k Δλ_k)`, into its row's `x`.
-#[inline(always)]
-fn moves(rows: &mut [Row]) {
-    let m = rows.len();
-    let mut before = [ZERO; 3];
-    for (k, row) in rows.iter_mut().enumerate() {
-        let mut here = [ZERO; 3];
-        if k + 1 < m {
-            for (h, n) in here.iter_mut().zip(&row.n) {
-                for ((h, n), l) in h.iter_mut().zip(n).zip(&row.dp) {
-                    *h = n * l;
-                }
-            }
-        }
-        for ((x, b), h) in row.x.iter_mut().zip(&before).zip(&here) {
-            for (((x, w), b), h) in x.iter_mut().zip(&row.w).zip(b).zip(h) {
-                *x = w * (b - h);
-            }
-        }
-        before = here;
     }
 }
 

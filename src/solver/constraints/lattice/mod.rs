@@ -23,10 +23,12 @@ use std::ops::Range;
 
 use bevy::math::Vec3;
 
+use crate::solver::chains::Row;
 use crate::solver::parallel::{self, CHUNK};
 use crate::solver::{Particles, SpringKind, Springs};
 
 mod limiter;
+mod lines;
 mod xpbd;
 
 use limiter::*;
@@ -303,8 +305,19 @@ pub(in crate::solver) struct Stencil {
     f: Lanes,
     /// The limiter's corrections in one call, summed per particle (zero between calls).
     dx: Lanes,
-    /// Positions at the start of the substep, for XPBD's damping (`lattice/xpbd.rs`).
+    /// Positions at the start of the substep, for XPBD's damping (`lattice/xpbd.rs`),
+    /// loaded when a family is `damped`.
     previous: Lanes,
+    damped: bool,
+    /// What rounding lost of the lines' moves in this substep (`lattice/lines.rs`), and
+    /// whether they moved anything since the lanes were loaded.
+    residue: Lanes,
+    lines_moved: bool,
+    /// The lines' tiles, the rows' and the columns': a set's chains side by side, one
+    /// row per particle along them; their springs' rest lengths and weights are taken
+    /// again when `tiles_synced` is false.
+    tiles: [Vec<Row>; 2],
+    tiles_synced: bool,
 }
 
 impl Stencil {
@@ -357,7 +370,13 @@ impl Stencil {
             f: Lanes::new(n),
             dx: Lanes::new(n),
             previous: Lanes::new(n),
+            damped: false,
+            residue: Lanes::new(n),
+            lines_moved: false,
+            tiles: [Vec::new(), Vec::new()],
+            tiles_synced: false,
         };
+        stencil.tiles = [true, false].map(|rows| vec![Row::default(); stencil.tile_rows(rows)]);
         stencil.sync(springs);
         Some(stencil)
     }
@@ -376,6 +395,7 @@ impl Stencil {
                 0.0
             };
         }
+        self.tiles_synced = false;
     }
 
     /// Spring `s` tore.
@@ -383,6 +403,7 @@ impl Stencil {
         let (o, a) = self.slot[s];
         if o != APART {
             self.offsets[o as usize].weight[a as usize] = 0.0;
+            self.tiles_synced = false;
         }
     }
 

@@ -17,7 +17,7 @@
 
 use bevy::math::Vec3;
 
-use super::{CHUNK, Offset, Stencil, parallel};
+use super::{CHUNK, Lanes, Offset, Stencil, parallel};
 use crate::solver::parallel::XPBD_PARALLEL_FROM;
 
 use crate::solver::Particles;
@@ -39,11 +39,23 @@ impl Stencil {
     /// each particle its corrections as velocity over `h`; `families` by [`SpringKind`].
     /// The same bits on any number of threads: a colour's springs share no particle.
     pub fn project_xpbd(&mut self, p: &mut Particles, families: &[Family; 5], h: f32) {
+        self.begin_xpbd(p, families);
+        self.sweep_xpbd(&p.inv_mass, families);
+        self.end_xpbd(p, h);
+    }
+
+    /// Loads the lanes for a substep's projections: the positions, and the substep's
+    /// start when a family of `families` is damped.
+    pub fn begin_xpbd(&mut self, p: &Particles, families: &[Family; 5]) {
         self.x.load(&p.position);
-        let damped = families.iter().any(|f| f.on && f.damping > 0.0);
-        if damped {
+        self.damped = families.iter().any(|f| f.on && f.damping > 0.0);
+        if self.damped {
             self.previous.load(&p.previous);
         }
+    }
+
+    /// One sweep of the acting families of `families` on the lanes (see the module doc).
+    pub fn sweep_xpbd(&mut self, inv_mass: &[f32], families: &[Family; 5]) {
         let Stencil {
             offsets,
             x,
@@ -60,7 +72,7 @@ impl Stencil {
                 let shared = Shared {
                     offset,
                     family,
-                    inv_mass: &p.inv_mass,
+                    inv_mass,
                     previous: &previous.0,
                     width: *width,
                 };
@@ -74,7 +86,12 @@ impl Stencil {
                 }
             }
         }
-        store(&x.0, p, h);
+    }
+
+    /// Stores the projected lanes as positions (see [`store`]).
+    pub fn end_xpbd(&mut self, p: &mut Particles, h: f32) {
+        let residue = std::mem::take(&mut self.lines_moved).then_some(&mut self.residue);
+        store(&self.x.0, residue, p, h);
     }
 }
 
@@ -332,7 +349,9 @@ fn chunks3(
 
 /// Stores the projected lanes as positions; each free particle's velocity takes the
 /// change from the predicted position over `h` (a held one's was set by its driver).
-fn store(x: &[Vec<f32>; 3], p: &mut Particles, h: f32) {
+/// With `residue`, the rounding the lines' compensated moves kept apart: it goes to the
+/// velocity too and joins the particle's residue, and the lanes are zeroed for the next.
+fn store(x: &[Vec<f32>; 3], residue: Option<&mut Lanes>, p: &mut Particles, h: f32) {
     let n = p.len();
     let [x0, x1, x2] = x;
     let lanes = x0.chunks(CHUNK).zip(x1.chunks(CHUNK)).zip(x2.chunks(CHUNK));
@@ -341,15 +360,39 @@ fn store(x: &[Vec<f32>; 3], p: &mut Particles, h: f32) {
         .chunks_mut(CHUNK)
         .zip(p.velocity.chunks_mut(CHUNK))
         .zip(lanes);
+    let Some(Lanes([r0, r1, r2])) = residue else {
+        parallel::for_each_from(
+            XPBD_PARALLEL_FROM,
+            n,
+            pieces,
+            |((position, velocity), ((x0, x1), x2))| {
+                for (k, (x, v)) in position.iter_mut().zip(velocity).enumerate() {
+                    let projected = Vec3::new(x0[k], x1[k], x2[k]);
+                    *v += (projected - *x) / h;
+                    *x = projected;
+                }
+            },
+        );
+        return;
+    };
+    let kept = r0
+        .chunks_mut(CHUNK)
+        .zip(r1.chunks_mut(CHUNK))
+        .zip(r2.chunks_mut(CHUNK));
+    let pieces = pieces.zip(p.residue.chunks_mut(CHUNK)).zip(kept);
     parallel::for_each_from(
         XPBD_PARALLEL_FROM,
         n,
         pieces,
-        |((position, velocity), ((x0, x1), x2))| {
-            for (k, (x, v)) in position.iter_mut().zip(velocity).enumerate() {
+        |((((position, velocity), ((x0, x1), x2)), residue), ((r0, r1), r2))| {
+            let particles = position.iter_mut().zip(velocity).zip(residue);
+            for (k, ((x, v), residue)) in particles.enumerate() {
                 let projected = Vec3::new(x0[k], x1[k], x2[k]);
-                *v += (projected - *x) / h;
+                let kept = Vec3::new(r0[k], r1[k], r2[k]);
+                *v += ((projected - *x) + kept) / h;
                 *x = projected;
+                *residue += kept;
+                (r0[k], r1[k], r2[k]) = (0.0, 0.0, 0.0);
             }
         },
     );
