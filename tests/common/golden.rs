@@ -15,10 +15,10 @@ use std::path::{Path, PathBuf};
 use bevy::math::Vec3;
 
 /// The farthest a bless may move any stored position, m. 5 mm: a change of summation
-/// order moves a settled cloth by float rounding (µm), a chaotic one (a cloth flapping in
-/// gusts, 120 steps) by up to a few mm; a move of centimetres is a change of behaviour,
-/// which the commit that makes it must own by raising this. (A change of rounding alone
-/// moved the gusty flag's dump 36 cm by step 120: its bless raised the bound once.)
+/// order moves a settled cloth by float rounding (µm), a curtain in gusts by a few mm by
+/// step 120, and the flag flapping on its pole, the most chaotic case, by tens of cm (36
+/// cm); a move past the bound is a change of behaviour, or of rounding in the flag,
+/// which the commit that makes it must own by raising this with its reason.
 pub const BLESS_BOUND_M: f32 = 0.005;
 
 /// The main crate's stored dumps.
