@@ -128,6 +128,7 @@ fn along_lines(
     let structural = SpringKind::Structural as usize;
     let mut before = *families;
     before[structural].on = false;
+    before[SpringKind::Shear as usize].on &= !shear_after_lines(families);
     let f = families[structural];
     let Some(stencil) = stencil else {
         sweep_families(&mut None, constraints, p, &before, h);
@@ -150,14 +151,23 @@ fn along_lines(
     stencil.end_xpbd(p, h);
 }
 
+/// Whether the shear family is swept after the lines instead of before: when it and the
+/// structural family are inextensible. Swept before, it met the lines' moves a substep
+/// late: a 256 × 256 cloth hung from its top row at one substep a frame stretched 6.8%
+/// (0.32% swept both before and after, 0.048% after only).
+fn shear_after_lines(families: &[xpbd::Family; 5]) -> bool {
+    let (structural, shear) = (SpringKind::Structural as usize, SpringKind::Shear as usize);
+    families[structural].on
+        && families[structural].compliance == 0.0
+        && families[shear].compliance == 0.0
+}
+
 /// What is swept after the lines: the seams again (they pull against them: swept only
 /// before the lines, a seam of the T-shirt stayed 3.5 mm open) and what bounds the
 /// structural length: an inextensible family projected on its own nonlinear lengths
 /// (the T-shirt's armpits, where seams meet, stretched to 8.5% without it and 5.2% with
-/// it), with an inextensible shear family before it (swept only before the lines, it
-/// met the lines' moves a substep late: a 256 × 256 cloth hung from its top row at one
-/// substep a frame stretched 6.8%, and 0.32% with it), or a compliant family's strain
-/// limit when `longer(max_stretch)` finds a spring past it.
+/// it), an inextensible shear family before it ([`shear_after_lines`]), or a compliant
+/// family's strain limit when `longer(max_stretch)` finds a spring past it.
 fn after_lines(
     families: &[xpbd::Family; 5],
     longer: impl FnOnce(f32) -> bool,
@@ -169,9 +179,8 @@ fn after_lines(
     if f.on && f.compliance == 0.0 {
         // Inextensible: a second, nonlinear projection is one more iteration.
         after[structural] = f;
-        let shear = SpringKind::Shear as usize;
-        if families[shear].compliance == 0.0 {
-            after[shear] = families[shear];
+        if shear_after_lines(families) {
+            after[SpringKind::Shear as usize] = families[SpringKind::Shear as usize];
         }
     } else if f.on && f.max_stretch.is_finite() && longer(f.max_stretch) {
         // Compliant: projected again it would be twice as stiff; only its limit, and
