@@ -1,8 +1,6 @@
 //! Stage 2 of a substep, the integrators the models share: Störmer–Verlet and
 //! semi-implicit (symplectic) Euler, piece by piece over the compute pool.
 
-use bevy::math::Vec3;
-
 use super::parallel;
 use super::state::ParticleChunk;
 use super::{ClothSolver, Particles};
@@ -97,9 +95,12 @@ pub(super) fn verlet(p: &mut Particles, h: f32, drag: f32) {
 }
 
 /// `x + r += delta`, keeping in `r` what rounding `x` lost (Kahan's compensated sum;
-/// Fast2Sum, exact while `|x| ≥ |delta + r|`).
+/// Fast2Sum, exact while `|x| ≥ |delta + r|`), for a position or one coordinate of it.
 #[inline(always)]
-pub(super) fn compensated_add(x: &mut Vec3, r: &mut Vec3, delta: Vec3) {
+pub(super) fn compensated_add<T>(x: &mut T, r: &mut T, delta: T)
+where
+    T: Copy + std::ops::Add<Output = T> + std::ops::Sub<Output = T>,
+{
     let t = delta + *r;
     let s = *x + t;
     *r = t - (s - *x);

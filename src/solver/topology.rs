@@ -78,7 +78,7 @@ impl Springs {
         let range = self.ranges[kind as usize].clone();
         let (a, b) = (&self.a[range.clone()], &self.b[range.clone()]);
         let (rest, alive) = (&self.rest_length[range.clone()], &self.alive[range]);
-        let bound = max_stretch * max_stretch * (1.0 - 1e-5);
+        let bound = squared_bound(max_stretch);
         let mut past = false;
         for (((&a, &b), &rest), &alive) in a.iter().zip(b).zip(rest).zip(alive) {
             let (a, b) = (a as usize, b as usize);
@@ -313,4 +313,11 @@ impl VertexFaces {
     pub fn of(&self, i: usize) -> &[u32] {
         &self.faces[self.start[i] as usize..self.start[i + 1] as usize]
     }
+}
+
+/// What [`Springs::any_longer_than`] holds a spring's squared length against, over its
+/// squared rest length: a few float steps below `max_stretch²`, so every spring a strain
+/// limit's projection (`len > max_stretch · l0`) would move is seen.
+pub(in crate::solver) fn squared_bound(max_stretch: f32) -> f32 {
+    max_stretch * max_stretch * (1.0 - 1e-5)
 }

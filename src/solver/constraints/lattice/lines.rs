@@ -13,7 +13,9 @@
 use super::{CHUNK, Lanes, Offset, Stencil, parallel};
 use crate::solver::SpringKind;
 use crate::solver::chains::{LANES, Row, solve_tile};
+use crate::solver::integrate::compensated_add;
 use crate::solver::parallel::XPBD_PARALLEL_FROM;
+use crate::solver::topology::squared_bound;
 use crate::solver::xpbd::Family;
 
 /// One set of a grid's lines: its rows or its columns, `LANES` of them to a tile.
@@ -113,7 +115,7 @@ impl Stencil {
     /// Whether a live, free spring of `kind` is longer than `max_stretch` times its rest
     /// length in the lanes (the general path's `Springs::any_longer_than`, on lanes).
     pub fn any_longer(&self, kind: SpringKind, inv_mass: &[f32], max_stretch: f32) -> bool {
-        let bound = max_stretch * max_stretch * (1.0 - 1e-5);
+        let bound = squared_bound(max_stretch);
         let [x, y, z] = &self.x.0;
         let n = x.len();
         let mut past = false;
@@ -224,7 +226,7 @@ fn fill(
 }
 
 /// Each particle's move in `tiles` (solved for `set`) added to its lane, what rounding
-/// lost kept in `residue` (Kahan's compensated sum, as `integrate::compensated_add`); in
+/// lost kept in `residue` ([`compensated_add`], as the chains' moves); in
 /// pieces of whole grid rows over the compute pool.
 fn add_moves(x: &mut Lanes, residue: &mut Lanes, tiles: &[Row], set: Set) {
     let (w, len) = (set.width, set.len());
@@ -246,7 +248,7 @@ fn add_moves(x: &mut Lanes, residue: &mut Lanes, tiles: &[Row], set: Set) {
                     let (t, j) = ((top + row) / LANES, (top + row) % LANES);
                     let moved = tiles[t * len..][..w].iter().map(|m| m.x[c][j]);
                     for ((x, r), m) in x.iter_mut().zip(r.iter_mut()).zip(moved) {
-                        kahan(x, r, m);
+                        compensated_add(x, r, m);
                     }
                 } else {
                     // Column `column` is lane `column % LANES` of tile `column / LANES`.
@@ -254,21 +256,11 @@ fn add_moves(x: &mut Lanes, residue: &mut Lanes, tiles: &[Row], set: Set) {
                     let lanes = x.chunks_mut(LANES).zip(r.chunks_mut(LANES));
                     for ((x, r), m) in lanes.zip(moved) {
                         for ((x, r), &m) in x.iter_mut().zip(r.iter_mut()).zip(&m.x[c]) {
-                            kahan(x, r, m);
+                            compensated_add(x, r, m);
                         }
                     }
                 }
             }
         }
     });
-}
-
-/// `x + r += m` with what rounding `x` lost kept in `r` (Fast2Sum, as
-/// `integrate::compensated_add`).
-#[inline(always)]
-fn kahan(x: &mut f32, r: &mut f32, m: f32) {
-    let t = m + *r;
-    let s = *x + t;
-    *r = t - (s - *x);
-    *x = s;
 }

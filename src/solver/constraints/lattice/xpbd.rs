@@ -17,7 +17,7 @@
 
 use bevy::math::Vec3;
 
-use super::{CHUNK, Lanes, Offset, Stencil, parallel};
+use super::{CHUNK, Offset, Stencil, parallel};
 use crate::solver::parallel::XPBD_PARALLEL_FROM;
 
 use crate::solver::Particles;
@@ -90,8 +90,12 @@ impl Stencil {
 
     /// Stores the projected lanes as positions (see [`store`]).
     pub fn end_xpbd(&mut self, p: &mut Particles, h: f32) {
-        let residue = std::mem::take(&mut self.lines_moved).then_some(&mut self.residue);
-        store(&self.x.0, residue, p, h);
+        let (x, r) = (&self.x.0, &mut self.residue.0);
+        if std::mem::take(&mut self.lines_moved) {
+            store::<true>(x, r, p, h);
+        } else {
+            store::<false>(x, r, p, h);
+        }
     }
 }
 
@@ -349,50 +353,36 @@ fn chunks3(
 
 /// Stores the projected lanes as positions; each free particle's velocity takes the
 /// change from the predicted position over `h` (a held one's was set by its driver).
-/// With `residue`, the rounding the lines' compensated moves kept apart: it goes to the
-/// velocity too and joins the particle's residue, and the lanes are zeroed for the next.
-fn store(x: &[Vec<f32>; 3], residue: Option<&mut Lanes>, p: &mut Particles, h: f32) {
+/// With `KEPT` (after the lines), the rounding their compensated moves kept apart in
+/// the residue lanes `r` goes to the velocity too and joins the particle's residue, and
+/// those lanes are zeroed for the next substep.
+fn store<const KEPT: bool>(x: &[Vec<f32>; 3], r: &mut [Vec<f32>; 3], p: &mut Particles, h: f32) {
     let n = p.len();
-    let [x0, x1, x2] = x;
-    let lanes = x0.chunks(CHUNK).zip(x1.chunks(CHUNK)).zip(x2.chunks(CHUNK));
+    let [x0, x1, x2] = x.each_ref().map(|l| l.chunks(CHUNK));
+    let [r0, r1, r2] = r.each_mut().map(|l| l.chunks_mut(CHUNK));
     let pieces = p
         .position
         .chunks_mut(CHUNK)
         .zip(p.velocity.chunks_mut(CHUNK))
-        .zip(lanes);
-    let Some(Lanes([r0, r1, r2])) = residue else {
-        parallel::for_each_from(
-            XPBD_PARALLEL_FROM,
-            n,
-            pieces,
-            |((position, velocity), ((x0, x1), x2))| {
-                for (k, (x, v)) in position.iter_mut().zip(velocity).enumerate() {
-                    let projected = Vec3::new(x0[k], x1[k], x2[k]);
-                    *v += (projected - *x) / h;
-                    *x = projected;
-                }
-            },
-        );
-        return;
-    };
-    let kept = r0
-        .chunks_mut(CHUNK)
-        .zip(r1.chunks_mut(CHUNK))
-        .zip(r2.chunks_mut(CHUNK));
-    let pieces = pieces.zip(p.residue.chunks_mut(CHUNK)).zip(kept);
+        .zip(p.residue.chunks_mut(CHUNK))
+        .zip(x0.zip(x1).zip(x2).zip(r0.zip(r1).zip(r2)));
     parallel::for_each_from(
         XPBD_PARALLEL_FROM,
         n,
         pieces,
-        |((((position, velocity), ((x0, x1), x2)), residue), ((r0, r1), r2))| {
+        |(((position, velocity), residue), (((x0, x1), x2), ((r0, r1), r2)))| {
             let particles = position.iter_mut().zip(velocity).zip(residue);
             for (k, ((x, v), residue)) in particles.enumerate() {
                 let projected = Vec3::new(x0[k], x1[k], x2[k]);
-                let kept = Vec3::new(r0[k], r1[k], r2[k]);
-                *v += ((projected - *x) + kept) / h;
+                if KEPT {
+                    let kept = Vec3::new(r0[k], r1[k], r2[k]);
+                    *v += ((projected - *x) + kept) / h;
+                    *residue += kept;
+                    (r0[k], r1[k], r2[k]) = (0.0, 0.0, 0.0);
+                } else {
+                    *v += (projected - *x) / h;
+                }
                 *x = projected;
-                *residue += kept;
-                (r0[k], r1[k], r2[k]) = (0.0, 0.0, 0.0);
             }
         },
     );
