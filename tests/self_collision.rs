@@ -351,7 +351,10 @@ fn the_doorways_strips_stay_whole_in_a_gale_with_self_collision() {
     // door, self-collision on, accuracy first) for its first 3 s, when the strips first
     // fold against each other. With the fabric's hinges projected once for several
     // substeps under self-collision, a strip passed 50% at 2.0 s (75.5%); projected
-    // every substep, the strips stay below 25% for 20 s.
+    // every substep, the strips stayed below 25% for 20 s. Self-contact pushes the
+    // folds apart after the constraints: with the strain limit solved along the lines
+    // once more after it, at the step's end, the strips stay at their 10% limit (19.9%
+    // without).
     use bevy_cloth::prelude::*;
     let setup = doorway::Doorway {
         wind: 10.0,
@@ -371,5 +374,5 @@ fn the_doorways_strips_stay_whole_in_a_gale_with_self_collision() {
     }
     eprintln!("the strips' largest strain in 3 s: {:.1}%", worst * 100.0);
     assert_eq!(strips, doorway::STRIPS);
-    assert!(worst < 0.35, "a strip stretched {:.1}%", worst * 100.0);
+    assert!(worst < 0.105, "a strip stretched {:.1}%", worst * 100.0);
 }

@@ -770,10 +770,12 @@ fn a_refused_set_says_its_key_once() {
 }
 
 /// `cloth storm`: every cell of a short storm holds together; mass-spring's substeps
-/// stay at its stability bound in any wind, XPBD's follow the wind with accuracy first
-/// and stay within the default budget's 30 (4 ms at 200 ns over 651 particles) inside
-/// it, where the gale's steps give accuracy and strain more (past 25% strain the budget
-/// gives way, up to what accuracy first takes).
+/// stay at its stability bound in any wind. XPBD's strain limit, solved along the
+/// flag's lines, holds the gale's stretch near its 10% where a sweep of it left 19–25%,
+/// so its accuracy loop no longer climbs with the wind (it took 297 substeps at 20 m/s,
+/// 15 times the calm's): the gale takes at most 1.5 times the calm's substeps, and the
+/// budgeted flag stays within the default budget's 30 (4 ms at 200 ns over 651
+/// particles) in every step.
 #[test]
 fn a_storm_maps_each_model_and_keeps_the_budgeted_flag_to_its_substeps() {
     let out = run_ok(["storm", "--seconds", "1", "--winds", "0,20", "--json"]);
@@ -802,27 +804,20 @@ fn a_storm_maps_each_model_and_keeps_the_budgeted_flag_to_its_substeps() {
         );
         let (calm, gale) = (find("xpbd", 0.0, on), find("xpbd", 20.0, on));
         assert!(
-            n(gale, "most_substeps") > 4.0 * n(calm, "most_substeps"),
-            "accuracy first follows the wind: {calm} {gale}"
+            n(gale, "most_substeps") <= 1.5 * n(calm, "most_substeps"),
+            "the gale's stretch does not drive the substeps up: {calm} {gale}"
         );
-        assert_eq!(n(gale, "steps_over_budget"), 0.0, "{gale}");
-        let budget = find("xpbd-budget", 20.0, on);
-        // Within its 30, unless the flag strained past 25%, when the budget gives way to
-        // what its accuracy asks for (never more than accuracy first takes).
-        let gave_way = n(budget, "largest_strain") > 0.25;
-        assert!(n(budget, "most_substeps") <= 30.0 || gave_way, "{budget}");
-        assert!(
-            n(budget, "most_substeps") <= n(gale, "most_substeps"),
-            "{budget} {gale}"
-        );
-        assert!(n(budget, "steps_over_budget") > 0.0, "{budget}");
-        assert!(
-            n(budget, "largest_strain") > n(gale, "largest_strain"),
-            "within the budget the gale strains the flag more: {budget} {gale}"
-        );
-        let calm_budget = find("xpbd-budget", 0.0, on);
-        assert_eq!(n(calm_budget, "steps_over_budget"), 0.0, "{calm_budget}");
+        for wind in [0.0, 20.0] {
+            let budget = find("xpbd-budget", wind, on);
+            assert!(n(budget, "most_substeps") <= 30.0, "{budget}");
+            assert_eq!(n(budget, "steps_over_budget"), 0.0, "{budget}");
+        }
     }
+    let gale = find("xpbd", 20.0, false);
+    assert!(
+        n(gale, "largest_strain") <= 0.11,
+        "the limit holds along the lines: {gale}"
+    );
 }
 
 /// `cloth crowd --budget-ms`: a world budget shared among the crowd's cloths caps each

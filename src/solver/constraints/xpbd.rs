@@ -86,6 +86,13 @@ pub(in crate::solver) struct Family {
 }
 
 impl Family {
+    /// A family that is only its strain limit: no stiffness of its own (infinite
+    /// compliance), a finite `max_stretch`. Projected, it moves only what is past the
+    /// limit.
+    pub fn limit_only(&self) -> bool {
+        self.on && self.compliance == f32::INFINITY && self.max_stretch.is_finite()
+    }
+
     /// The coefficients of a family of stiffness `k`, spring damping `c`, substep `h`.
     pub fn new(k: f32, c: f32, h: f32, limit: Option<f32>) -> Self {
         let (compliance, damping) = if k == f32::INFINITY {

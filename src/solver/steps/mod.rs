@@ -51,6 +51,9 @@ pub(super) trait ModelSteps {
     fn fit_targets(&self, _cloth: &mut ClothSolver) {}
     /// Stage 4, between the drivers and contact: the model's constraints.
     fn constrain(&self, _cloth: &mut ClothSolver) {}
+    /// In the step's last substep, after self-contact and before the motion
+    /// constraints and contact: what the model takes back of what self-contact did.
+    fn settle(&self, _cloth: &mut ClothSolver) {}
     /// After the substeps: tearing.
     fn end(&self, _cloth: &mut ClothSolver) {}
 }
@@ -376,6 +379,9 @@ impl ClothSolver {
         let constrained = Instant::now();
         self.self_contact
             .resolve(&mut self.particles, h, &mut self.touched);
+        if self.clock.substep_index + 1 == self.clock.substeps {
+            model_steps(&model).settle(self);
+        }
         let separated = Instant::now();
         self.drivers.motion.hold(&mut self.particles, t, h);
         let tau = self.clock.left_after_substep();

@@ -192,3 +192,36 @@ fn a_grid_is_covered_by_its_rows_then_its_columns() {
     assert_eq!(rows.tiles[0].1, width);
     assert_eq!(columns.tiles[0].1, height);
 }
+
+#[test]
+fn the_strain_limit_along_a_chain_takes_back_only_what_is_past_it() {
+    // A straight chain pinned at its first particle, its links 2%, 30%, 25%, 5% and 40%
+    // past their rest lengths: under a 10% limit along the chain, the three past it
+    // come back to 110% (exactly, a straight chain being linear), the two within it keep
+    // their lengths.
+    let stretch = [1.02f32, 1.3, 1.25, 1.05, 1.4];
+    let mut y = vec![Vec3::ZERO];
+    for s in stretch {
+        y.push(*y.last().unwrap() + Vec3::new(0.1 * s, 0.0, 0.0));
+    }
+    let rest = vec![0.1f32; stretch.len()];
+    let mut w = vec![1.0f32; y.len()];
+    w[0] = 0.0;
+    let limit = Family {
+        on: true,
+        compliance: f32::INFINITY,
+        damping: 0.0,
+        max_stretch: 1.1,
+    };
+    assert!(limit.limit_only());
+    let moves = tile_solve(&y, &w, &rest, limit);
+    y.iter_mut().zip(&moves).for_each(|(a, b)| *a += *b);
+    let got: Vec<f32> = (0..stretch.len())
+        .map(|k| y[k].distance(y[k + 1]) / rest[k])
+        .collect();
+    println!("stretches after the limit: {got:?}");
+    for (k, (&g, &s)) in got.iter().zip(&stretch).enumerate() {
+        let want = s.min(1.1);
+        assert!((g - want).abs() < 1e-5, "link {k}: {g} against {want}");
+    }
+}

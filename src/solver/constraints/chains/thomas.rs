@@ -38,7 +38,11 @@ pub(in crate::solver) fn solve_tile<const DAMPED: bool>(rows: &mut [Row], f: Fam
         rows.iter_mut().for_each(|row| row.x = [ZERO; 3]);
         return;
     }
-    eliminate::<DAMPED>(rows, f);
+    if f.limit_only() {
+        eliminate::<false, true>(rows, f);
+    } else {
+        eliminate::<DAMPED, false>(rows, f);
+    }
     substitute(rows);
     moves(rows);
 }
@@ -49,9 +53,20 @@ const ZERO: Lane = [0.0; LANES];
 /// modified upper diagonal (of the row before, once this one's off-diagonal is known)
 /// and right-hand side. What a constraint hands the next is carried in locals, lane by
 /// lane; rows are read in place (no copies of whole rows).
+///
+/// `LIMIT`: the family's strain limit alone ([`Family::limit_only`]), solved along the
+/// chains: every constraint longer than `max_stretch` times its rest length is taken
+/// back to that length and every other one keeps the length it has (to first order),
+/// so the move that shortens one link does not stretch its neighbours past the limit
+/// (as it would if they were left free). Provot's (1995) limit, which a sweep carries
+/// one constraint a substep, then holds along a whole line at once.
 #[inline(always)]
-fn eliminate<const DAMPED: bool>(rows: &mut [Row], f: Family) {
-    let g = 1.0 + f.damping;
+fn eliminate<const DAMPED: bool, const LIMIT: bool>(rows: &mut [Row], f: Family) {
+    let (g, compliance) = if LIMIT {
+        (1.0, 0.0)
+    } else {
+        (1.0 + f.damping, f.compliance)
+    };
     let (mut n_before, mut inv_before, mut d_before) = ([ZERO; 3], ZERO, ZERO);
     for k in 0..rows.len() - 1 {
         let (head, tail) = rows.split_at_mut(k + 1);
@@ -64,7 +79,12 @@ fn eliminate<const DAMPED: bool>(rows: &mut [Row], f: Family) {
                 b.x[2][j] - a.x[2][j],
             ];
             let len = (dx[0] * dx[0] + dx[1] * dx[1] + dx[2] * dx[2]).sqrt();
-            let (wa, rest) = (a.w[j], a.rest[j]);
+            let wa = a.w[j];
+            let rest = if LIMIT {
+                a.rest[j] * f.max_stretch
+            } else {
+                a.rest[j]
+            };
             let wsum = wa + b.w[j];
             let on = a.live[j] > 0.0 && wsum > 0.0 && len > f32::EPSILON * rest;
             let inv = if on {
@@ -73,13 +93,17 @@ fn eliminate<const DAMPED: bool>(rows: &mut [Row], f: Family) {
                 0.0
             };
             let nj = [dx[0] * inv, dx[1] * inv, dx[2] * inv];
-            let mut rhs = if on { rest - len } else { 0.0 };
+            let mut rhs = match (on, LIMIT) {
+                (false, _) => 0.0,
+                (true, false) => rest - len,
+                (true, true) => (rest - len).min(0.0),
+            };
             if DAMPED {
                 let rel =
                     [0, 1, 2].map(|c| (b.x[c][j] - b.prev[c][j]) - (a.x[c][j] - a.prev[c][j]));
                 rhs -= f.damping * (nj[0] * rel[0] + nj[1] * rel[1] + nj[2] * rel[2]);
             }
-            let diag = if on { g * wsum + f.compliance } else { 1.0 };
+            let diag = if on { g * wsum + compliance } else { 1.0 };
             let dot = n_before[0][j] * nj[0] + n_before[1][j] * nj[1] + n_before[2][j] * nj[2];
             let off = -g * wa * dot;
             c_before[j] = off * inv_before[j];

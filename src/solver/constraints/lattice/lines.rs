@@ -80,7 +80,7 @@ impl Stencil {
                 continue;
             }
             let set = self.set(rows);
-            let previous = self.damped.then_some(&self.previous);
+            let previous = (self.damped && !f.limit_only()).then_some(&self.previous);
             let read = Read {
                 set,
                 x: &self.x,
