@@ -18,11 +18,8 @@ use bevy::math::Vec3;
 /// order moves a settled cloth by float rounding (µm), a curtain in gusts by a few mm by
 /// step 120, and the flag flapping on its pole, the most chaotic case, by tens of cm (36
 /// cm); a move past the bound is a change of behaviour, or of rounding in the flag,
-/// which the commit that makes it must own by raising this with its reason. Raised to
-/// 0.6 m once: XPBD's strain limit now solved along the lines holds the gusty flag's
-/// top edge at 10% where a sweep of it let it stretch 19%, so the flag flaps another
-/// way (59 cm apart by step 120).
-pub const BLESS_BOUND_M: f32 = 0.6;
+/// which the commit that makes it must own by raising this with its reason.
+pub const BLESS_BOUND_M: f32 = 0.005;
 
 /// The main crate's stored dumps.
 pub fn main_dir() -> PathBuf {
