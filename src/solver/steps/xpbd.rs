@@ -185,19 +185,20 @@ fn limit_along_lines(after: &mut [xpbd::Family; 5]) -> Option<xpbd::Family> {
 const LIMIT_SOLVES_AT_END: usize = 3;
 
 /// The structural strain limit solved along the lines once more in the step's last
-/// substep, after self-contact, in a step in which self-contact or contact moved a
-/// particle (up to [`LIMIT_SOLVES_AT_END`] times, while a spring is past it): what
-/// self-contact does after the constraints (a fold's layers pushed apart stretch them:
-/// a flag with self-collision in a 10 m/s gale stretched 24%) is taken back before the
+/// substep, after self-contact (up to [`LIMIT_SOLVES_AT_END`] times, while a spring is
+/// past it): what self-contact does after the constraints (a fold's layers pushed apart
+/// stretch them: a flag with self-collision in a 10 m/s gale stretched 24%), and what a
+/// substep too long for its linearised line solve leaves (a denim curtain capped at one
+/// or two substeps by a frame budget: 27% at the step's end), is taken back before the
 /// step is drawn and measured. Positions only: the velocities stay as the substeps left
-/// them, so the correction adds no energy. The motion constraints and contact come
-/// after it, so a skinned cloth stays within its painted distances and no particle is
-/// left inside a body; what contact itself stretches (a cloth wrapped round a pole
-/// thinner than its edges are long, pushed out radially) stays.
+/// them, so the correction adds no energy. The motion constraints and contact come after
+/// it, so a skinned cloth stays within its painted distances and no particle is left
+/// inside a body; what contact itself stretches (a cloth wrapped round a pole thinner
+/// than its edges are long, pushed out radially) stays.
 fn limit_at_end(cloth: &mut ClothSolver) {
     let f = families(&cloth.params, cloth.clock.h)[SpringKind::Structural as usize];
     let limited = f.on && f.compliance > 0.0 && f.max_stretch.is_finite();
-    if !limited || !cloth.touched.contains(&true) {
+    if !limited {
         return;
     }
     for _ in 0..LIMIT_SOLVES_AT_END {
