@@ -192,8 +192,8 @@ impl ClothSolver {
     /// Caps the automatic substeps of XPBD at `most` a step from the next step on (at
     /// least 1; `None` lifts the cap): a frame budget's share, which the plugin sets
     /// from [`ClothBudget`](crate::ClothBudget). Below what its accuracy target asks,
-    /// the cloth gives accuracy and reports it ([`StepReport::over_budget`], with
-    /// the strain its constraints left in [`StepReport::solver_strain`]). The explicit
+    /// the cloth gives accuracy and reports it ([`StepReport::over_budget`](super::StepReport::over_budget), with
+    /// the strain its constraints left in [`StepReport::solver_strain`](super::StepReport::solver_strain)). The explicit
     /// models keep their stable count whatever the cap, and a fixed count is the cloth's
     /// own choice: neither is capped.
     pub fn set_substep_budget(&mut self, most: Option<u32>) {

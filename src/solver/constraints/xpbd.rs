@@ -93,6 +93,16 @@ impl Family {
         self.on && self.compliance == f32::INFINITY && self.max_stretch.is_finite()
     }
 
+    /// The strain limit `max_stretch` alone ([`Family::limit_only`]).
+    pub fn limit(max_stretch: f32) -> Self {
+        Self {
+            on: true,
+            compliance: f32::INFINITY,
+            damping: 0.0,
+            max_stretch,
+        }
+    }
+
     /// The coefficients of a family of stiffness `k`, spring damping `c`, substep `h`.
     pub fn new(k: f32, c: f32, h: f32, limit: Option<f32>) -> Self {
         let (compliance, damping) = if k == f32::INFINITY {

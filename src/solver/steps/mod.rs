@@ -52,7 +52,8 @@ pub(super) trait ModelSteps {
     /// Stage 4, between the drivers and contact: the model's constraints.
     fn constrain(&self, _cloth: &mut ClothSolver) {}
     /// In the step's last substep, after self-contact and before the motion
-    /// constraints and contact: what the model takes back of what self-contact did.
+    /// constraints and contact: what the model takes back of what the substeps and
+    /// self-contact left past its bounds.
     fn settle(&self, _cloth: &mut ClothSolver) {}
     /// After the substeps: tearing.
     fn end(&self, _cloth: &mut ClothSolver) {}
@@ -72,7 +73,7 @@ pub(super) fn model_steps(model: &Model) -> &dyn ModelSteps {
 }
 
 /// The most of its rest length a structural spring may change length or turn by in one
-/// substep of a step a budget caps ([`ClothSolver::speed_floor`]).
+/// substep of a step a budget caps (`ClothSolver::speed_floor`).
 const SPEED_REACH: f32 = 0.25;
 
 /// What a step did, returned by [`ClothSolver::step`] and [`ClothSolver::end_step`].
@@ -100,9 +101,9 @@ pub struct StepReport {
     /// gusts stretched 63% (a last projection or three in the last substep changed that
     /// by a few points), at 30 substeps 14%.
     pub over_budget: bool,
-    /// The fewest substeps a budget could cap this step at
-    /// ([`ClothSolver::speed_floor`]: no structural spring changing length or turning by
-    /// more than a quarter of its rest length a substep); 0 when no budget applied.
+    /// The fewest substeps a budget could cap this step at: enough that no structural
+    /// spring, at its ends' relative speed, changes length or turns by more than a
+    /// quarter of its rest length a substep; 0 when no budget applied.
     pub budget_floor: u32,
     /// The largest stretch `(l − l0)/l0` of a whole structural spring with a free end at
     /// the end of the step, when the step measured it (XPBD's automatic substeps do, each
@@ -356,7 +357,7 @@ impl ClothSolver {
     /// step: a denim curtain capped at one substep alternated with steps of 35 to 200
     /// and reached 1,179% strain. A cloth carried along whole (a cape on a running
     /// body) moves its springs' ends together and needs nothing more.
-    pub fn speed_floor(&self, dt: f32) -> u32 {
+    fn speed_floor(&self, dt: f32) -> u32 {
         let (v, s) = (&self.particles.velocity, &self.structure.springs);
         let mut rate = 0.0f32;
         for k in s.ranges[SpringKind::Structural as usize].clone() {

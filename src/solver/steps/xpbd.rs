@@ -141,41 +141,36 @@ fn along_lines(
         sweep_families(&mut None, constraints, p, &before, h);
         constraints.chains.solve(p, f, h);
         let (x, w) = (&p.position, &p.inv_mass);
-        let mut after = after_lines(families, |max| {
+        if let Some(limit) = limit_past(f, |max| {
             springs.any_longer_than(SpringKind::Structural, x, w, max)
-        });
-        if let Some(limit) = limit_along_lines(&mut after) {
+        }) {
             constraints.chains.solve(p, limit, h);
         }
-        sweep_families(&mut None, constraints, p, &after, h);
+        sweep_families(&mut None, constraints, p, &after_lines(families), h);
         return;
     };
     stencil.begin_xpbd(p, families);
     stencil.sweep_xpbd(&p.inv_mass, &before);
     stencil.solve_lines(&p.inv_mass, f);
     let w = &p.inv_mass;
-    let mut after = after_lines(families, |max| {
-        stencil.any_longer(SpringKind::Structural, w, max)
-    });
-    if let Some(limit) = limit_along_lines(&mut after) {
+    if let Some(limit) = limit_past(f, |max| stencil.any_longer(SpringKind::Structural, w, max)) {
         stencil.solve_lines(w, limit);
     }
-    stencil.sweep_xpbd(w, &after);
+    stencil.sweep_xpbd(w, &after_lines(families));
     stencil.end_xpbd(p, h);
 }
 
-/// The structural strain limit of `after` taken out of its sweep, to be solved along
-/// the lines instead ([`xpbd::Family::limit_only`]): a sweep moves a line's tension one
-/// constraint a substep, so a flag's top edge in a gale stayed 19% long under a 10%
-/// limit at 30 substeps; along its lines the limit holds at once.
-fn limit_along_lines(after: &mut [xpbd::Family; 5]) -> Option<xpbd::Family> {
-    let structural = &mut after[SpringKind::Structural as usize];
-    if !structural.limit_only() {
-        return None;
-    }
-    let limit = *structural;
-    structural.on = false;
-    Some(limit)
+/// A compliant structural family `f`'s strain limit alone ([`xpbd::Family::limit`]),
+/// when `longer(max_stretch)` finds a spring past it, to be solved along the lines
+/// ([`xpbd::Family::limit_only`]); `None` without a limit, for an inextensible family
+/// (its lines hold it) or with no spring past it. Projected again, a compliant family
+/// would be twice as stiff; a sweep of its limit moved a line's tension one constraint
+/// a substep, so a flag's top edge in a gale stayed 19% long under a 10% limit at 30
+/// substeps; along its lines the limit holds at once. With no spring past it nothing is
+/// solved (a sweep that moved nothing was a sixth of the crowd's step on denim).
+fn limit_past(f: xpbd::Family, longer: impl FnOnce(f32) -> bool) -> Option<xpbd::Family> {
+    let limited = f.on && f.compliance > 0.0 && f.max_stretch.is_finite();
+    (limited && longer(f.max_stretch)).then(|| xpbd::Family::limit(f.max_stretch))
 }
 
 /// How many times at most the strain limit is solved along the lines at the end of a
@@ -197,42 +192,26 @@ const LIMIT_SOLVES_AT_END: usize = 3;
 /// than its edges are long, pushed out radially) stays.
 fn limit_at_end(cloth: &mut ClothSolver) {
     let f = families(&cloth.params, cloth.clock.h)[SpringKind::Structural as usize];
-    let limited = f.on && f.compliance > 0.0 && f.max_stretch.is_finite();
-    if !limited {
-        return;
-    }
     for _ in 0..LIMIT_SOLVES_AT_END {
         let (x, w) = (&cloth.particles.position, &cloth.particles.inv_mass);
         let springs = &cloth.structure.springs;
-        if !springs.any_longer_than(SpringKind::Structural, x, w, f.max_stretch) {
-            break;
+        let longer = |max| springs.any_longer_than(SpringKind::Structural, x, w, max);
+        let Some(limit) = limit_past(f, longer) else {
+            return;
+        };
+        // An infinite substep: the moves change no velocity.
+        let still = f32::INFINITY;
+        let p = &mut cloth.particles;
+        match (&mut cloth.structure.stencil, &mut cloth.model) {
+            (Some(stencil), _) => {
+                // Nothing damped: the substep's start positions are not loaded.
+                stencil.begin_xpbd(p, &[xpbd::Family::default(); 5]);
+                stencil.solve_lines(&p.inv_mass, limit);
+                stencil.end_xpbd(p, still);
+            }
+            (None, ModelState::Xpbd(constraints)) => constraints.chains.solve(p, limit, still),
+            _ => return,
         }
-        solve_limit(cloth, f.max_stretch);
-    }
-}
-
-/// The structural strain limit `max_stretch` solved once along the lines, moving
-/// positions only.
-fn solve_limit(cloth: &mut ClothSolver, max_stretch: f32) {
-    let p = &mut cloth.particles;
-    let limit = xpbd::Family {
-        on: true,
-        compliance: f32::INFINITY,
-        damping: 0.0,
-        max_stretch,
-    };
-    // An infinite substep: the moves change no velocity.
-    let still = f32::INFINITY;
-    match (&mut cloth.structure.stencil, &mut cloth.model) {
-        (Some(stencil), _) => {
-            let mut only = [xpbd::Family::default(); 5];
-            only[SpringKind::Structural as usize] = limit;
-            stencil.begin_xpbd(p, &only);
-            stencil.solve_lines(&p.inv_mass, limit);
-            stencil.end_xpbd(p, still);
-        }
-        (None, ModelState::Xpbd(constraints)) => constraints.chains.solve(p, limit, still),
-        _ => {}
     }
 }
 
@@ -248,15 +227,12 @@ fn shear_after_lines(families: &[xpbd::Family; 5]) -> bool {
 }
 
 /// What is swept after the lines: the seams again (they pull against them: swept only
-/// before the lines, a seam of the T-shirt stayed 3.5 mm open) and what bounds the
-/// structural length: an inextensible family projected on its own nonlinear lengths
-/// (the T-shirt's armpits, where seams meet, stretched to 8.5% without it and 5.2% with
-/// it), an inextensible shear family before it ([`shear_after_lines`]), or a compliant
-/// family's strain limit when `longer(max_stretch)` finds a spring past it.
-fn after_lines(
-    families: &[xpbd::Family; 5],
-    longer: impl FnOnce(f32) -> bool,
-) -> [xpbd::Family; 5] {
+/// before the lines, a seam of the T-shirt stayed 3.5 mm open) and, for an inextensible
+/// structural family, what bounds its length: the family projected on its own nonlinear
+/// lengths (the T-shirt's armpits, where seams meet, stretched to 8.5% without it and
+/// 5.2% with it), an inextensible shear family before it ([`shear_after_lines`]). A
+/// compliant family's strain limit is solved along the lines instead ([`limit_past`]).
+fn after_lines(families: &[xpbd::Family; 5]) -> [xpbd::Family; 5] {
     let (structural, seam) = (SpringKind::Structural as usize, SpringKind::Seam as usize);
     let mut after = [xpbd::Family::default(); 5];
     after[seam] = families[seam];
@@ -267,16 +243,6 @@ fn after_lines(
         if shear_after_lines(families) {
             after[SpringKind::Shear as usize] = families[SpringKind::Shear as usize];
         }
-    } else if f.on && f.max_stretch.is_finite() && longer(f.max_stretch) {
-        // Compliant: projected again it would be twice as stiff; only its limit, and
-        // only when a spring is past it (a sweep that moves nothing is a sixth of the
-        // crowd's step on denim).
-        after[structural] = xpbd::Family {
-            on: true,
-            compliance: f32::INFINITY,
-            damping: 0.0,
-            max_stretch: f.max_stretch,
-        };
     }
     after
 }

@@ -207,12 +207,7 @@ fn the_strain_limit_along_a_chain_takes_back_only_what_is_past_it() {
     let rest = vec![0.1f32; stretch.len()];
     let mut w = vec![1.0f32; y.len()];
     w[0] = 0.0;
-    let limit = Family {
-        on: true,
-        compliance: f32::INFINITY,
-        damping: 0.0,
-        max_stretch: 1.1,
-    };
+    let limit = Family::limit(1.1);
     assert!(limit.limit_only());
     let moves = tile_solve(&y, &w, &rest, limit);
     y.iter_mut().zip(&moves).for_each(|(a, b)| *a += *b);
